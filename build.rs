@@ -1,0 +1,150 @@
+//! Compiles every WGSL file in `shaders/` to SPIR-V with naga, validating it with every check on.
+//!
+//! A shader error fails the build with `file:line:column: message` followed by naga's annotated
+//! source excerpt. For each shader the build also writes reflection constants (binding numbers,
+//! descriptor kinds, uniform struct sizes, immediate-block size) so that Rust code never hand-syncs
+//! binding numbers: see `src/gpu/shaders.rs`.
+//!
+//! Y convention: SPIR-V is written with `ADJUST_COORDINATE_SPACE`, so shaders work in a Y-up clip
+//! space (like WebGPU/OpenGL) and naga negates `position.y` on the way out. Shadow-map UVs are
+//! therefore `(x * 0.5 + 0.5, 0.5 - y * 0.5)`.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+fn main() {
+    let out_dir = std::env::var("OUT_DIR").expect("OUT_DIR");
+    println!("cargo:rerun-if-changed=shaders");
+    let mut entries: Vec<_> = std::fs::read_dir("shaders")
+        .expect("shaders/ folder")
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "wgsl"))
+        .collect();
+    entries.sort();
+    let mut generated = String::new();
+    let mut failures = Vec::new();
+    for path in &entries {
+        println!("cargo:rerun-if-changed={}", path.display());
+        match compile(path, &out_dir) {
+            Ok(code) => generated.push_str(&code),
+            Err(msg) => failures.push(msg),
+        }
+    }
+    if !failures.is_empty() {
+        for f in &failures {
+            eprintln!("{f}");
+        }
+        // The first line of each failure is `file:line:col: error`, which cargo prints verbatim.
+        panic!("shader compilation failed:\n{}", failures.join("\n"));
+    }
+    std::fs::write(Path::new(&out_dir).join("shaders.rs"), generated).expect("write shaders.rs");
+}
+
+fn location_prefix(path: &Path, source: &str, loc: Option<naga::SourceLocation>) -> String {
+    let _ = source;
+    match loc {
+        Some(l) => format!("{}:{}:{}", path.display(), l.line_number, l.line_position),
+        None => format!("{}:1:1", path.display()),
+    }
+}
+
+fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
+    let source = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let file = path.display().to_string();
+    let module = naga::front::wgsl::parse_str(&source).map_err(|e| {
+        format!(
+            "{}: error: {}\n{}",
+            location_prefix(path, &source, e.location(&source)),
+            e.message(),
+            e.emit_to_string_with_path(&source, &file)
+        )
+    })?;
+    let mut validator = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::IMMEDIATES,
+    );
+    let info = validator.validate(&module).map_err(|e| {
+        format!(
+            "{}: error: {}\n{}",
+            location_prefix(path, &source, e.location(&source)),
+            e.as_inner(),
+            e.emit_to_string_with_path(&source, &file)
+        )
+    })?;
+    let options = naga::back::spv::Options {
+        lang_version: (1, 3),
+        flags: naga::back::spv::WriterFlags::ADJUST_COORDINATE_SPACE
+            | naga::back::spv::WriterFlags::LABEL_VARYINGS
+            | naga::back::spv::WriterFlags::DEBUG,
+        ..Default::default()
+    };
+    let words = naga::back::spv::write_vec(&module, &info, &options, None)
+        .map_err(|e| format!("{}:1:1: error: SPIR-V output: {e}", path.display()))?;
+    let stem = path.file_stem().unwrap().to_string_lossy().to_string();
+    let spv_path = Path::new(out_dir).join(format!("{stem}.spv"));
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    std::fs::write(&spv_path, bytes).map_err(|e| e.to_string())?;
+
+    // Reflection.
+    let mut layouter = naga::proc::Layouter::default();
+    layouter
+        .update(module.to_ctx())
+        .map_err(|e| format!("{}:1:1: error: layout: {e}", path.display()))?;
+    let mut code = String::new();
+    writeln!(code, "/// Generated from `{}`.", file).unwrap();
+    writeln!(code, "pub mod {stem} {{").unwrap();
+    writeln!(code, "    #[allow(unused_imports)] use super::*;").unwrap();
+    writeln!(
+        code,
+        "    /// SPIR-V words.\n    pub const SPIRV: &[u8] = include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{stem}.spv\"));"
+    )
+    .unwrap();
+    let mut bindings = Vec::new();
+    let mut immediate_size = 0u32;
+    for (handle, var) in module.global_variables.iter() {
+        let name = var.name.clone().unwrap_or_default().to_uppercase();
+        let ty = &module.types[var.ty];
+        let size = layouter[var.ty].size;
+        if var.space == naga::AddressSpace::Immediate {
+            immediate_size = size;
+            continue;
+        }
+        let Some(b) = &var.binding else { continue };
+        let kind = match (&var.space, &ty.inner) {
+            (naga::AddressSpace::Uniform, _) => "BindingKind::UniformBuffer",
+            (naga::AddressSpace::Storage { .. }, _) => "BindingKind::StorageBuffer",
+            (_, naga::TypeInner::Sampler { comparison: true }) => "BindingKind::ComparisonSampler",
+            (_, naga::TypeInner::Sampler { comparison: false }) => "BindingKind::Sampler",
+            (_, naga::TypeInner::Image { class, .. }) => match class {
+                naga::ImageClass::Depth { .. } => "BindingKind::DepthTexture",
+                _ => "BindingKind::Texture",
+            },
+            _ => "BindingKind::Other",
+        };
+        // Which stages use it.
+        let mut vertex = false;
+        let mut fragment = false;
+        for (i, ep) in module.entry_points.iter().enumerate() {
+            let used = !info.get_entry_point(i)[handle].is_empty();
+            match ep.stage {
+                naga::ShaderStage::Vertex => vertex |= used,
+                naga::ShaderStage::Fragment => fragment |= used,
+                _ => {}
+            }
+        }
+        writeln!(code, "    /// `{}`: group {}, binding {}.", name.to_lowercase(), b.group, b.binding).unwrap();
+        writeln!(code, "    pub const {name}: ReflectedBinding = ReflectedBinding {{ name: \"{}\", group: {}, binding: {}, kind: {kind}, size: {size}, vertex: {vertex}, fragment: {fragment} }};", name.to_lowercase(), b.group, b.binding).unwrap();
+        bindings.push(name);
+    }
+    writeln!(code, "    /// Every resource binding of the module.").unwrap();
+    writeln!(code, "    pub const BINDINGS: &[ReflectedBinding] = &[{}];", bindings.join(", ")).unwrap();
+    writeln!(code, "    /// Size in bytes of the immediate (push-constant) block, 0 if none.").unwrap();
+    writeln!(code, "    pub const IMMEDIATE_SIZE: u32 = {immediate_size};").unwrap();
+    for ep in &module.entry_points {
+        writeln!(code, "    /// Entry point `{}`.", ep.name).unwrap();
+        writeln!(code, "    pub const ENTRY_{}: &std::ffi::CStr = c\"{}\";", ep.name.to_uppercase(), ep.name).unwrap();
+    }
+    writeln!(code, "}}").unwrap();
+    Ok(code)
+}

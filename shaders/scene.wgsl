@@ -1,0 +1,263 @@
+// Camera pass: Blinn-Phong with tangent-space normal mapping and shadow-map visibility.
+//
+// L = ka*Ia + vis * sum_i [ kd*(I/r^2)*max(0,n.l) + ks*(I/r^2)*max(0,n.h)^p ]
+// where vis is 1 for lights without a shadow map, and for the shadowed light the filtered
+// shadow-map comparison times (geometric n.l > 0). `--view shadow` writes exactly `vis`.
+//
+// Reversed-z everywhere: the shadow map stores the largest depth (closest to the light); a receiver
+// is lit where its light-space depth >= the stored depth (compare op GREATER_OR_EQUAL).
+// Y convention: clip space is Y-up, naga flips Y for Vulkan (build.rs); shadow UV v = 0.5 - 0.5*y.
+
+const MAX_LIGHTS: u32 = 8u;
+const LIGHT_DIRECTIONAL: f32 = 0.0;
+const LIGHT_POINT: f32 = 1.0;
+const LIGHT_SPOT: f32 = 2.0;
+
+const VIEW_LIT: u32 = 0u;
+const VIEW_SHADOW: u32 = 1u;
+const VIEW_NORMALS: u32 = 2u;
+
+struct Light {
+    // xyz: position (point, spot); w: kind (0 directional, 1 point, 2 spot)
+    position: vec4<f32>,
+    // xyz: unit direction the light travels (directional, spot); w: unused
+    direction: vec4<f32>,
+    // rgb: colour * intensity; w: unused
+    color: vec4<f32>,
+    // x: cos(inner cone), y: cos(outer cone)
+    cone: vec4<f32>,
+}
+
+struct Frame {
+    clip_from_world: mat4x4<f32>,
+    light_clip_from_world: mat4x4<f32>,
+    // xyz: camera position in world
+    camera_position: vec4<f32>,
+    // rgb: ambient intensity Ia
+    ambient: vec4<f32>,
+    // x: shadow-map size in texels, y: normal-offset bias in texels,
+    // z: world size of one texel (directional) or per unit distance (spot), w: 1 if shadows on
+    shadow: vec4<f32>,
+    // xyz: shadowed light position (spot), w: index of the shadowed light
+    shadow_light: vec4<f32>,
+    // x: view mode, y: PCF kernel width in bilinear taps (0 = single nearest compare),
+    // z: 1 if hardware linear comparison filtering is used, w: number of lights
+    modes: vec4<u32>,
+    lights: array<Light, 8>,
+}
+
+struct Material {
+    base_color: vec4<f32>,
+    // rgb: emissive factor; w: normal-map scale
+    emissive: vec4<f32>,
+    // x: metallic, y: roughness, z: 1 if a normal map is used, w: 1 if unlit
+    params: vec4<f32>,
+    // x: alpha cutoff (masked materials; 0 = opaque)
+    extra: vec4<f32>,
+}
+
+struct Immediates {
+    world_from_model: mat4x4<f32>,
+    // columns of the normal matrix (inverse transpose of the upper 3x3); normal_x.w = sign of det
+    normal_x: vec4<f32>,
+    normal_y: vec4<f32>,
+    normal_z: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var shadow_map: texture_depth_2d;
+@group(0) @binding(2) var shadow_sampler: sampler_comparison;
+
+@group(1) @binding(0) var<uniform> material: Material;
+@group(1) @binding(1) var base_color_tex: texture_2d<f32>;
+@group(1) @binding(2) var normal_tex: texture_2d<f32>;
+@group(1) @binding(3) var metal_rough_tex: texture_2d<f32>;
+@group(1) @binding(4) var emissive_tex: texture_2d<f32>;
+@group(1) @binding(5) var material_sampler: sampler;
+
+var<immediate> pc: Immediates;
+
+struct VsIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) tangent: vec4<f32>,
+}
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) tangent: vec4<f32>,
+}
+
+@vertex
+fn vs_main(v: VsIn) -> VsOut {
+    var out: VsOut;
+    let world = pc.world_from_model * vec4<f32>(v.position, 1.0);
+    out.world_position = world.xyz;
+    out.clip = frame.clip_from_world * world;
+    let normal_matrix = mat3x3<f32>(pc.normal_x.xyz, pc.normal_y.xyz, pc.normal_z.xyz);
+    out.normal = normal_matrix * v.normal;
+    let m3 = mat3x3<f32>(pc.world_from_model[0].xyz, pc.world_from_model[1].xyz, pc.world_from_model[2].xyz);
+    // A mirroring transform flips the bitangent.
+    out.tangent = vec4<f32>(m3 * v.tangent.xyz, v.tangent.w * pc.normal_x.w);
+    out.uv = v.uv;
+    return out;
+}
+
+// One depth comparison against texel `c` (clamped to the map): 1 = lit.
+fn compare_texel(c: vec2<i32>, depth: f32, size: i32) -> f32 {
+    let cc = clamp(c, vec2<i32>(0), vec2<i32>(size - 1));
+    let stored = textureLoad(shadow_map, cc, 0);
+    return select(0.0, 1.0, depth >= stored);
+}
+
+// Bilinearly weighted 2x2 comparison at a position given in texel units (texel centres at +0.5).
+fn bilinear_compare(p: vec2<f32>, depth: f32, size: i32) -> f32 {
+    if frame.modes.z == 1u {
+        return textureSampleCompareLevel(shadow_map, shadow_sampler, p / f32(size), depth);
+    }
+    let t = p - vec2<f32>(0.5);
+    let i = vec2<i32>(floor(t));
+    let f = t - floor(t);
+    let c00 = compare_texel(i, depth, size);
+    let c10 = compare_texel(i + vec2<i32>(1, 0), depth, size);
+    let c01 = compare_texel(i + vec2<i32>(0, 1), depth, size);
+    let c11 = compare_texel(i + vec2<i32>(1, 1), depth, size);
+    return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
+}
+
+// Filtered shadow-map visibility of world point `p` with geometric normal `ng`, light direction `l`.
+fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>) -> f32 {
+    if frame.shadow.w < 0.5 {
+        return 1.0;
+    }
+    var texel_world = frame.shadow.z;
+    let li = u32(frame.shadow_light.w);
+    if frame.lights[li].position.w == LIGHT_SPOT {
+        texel_world = frame.shadow.z * distance(frame.shadow_light.xyz, p);
+    }
+    // Normal offset: move the lookup point off the surface by a number of shadow texels, more at
+    // grazing angles where acne appears.
+    let cos_theta = clamp(dot(ng, l), 0.0, 1.0);
+    let sin_theta = sqrt(1.0 - cos_theta * cos_theta);
+    let offset = ng * (frame.shadow.y * texel_world * sin_theta);
+    let lc = frame.light_clip_from_world * vec4<f32>(p + offset, 1.0);
+    if lc.w <= 0.0 {
+        return 1.0;
+    }
+    let ndc = lc.xyz / lc.w;
+    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+        return 1.0;
+    }
+    // Depth clamp is on in the shadow pass, so receivers are clamped the same way.
+    let depth = clamp(ndc.z, 0.0, 1.0);
+    let size = i32(frame.shadow.x);
+    let p_texel = uv * frame.shadow.x;
+    let kernel = i32(frame.modes.y);
+    if kernel == 0 {
+        return compare_texel(vec2<i32>(floor(p_texel)), depth, size);
+    }
+    var sum = 0.0;
+    let half = f32(kernel - 1) * 0.5;
+    for (var y = 0; y < kernel; y++) {
+        for (var x = 0; x < kernel; x++) {
+            let o = vec2<f32>(f32(x) - half, f32(y) - half);
+            sum += bilinear_compare(p_texel + o, depth, size);
+        }
+    }
+    return sum / f32(kernel * kernel);
+}
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    let lo = c / 12.92;
+    let hi = pow((c + vec3<f32>(0.055)) / 1.055, vec3<f32>(2.4));
+    return select(hi, lo, c <= vec3<f32>(0.04045));
+}
+
+@fragment
+fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let base = material.base_color * textureSample(base_color_tex, material_sampler, in.uv);
+    if material.extra.x > 0.0 && base.a < material.extra.x {
+        discard;
+    }
+    var n_geo = normalize(in.normal);
+    var n = n_geo;
+    let normal_sample = textureSample(normal_tex, material_sampler, in.uv).xyz;
+    if material.params.z > 0.5 {
+        let t_raw = in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz);
+        if dot(t_raw, t_raw) > 1e-12 {
+            let t = normalize(t_raw);
+            let b = cross(n_geo, t) * select(-1.0, 1.0, in.tangent.w >= 0.0);
+            var tn = normal_sample * 2.0 - vec3<f32>(1.0);
+            tn = vec3<f32>(tn.xy * material.emissive.w, tn.z);
+            n = normalize(t * tn.x + b * tn.y + n_geo * tn.z);
+        }
+    }
+    if !front_facing {
+        n_geo = -n_geo;
+        n = -n;
+    }
+    let mr = textureSample(metal_rough_tex, material_sampler, in.uv);
+    let metallic = clamp(material.params.x * mr.b, 0.0, 1.0);
+    let roughness = clamp(material.params.y * mr.g, 0.03, 1.0);
+    // glTF metallic-roughness -> Blinn-Phong (same mapping as src/scene/material.rs).
+    let kd = base.rgb * (1.0 - metallic);
+    let ks = mix(vec3<f32>(0.04), base.rgb, metallic);
+    let alpha = roughness * roughness;
+    let shininess = clamp(2.0 / (alpha * alpha) - 2.0, 1.0, 2048.0);
+    let ka = base.rgb;
+    let emissive = material.emissive.rgb * textureSample(emissive_tex, material_sampler, in.uv).rgb;
+
+    let p = in.world_position;
+    let v = normalize(frame.camera_position.xyz - p);
+    var color = ka * frame.ambient.rgb + emissive;
+    var shadow_term = 1.0;
+    let count = min(frame.modes.w, MAX_LIGHTS);
+    for (var i = 0u; i < count; i++) {
+        let light = frame.lights[i];
+        var l: vec3<f32>;
+        var radiance = light.color.rgb;
+        if light.position.w == LIGHT_DIRECTIONAL {
+            l = -light.direction.xyz;
+        } else {
+            let d = light.position.xyz - p;
+            let r2 = max(dot(d, d), 1e-8);
+            l = d * inverseSqrt(r2);
+            radiance = radiance / r2;
+            if light.position.w == LIGHT_SPOT {
+                let cd = dot(-l, light.direction.xyz);
+                radiance *= smoothstep(light.cone.y, light.cone.x, cd);
+            }
+        }
+        var vis = select(0.0, 1.0, dot(n_geo, l) > 0.0);
+        if u32(frame.shadow_light.w) == i {
+            if frame.shadow.w > 0.5 {
+                vis *= shadow_visibility(p, n_geo, l);
+            }
+            shadow_term = vis;
+        }
+        let h = normalize(l + v);
+        let ndl = max(dot(n, l), 0.0);
+        let ndh = max(dot(n, h), 0.0);
+        color += vis * radiance * (kd * ndl + ks * pow(ndh, shininess));
+    }
+    if material.params.w > 0.5 {
+        color = base.rgb;
+    }
+    switch frame.modes.x {
+        case 1u: {
+            // Debug views write values that the sRGB target stores unchanged as bytes.
+            return vec4<f32>(srgb_to_linear(vec3<f32>(shadow_term)), 1.0);
+        }
+        case 2u: {
+            return vec4<f32>(srgb_to_linear(n * 0.5 + vec3<f32>(0.5)), 1.0);
+        }
+        default: {
+            return vec4<f32>(color, 1.0);
+        }
+    }
+}

@@ -1,0 +1,130 @@
+//! Axis-aligned bounding boxes.
+
+use glam::{Mat4, Vec3};
+
+/// An axis-aligned box. `Aabb::EMPTY` has min > max and contains nothing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box (the identity of `union`).
+    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
+
+    /// A box from two corners.
+    pub fn new(min: Vec3, max: Vec3) -> Self {
+        Self { min, max }
+    }
+
+    /// The smallest box around `points` (empty for no points; non-finite points are skipped).
+    pub fn from_points<I: IntoIterator<Item = Vec3>>(points: I) -> Self {
+        let mut b = Self::EMPTY;
+        for p in points {
+            if p.is_finite() {
+                b.grow(p);
+            }
+        }
+        b
+    }
+
+    /// True when the box holds no point.
+    pub fn is_empty(&self) -> bool {
+        !(self.min.x <= self.max.x && self.min.y <= self.max.y && self.min.z <= self.max.z)
+    }
+
+    /// Extends the box to hold `p`.
+    pub fn grow(&mut self, p: Vec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    /// The smallest box holding both.
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    /// The overlap of two boxes (may be empty).
+    pub fn intersection(&self, o: &Aabb) -> Aabb {
+        Aabb { min: self.min.max(o.min), max: self.max.min(o.max) }
+    }
+
+    /// Centre point.
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Size along each axis.
+    pub fn extent(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    /// Length of the diagonal (0 for an empty box).
+    pub fn diagonal(&self) -> f32 {
+        if self.is_empty() {
+            0.0
+        } else {
+            self.extent().length()
+        }
+    }
+
+    /// The 8 corners.
+    pub fn corners(&self) -> [Vec3; 8] {
+        let (a, b) = (self.min, self.max);
+        [
+            Vec3::new(a.x, a.y, a.z),
+            Vec3::new(b.x, a.y, a.z),
+            Vec3::new(a.x, b.y, a.z),
+            Vec3::new(b.x, b.y, a.z),
+            Vec3::new(a.x, a.y, b.z),
+            Vec3::new(b.x, a.y, b.z),
+            Vec3::new(a.x, b.y, b.z),
+            Vec3::new(b.x, b.y, b.z),
+        ]
+    }
+
+    /// The box around this box's corners after an affine transform.
+    pub fn transformed(&self, m: &Mat4) -> Aabb {
+        if self.is_empty() {
+            return *self;
+        }
+        Aabb::from_points(self.corners().iter().map(|c| m.transform_point3(*c)))
+    }
+
+    /// True when the boxes overlap (touching counts).
+    pub fn overlaps(&self, o: &Aabb) -> bool {
+        !self.intersection(o).is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_union_and_intersection() {
+        let a = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let b = Aabb::new(Vec3::splat(0.5), Vec3::splat(2.0));
+        assert!(Aabb::EMPTY.is_empty());
+        assert_eq!(Aabb::EMPTY.union(&a), a);
+        assert_eq!(a.intersection(&b), Aabb::new(Vec3::splat(0.5), Vec3::ONE));
+        assert!(a.intersection(&Aabb::new(Vec3::splat(3.0), Vec3::splat(4.0))).is_empty());
+        assert!(a.overlaps(&b));
+        // A flat box is not empty.
+        assert!(!Aabb::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0)).is_empty());
+    }
+
+    #[test]
+    fn transform_rotated_box() {
+        let a = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+        let m = Mat4::from_rotation_y(std::f32::consts::FRAC_PI_4);
+        let t = a.transformed(&m);
+        assert!((t.max.x - 2f32.sqrt()).abs() < 1e-5);
+        assert!((t.max.y - 1.0).abs() < 1e-6);
+        let s = Aabb::from_points([Vec3::ONE, Vec3::NAN, -Vec3::ONE]);
+        assert_eq!(s, a);
+    }
+}

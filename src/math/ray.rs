@@ -1,0 +1,172 @@
+//! Rays: Möller–Trumbore ray–triangle and slab ray–AABB intersection.
+
+use super::Aabb;
+use glam::Vec3;
+
+/// A ray `origin + t * dir`. `inv_dir` is cached for slab tests (±∞ for zero components).
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    /// Start point.
+    pub origin: Vec3,
+    /// Direction (need not be unit length; t is in units of it).
+    pub dir: Vec3,
+    /// Component-wise 1 / dir.
+    pub inv_dir: Vec3,
+}
+
+impl Ray {
+    /// A ray from `origin` along `dir`.
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Self { origin, dir, inv_dir: Vec3::ONE / dir }
+    }
+
+    /// The point at parameter `t`.
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
+/// A ray–triangle hit: distance parameter and barycentric (u, v) of vertices 1 and 2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Barycentric weight of the second vertex.
+    pub u: f32,
+    /// Barycentric weight of the third vertex.
+    pub v: f32,
+}
+
+/// Möller–Trumbore: the hit of `ray` with triangle (a, b, c) for t in (t_min, t_max), both faces.
+/// Rays parallel to the triangle's plane (|det| below a relative epsilon) miss. Edges count as hits.
+pub fn ray_triangle(ray: &Ray, a: Vec3, b: Vec3, c: Vec3, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+    let e1 = b - a;
+    let e2 = c - a;
+    let p = ray.dir.cross(e2);
+    let det = e1.dot(p);
+    let scale = e1.length() * e2.length() * ray.dir.length();
+    if det.abs() <= 1e-9 * scale || scale == 0.0 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = ray.origin - a;
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = ray.dir.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(q) * inv;
+    if t > t_min && t < t_max {
+        Some(TriangleHit { t, u, v })
+    } else {
+        None
+    }
+}
+
+/// Slab test: the parameter interval [t_enter, t_exit] where `ray` is inside `b`, clipped to
+/// [t_min, t_max]. A flat box (t_enter == t_exit) is a hit; t_exit < t_min is a miss. A ray that
+/// starts inside the box enters at t_min.
+pub fn ray_aabb(ray: &Ray, b: &Aabb, t_min: f32, t_max: f32) -> Option<(f32, f32)> {
+    let mut t0 = t_min;
+    let mut t1 = t_max;
+    for axis in 0..3 {
+        let o = ray.origin[axis];
+        let inv = ray.inv_dir[axis];
+        let (lo, hi) = (b.min[axis], b.max[axis]);
+        if inv.is_infinite() {
+            // Parallel to this slab: inside it or never.
+            if o < lo || o > hi {
+                return None;
+            }
+            continue;
+        }
+        let mut ta = (lo - o) * inv;
+        let mut tb = (hi - o) * inv;
+        if ta > tb {
+            std::mem::swap(&mut ta, &mut tb);
+        }
+        // max/min written so NaN (0 * inf) never widens the interval.
+        t0 = if ta > t0 { ta } else { t0 };
+        t1 = if tb < t1 { tb } else { t1 };
+        if t0 > t1 {
+            return None;
+        }
+    }
+    Some((t0, t1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const A: Vec3 = Vec3::new(0.0, 0.0, 0.0);
+    const B: Vec3 = Vec3::new(1.0, 0.0, 0.0);
+    const C: Vec3 = Vec3::new(0.0, 1.0, 0.0);
+
+    #[test]
+    fn through_centroid() {
+        let centroid = (A + B + C) / 3.0;
+        let r = Ray::new(centroid + Vec3::Z * 2.0, -Vec3::Z);
+        let h = ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).unwrap();
+        assert!((h.t - 2.0).abs() < 1e-6);
+        assert!((h.u - 1.0 / 3.0).abs() < 1e-6 && (h.v - 1.0 / 3.0).abs() < 1e-6);
+        // From below too (both faces).
+        let r = Ray::new(centroid - Vec3::Z, Vec3::Z);
+        assert!(ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_some());
+    }
+
+    #[test]
+    fn along_edge_and_outside() {
+        // Hits exactly on the edge AB count.
+        let r = Ray::new(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z);
+        let h = ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).unwrap();
+        assert!(h.v.abs() < 1e-7 && (h.u - 0.5).abs() < 1e-6);
+        let r = Ray::new(Vec3::new(0.6, 0.6, 1.0), -Vec3::Z);
+        assert!(ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn parallel_and_behind() {
+        let r = Ray::new(Vec3::new(0.2, 0.2, 0.0), Vec3::X);
+        assert!(ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(), "in-plane ray");
+        let r = Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::X);
+        assert!(ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(), "parallel above");
+        let r = Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::Z);
+        assert!(ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(), "behind origin");
+        // Limited range.
+        let r = Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
+        assert!(ray_triangle(&r, A, B, C, 0.0, 0.5).is_none());
+        // Degenerate triangle.
+        assert!(ray_triangle(&r, A, B, B, 0.0, 10.0).is_none());
+    }
+
+    #[test]
+    fn aabb_hits_misses_inside_and_flat() {
+        let b = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let r = Ray::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z);
+        assert_eq!(ray_aabb(&r, &b, 0.0, f32::INFINITY), Some((1.0, 2.0)));
+        // Starting inside: enters at t_min.
+        let r = Ray::new(Vec3::splat(0.5), Vec3::X);
+        assert_eq!(ray_aabb(&r, &b, 0.0, f32::INFINITY), Some((0.0, 0.5)));
+        // Box entirely behind: t_exit < 0 is a miss.
+        let r = Ray::new(Vec3::new(0.5, 0.5, 3.0), Vec3::Z);
+        assert_eq!(ray_aabb(&r, &b, 0.0, f32::INFINITY), None);
+        // A flat box (zero thickness in y) hit straight on: t_enter == t_exit is a hit.
+        let flat = Aabb::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 1.0, 1.0));
+        let r = Ray::new(Vec3::new(0.5, 3.0, 0.5), -Vec3::Y);
+        assert_eq!(ray_aabb(&r, &flat, 0.0, f32::INFINITY), Some((2.0, 2.0)));
+        // Grazing the flat box inside its plane.
+        let r = Ray::new(Vec3::new(-1.0, 1.0, 0.5), Vec3::X);
+        assert_eq!(ray_aabb(&r, &flat, 0.0, f32::INFINITY), Some((1.0, 2.0)));
+        // Parallel, outside the slab.
+        let r = Ray::new(Vec3::new(-1.0, 1.5, 0.5), Vec3::X);
+        assert_eq!(ray_aabb(&r, &flat, 0.0, f32::INFINITY), None);
+        // Through a corner exactly.
+        let r = Ray::new(Vec3::new(-1.0, -1.0, 0.5), Vec3::new(1.0, 1.0, 0.0));
+        assert_eq!(ray_aabb(&r, &b, 0.0, f32::INFINITY), Some((1.0, 2.0)));
+    }
+}

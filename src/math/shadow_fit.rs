@@ -1,0 +1,385 @@
+//! Fitting a light's projection to what matters ("model no more than a scene needs").
+//!
+//! Directional lights: the orthographic light frustum covers the receivers the camera can see
+//! (camera frustum ∩ scene bounds, computed exactly by clipping the two convex solids against each
+//! other) and reaches towards the light far enough to include every caster in the scene bounds.
+//! With `snap`, the square extent is quantised to steps of 2^(1/8) and the origin is snapped to
+//! whole shadow texels in a light space that only rotates with the light, so camera motion moves
+//! the map by whole texels and shadow edges do not shimmer.
+
+use super::projection::{orthographic_reversed, perspective_infinite_reversed};
+use super::Aabb;
+use glam::{Mat4, Vec3, Vec4};
+
+/// A camera frustum to fit against.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraFrustum {
+    /// World → view (right-handed, looking down −Z).
+    pub view_from_world: Mat4,
+    /// Vertical field of view in radians.
+    pub fov_y: f32,
+    /// Width / height.
+    pub aspect: f32,
+    /// Near distance.
+    pub near: f32,
+    /// Far distance (use the scene's extent for an infinite projection).
+    pub far: f32,
+}
+
+impl CameraFrustum {
+    /// The 8 corners in world space: near plane first (−−, +−, −+, ++ in x/y), then far.
+    pub fn corners(&self) -> [Vec3; 8] {
+        let world_from_view = self.view_from_world.inverse();
+        let ty = (self.fov_y * 0.5).tan();
+        let tx = ty * self.aspect;
+        let mut out = [Vec3::ZERO; 8];
+        for (i, d) in [self.near, self.far].into_iter().enumerate() {
+            for (j, (sx, sy)) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].into_iter().enumerate() {
+                let p = Vec3::new(sx * tx * d, sy * ty * d, -d);
+                out[i * 4 + j] = world_from_view.transform_point3(p);
+            }
+        }
+        out
+    }
+
+    /// The 6 faces as polygons (world space), each counter-clockwise seen from outside.
+    fn faces(&self) -> [[Vec3; 4]; 6] {
+        let c = self.corners();
+        [
+            [c[0], c[2], c[3], c[1]], // near
+            [c[4], c[5], c[7], c[6]], // far
+            [c[0], c[4], c[6], c[2]], // left
+            [c[1], c[3], c[7], c[5]], // right
+            [c[0], c[1], c[5], c[4]], // bottom
+            [c[2], c[6], c[7], c[3]], // top
+        ]
+    }
+}
+
+/// A half-space n·p + d ≥ 0.
+#[derive(Clone, Copy, Debug)]
+struct Plane {
+    n: Vec3,
+    d: f32,
+}
+
+impl Plane {
+    fn dist(&self, p: Vec3) -> f32 {
+        self.n.dot(p) + self.d
+    }
+}
+
+fn clip_polygon(poly: &[Vec3], plane: Plane) -> Vec<Vec3> {
+    let mut out = Vec::with_capacity(poly.len() + 2);
+    for i in 0..poly.len() {
+        let a = poly[i];
+        let b = poly[(i + 1) % poly.len()];
+        let (da, db) = (plane.dist(a), plane.dist(b));
+        if da >= 0.0 {
+            out.push(a);
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            let t = da / (da - db);
+            out.push(a + (b - a) * t);
+        }
+    }
+    out
+}
+
+fn box_planes(b: &Aabb) -> [Plane; 6] {
+    [
+        Plane { n: Vec3::X, d: -b.min.x },
+        Plane { n: -Vec3::X, d: b.max.x },
+        Plane { n: Vec3::Y, d: -b.min.y },
+        Plane { n: -Vec3::Y, d: b.max.y },
+        Plane { n: Vec3::Z, d: -b.min.z },
+        Plane { n: -Vec3::Z, d: b.max.z },
+    ]
+}
+
+fn box_faces(b: &Aabb) -> [[Vec3; 4]; 6] {
+    let c = b.corners();
+    [
+        [c[0], c[2], c[6], c[4]],
+        [c[1], c[5], c[7], c[3]],
+        [c[0], c[4], c[5], c[1]],
+        [c[2], c[3], c[7], c[6]],
+        [c[0], c[1], c[3], c[2]],
+        [c[4], c[6], c[7], c[5]],
+    ]
+}
+
+/// The vertices of (camera frustum ∩ box): every face of each solid clipped by the other.
+/// Empty when they do not meet.
+pub fn frustum_box_intersection(f: &CameraFrustum, b: &Aabb) -> Vec<Vec3> {
+    if b.is_empty() {
+        return Vec::new();
+    }
+    let faces = f.faces();
+    let centre = f.corners().iter().copied().sum::<Vec3>() / 8.0;
+    let fplanes: Vec<Plane> = faces
+        .iter()
+        .map(|q| {
+            let mut n = (q[1] - q[0]).cross(q[2] - q[0]).normalize_or_zero();
+            let mut d = -n.dot(q[0]);
+            if n.dot(centre) + d < 0.0 {
+                n = -n;
+                d = -d;
+            }
+            Plane { n, d }
+        })
+        .collect();
+    let mut pts = Vec::new();
+    for face in faces.iter() {
+        let mut poly = face.to_vec();
+        for p in box_planes(b) {
+            poly = clip_polygon(&poly, p);
+        }
+        pts.extend(poly);
+    }
+    for face in box_faces(b).iter() {
+        let mut poly = face.to_vec();
+        for p in &fplanes {
+            poly = clip_polygon(&poly, *p);
+        }
+        pts.extend(poly);
+    }
+    pts
+}
+
+/// What a fitted directional-light projection needs.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectionalFitInput {
+    /// Direction the light travels (from the light into the scene).
+    pub direction: Vec3,
+    /// Bounds of everything that can cast or receive.
+    pub scene_bounds: Aabb,
+    /// The camera; `None` fits the whole scene.
+    pub camera: Option<CameraFrustum>,
+    /// Shadow-map size in texels.
+    pub map_size: u32,
+    /// Quantise the extent and snap the origin to whole texels.
+    pub snap: bool,
+}
+
+/// A fitted directional-light projection.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectionalFit {
+    /// World → light view (rotation only: the light space origin is the world origin).
+    pub light_view_from_world: Mat4,
+    /// World → light clip space (reversed-z orthographic).
+    pub light_clip_from_world: Mat4,
+    /// Light-space box covered: x/y extent and z from far (min) to near (max).
+    pub light_box: Aabb,
+    /// World size of one shadow texel.
+    pub texel_world: f32,
+}
+
+/// World → light view rotation for a light travelling along `direction`.
+pub fn light_view_rotation(direction: Vec3) -> Mat4 {
+    let d = direction.try_normalize().unwrap_or(-Vec3::Y);
+    let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    Mat4::look_to_rh(Vec3::ZERO, d, up)
+}
+
+/// Quantises `x > 0` up to the next step of a geometric ladder with 8 steps per doubling.
+pub fn quantize_extent(x: f32) -> f32 {
+    let steps = (x.log2() * 8.0).ceil();
+    (steps / 8.0).exp2()
+}
+
+/// Fits an orthographic light projection (see the module documentation).
+pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
+    let view = light_view_rotation(input.direction);
+    let scene = if input.scene_bounds.is_empty() {
+        Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))
+    } else {
+        input.scene_bounds
+    };
+    let scene_l = scene.transformed(&view);
+    let receivers_world = match &input.camera {
+        Some(c) => frustum_box_intersection(c, &scene),
+        None => Vec::new(),
+    };
+    let mut recv = if receivers_world.is_empty() {
+        scene_l
+    } else {
+        Aabb::from_points(receivers_world.iter().map(|p| view.transform_point3(*p))).intersection(&scene_l)
+    };
+    if recv.is_empty() {
+        recv = scene_l;
+    }
+    let size = input.map_size.max(1) as f32;
+    // Guard against a degenerate (flat or point) receiver set.
+    let min_extent = (scene.diagonal() * 1e-4).max(1e-4);
+    let raw = (recv.max.x - recv.min.x).max(recv.max.y - recv.min.y).max(min_extent);
+    let cx = 0.5 * (recv.min.x + recv.max.x);
+    let cy = 0.5 * (recv.min.y + recv.max.y);
+    // z: from the farthest receiver to the caster nearest the light (light looks down −z).
+    let z_far = recv.min.z;
+    let z_near = scene_l.max.z;
+    let (lo_x, lo_y, extent, texel, mut zf, mut zn);
+    if input.snap {
+        extent = quantize_extent(raw * (1.0 + 4.0 / size));
+        texel = extent / size;
+        lo_x = ((cx - 0.5 * extent) / texel).floor() * texel;
+        lo_y = ((cy - 0.5 * extent) / texel).floor() * texel;
+        zf = ((z_far / texel).floor() - 2.0) * texel;
+        zn = ((z_near / texel).ceil() + 2.0) * texel;
+    } else {
+        extent = raw;
+        texel = extent / size;
+        lo_x = cx - 0.5 * extent;
+        lo_y = cy - 0.5 * extent;
+        zf = z_far - 2.0 * texel;
+        zn = z_near + 2.0 * texel;
+    }
+    if zn - zf < texel {
+        zn += texel;
+        zf -= texel;
+    }
+    // View space looks down −z: near distance = −zn, far distance = −zf.
+    let proj = orthographic_reversed(lo_x, lo_x + extent, lo_y, lo_y + extent, -zn, -zf);
+    DirectionalFit {
+        light_view_from_world: view,
+        light_clip_from_world: proj * view,
+        light_box: Aabb::new(Vec3::new(lo_x, lo_y, zf), Vec3::new(lo_x + extent, lo_y + extent, zn)),
+        texel_world: texel,
+    }
+}
+
+/// A spot light's shadow projection: reversed-z infinite perspective from `position` along
+/// `direction`, field of view the outer cone plus a margin. Returns (clip_from_world, tan of half
+/// fov): a texel at distance d is `2 * d * tan_half / map_size` wide.
+pub fn fit_spot(position: Vec3, direction: Vec3, outer_cone: f32, scene_bounds: &Aabb) -> (Mat4, f32) {
+    let d = direction.try_normalize().unwrap_or(-Vec3::Y);
+    let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let view = Mat4::look_to_rh(position, d, up);
+    let half = (outer_cone.clamp(0.01, 1.45) * 1.05).min(1.5);
+    let near = (scene_bounds.diagonal() * 1e-3).max(1e-3);
+    let proj = perspective_infinite_reversed(2.0 * half, 1.0, near);
+    (proj * view, half.tan())
+}
+
+/// Light-space clip position of `p` (after the divide).
+pub fn project(m: &Mat4, p: Vec3) -> Vec3 {
+    let c = *m * Vec4::new(p.x, p.y, p.z, 1.0);
+    c.truncate() / c.w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera(eye: Vec3, target: Vec3) -> CameraFrustum {
+        CameraFrustum {
+            view_from_world: Mat4::look_at_rh(eye, target, Vec3::Y),
+            fov_y: 0.8,
+            aspect: 16.0 / 9.0,
+            near: 0.1,
+            far: 60.0,
+        }
+    }
+
+    fn scene() -> Aabb {
+        Aabb::new(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 3.0, 10.0))
+    }
+
+    #[test]
+    fn intersection_points_are_inside_both() {
+        let cam = camera(Vec3::new(0.0, 5.0, 15.0), Vec3::ZERO);
+        let pts = frustum_box_intersection(&cam, &scene());
+        assert!(!pts.is_empty());
+        let grown = Aabb::new(scene().min - 1e-3, scene().max + 1e-3);
+        for p in &pts {
+            assert!(grown.overlaps(&Aabb::new(*p, *p)), "{p}");
+        }
+        // A camera looking away sees nothing of the box.
+        let away = camera(Vec3::new(0.0, 5.0, 15.0), Vec3::new(0.0, 5.0, 30.0));
+        assert!(frustum_box_intersection(&away, &scene()).is_empty());
+    }
+
+    #[test]
+    fn fitted_extent_at_most_scene_and_covers_receivers() {
+        let dir = Vec3::new(-0.3, -1.0, -0.2).normalize();
+        let cam = camera(Vec3::new(2.0, 2.0, 4.0), Vec3::new(0.0, 0.0, 0.0));
+        for snap in [false, true] {
+            let whole = fit_directional(&DirectionalFitInput {
+                direction: dir,
+                scene_bounds: scene(),
+                camera: None,
+                map_size: 2048,
+                snap,
+            });
+            let fit = fit_directional(&DirectionalFitInput {
+                direction: dir,
+                scene_bounds: scene(),
+                camera: Some(cam),
+                map_size: 2048,
+                snap,
+            });
+            let e = fit.light_box.extent();
+            let w = whole.light_box.extent();
+            assert!(e.x <= w.x + 1e-3 && e.y <= w.y + 1e-3, "{e} vs {w}");
+            assert!(fit.texel_world < whole.texel_world);
+            // Every receiver point lands inside the light's clip box.
+            for p in frustum_box_intersection(&cam, &scene()) {
+                let q = project(&fit.light_clip_from_world, p);
+                assert!(q.x.abs() <= 1.0 + 1e-4 && q.y.abs() <= 1.0 + 1e-4 && (0.0..=1.0).contains(&q.z), "{q}");
+            }
+            // Every scene corner (potential caster) is at depth <= 1 or clamps there; the ones
+            // that can shade receivers are inside the depth range.
+            for c in scene().corners() {
+                let q = project(&fit.light_clip_from_world, c);
+                assert!(q.z <= 1.0 + 1e-5, "caster beyond near: {q}");
+            }
+        }
+    }
+
+    #[test]
+    fn snapped_fit_moves_by_whole_texels() {
+        let dir = Vec3::new(-0.4, -1.0, 0.3).normalize();
+        let base = fit_directional(&DirectionalFitInput {
+            direction: dir,
+            scene_bounds: scene(),
+            camera: Some(camera(Vec3::new(3.0, 4.0, 9.0), Vec3::ZERO)),
+            map_size: 1024,
+            snap: true,
+        });
+        for i in 1..20 {
+            let dx = i as f32 * base.texel_world * 0.09;
+            let moved = fit_directional(&DirectionalFitInput {
+                direction: dir,
+                scene_bounds: scene(),
+                camera: Some(camera(Vec3::new(3.0 + dx, 4.0, 9.0), Vec3::new(dx, 0.0, 0.0))),
+                map_size: 1024,
+                snap: true,
+            });
+            assert_eq!(moved.texel_world, base.texel_world);
+            let shift = (moved.light_box.min - base.light_box.min) / base.texel_world;
+            assert!((shift.x - shift.x.round()).abs() < 1e-2 && (shift.y - shift.y.round()).abs() < 1e-2, "{shift}");
+        }
+    }
+
+    #[test]
+    fn quantize_is_monotone_and_bounded() {
+        let mut last = 0.0;
+        for i in 1..1000 {
+            let x = i as f32 * 0.037;
+            let q = quantize_extent(x);
+            assert!(q >= x * 0.9999 && q <= x * 1.0906 + 1e-6, "{x} {q}");
+            assert!(q >= last);
+            last = q;
+        }
+    }
+
+    #[test]
+    fn spot_projection_centre_and_cone() {
+        let (m, tan_half) = fit_spot(Vec3::new(0.0, 5.0, 0.0), -Vec3::Y, 0.5, &scene());
+        let q = project(&m, Vec3::ZERO);
+        assert!(q.x.abs() < 1e-5 && q.y.abs() < 1e-5 && q.z > 0.0 && q.z < 1.0);
+        assert!(tan_half > 0.5f32.tan());
+        let edge = project(&m, Vec3::new(5.0 * 0.5f32.tan(), 0.0, 0.0));
+        assert!(edge.x.abs() < 1.0 && edge.x.abs() > 0.8);
+    }
+}

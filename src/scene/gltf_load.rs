@@ -1,0 +1,523 @@
+//! glTF 2.0 import (`.gltf` with external or data-URI resources, and `.glb`) into a [`Scene`].
+//!
+//! Untrusted input: every accessor is bounds-checked against its buffer view and buffer before it
+//! is read, indices are checked against the vertex count, external files must resolve inside the
+//! model's folder, and any remaining panic inside the parser is turned into an error.
+
+use super::tangents::{compute_smooth_normals, count_degenerate, fallback_tangent, generate_mikktspace};
+use super::{AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Primitive, Scene, Texture, TextureRef};
+use base64::Engine as _;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use std::path::{Component, Path, PathBuf};
+
+/// Largest texture side accepted (larger images are refused with a warning).
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+/// Largest file accepted, in bytes.
+pub const MAX_FILE_BYTES: u64 = 2 << 30;
+
+/// Why a glTF file could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    /// The file or one of its resources could not be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// Path tried.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// The file is empty.
+    #[error("{0}: file is empty")]
+    Empty(PathBuf),
+    /// The file is not valid glTF (bad JSON, truncated GLB, failed validation).
+    #[error("{path}: not a valid glTF file: {message}")]
+    Invalid {
+        /// File.
+        path: PathBuf,
+        /// What the parser said.
+        message: String,
+    },
+    /// A URI points outside the model's folder (or is absolute, or a remote URL).
+    #[error("{path}: {what} URI '{uri}' is refused: it points outside the model's folder")]
+    OutsideFolder {
+        /// File.
+        path: PathBuf,
+        /// "buffer 0", "image 3".
+        what: String,
+        /// The URI.
+        uri: String,
+    },
+    /// A structural problem found while reading data (bounds, indices, counts).
+    #[error("{path}: {message}")]
+    Corrupt {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file requires an extension umbra does not implement.
+    #[error("{path}: requires unsupported extension {extension}")]
+    UnsupportedExtension {
+        /// File.
+        path: PathBuf,
+        /// Extension name.
+        extension: String,
+    },
+}
+
+/// Extensions that may appear in `extensionsRequired`.
+const SUPPORTED_REQUIRED: &[&str] = &["KHR_materials_unlit", "KHR_lights_punctual", "KHR_texture_transform"];
+
+/// Loads a `.gltf` or `.glb` file into a scene.
+pub fn load_gltf(path: &Path) -> Result<Scene, LoadError> {
+    let meta = std::fs::metadata(path).map_err(|e| LoadError::Io { path: path.into(), source: e })?;
+    if meta.is_dir() {
+        return Err(LoadError::Io {
+            path: path.into(),
+            source: std::io::Error::other("is a directory, not a glTF file"),
+        });
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(LoadError::Corrupt { path: path.into(), message: format!("file is {} bytes, over the limit", meta.len()) });
+    }
+    let bytes = std::fs::read(path).map_err(|e| LoadError::Io { path: path.into(), source: e })?;
+    if bytes.is_empty() {
+        return Err(LoadError::Empty(path.into()));
+    }
+    let p = path.to_path_buf();
+    // The gltf crate is trusted not to panic, but a user's file must never crash us.
+    match std::panic::catch_unwind(|| load_bytes(&p, &bytes)) {
+        Ok(r) => r,
+        Err(_) => Err(LoadError::Corrupt { path: path.into(), message: "malformed data (parser failure)".into() }),
+    }
+}
+
+fn invalid(path: &Path, e: impl std::fmt::Display) -> LoadError {
+    LoadError::Invalid { path: path.into(), message: e.to_string().replace('\n', " ") }
+}
+
+fn corrupt(path: &Path, message: String) -> LoadError {
+    LoadError::Corrupt { path: path.into(), message }
+}
+
+fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| invalid(path, e))?;
+    for ext in gltf.extensions_required() {
+        if !SUPPORTED_REQUIRED.contains(&ext) {
+            return Err(LoadError::UnsupportedExtension { path: path.into(), extension: ext.to_string() });
+        }
+    }
+    let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_else(|| PathBuf::from("."));
+    let base = if base.as_os_str().is_empty() { PathBuf::from(".") } else { base };
+    let mut scene = Scene {
+        name: path.file_name().map(|s| s.to_string_lossy().to_string()).unwrap_or_default(),
+        ..Default::default()
+    };
+
+    // Buffers.
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for b in gltf.buffers() {
+        let data = match b.source() {
+            gltf::buffer::Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or_else(|| corrupt(path, format!("buffer {} refers to a GLB binary chunk that is missing", b.index())))?,
+            gltf::buffer::Source::Uri(uri) => read_uri(path, &base, uri, &format!("buffer {}", b.index()))?,
+        };
+        if data.len() < b.length() {
+            return Err(corrupt(
+                path,
+                format!("buffer {} holds {} bytes but declares {}", b.index(), data.len(), b.length()),
+            ));
+        }
+        buffers.push(data);
+    }
+    for v in gltf.views() {
+        let end = v.offset().checked_add(v.length());
+        if end.is_none_or(|e| e > buffers[v.buffer().index()].len()) {
+            return Err(corrupt(path, format!("buffer view {} reads past the end of buffer {}", v.index(), v.buffer().index())));
+        }
+    }
+    for a in gltf.accessors() {
+        check_accessor(path, &a)?;
+    }
+
+    // Images (decoded once; a broken image becomes a warning and the material slot falls back).
+    let mut image_slots: Vec<Option<usize>> = Vec::new();
+    for img in gltf.images() {
+        let what = format!("image {}", img.index());
+        let data = match img.source() {
+            gltf::image::Source::View { view, .. } => {
+                let buf = &buffers[view.buffer().index()];
+                Ok(buf[view.offset()..view.offset() + view.length()].to_vec())
+            }
+            gltf::image::Source::Uri { uri, .. } => read_uri(path, &base, uri, &what),
+        };
+        let data = match data {
+            Ok(d) => d,
+            Err(e @ LoadError::OutsideFolder { .. }) => return Err(e),
+            Err(e) => {
+                scene.warn(format!("{what} not loaded ({e}); using a default"));
+                image_slots.push(None);
+                continue;
+            }
+        };
+        match decode_image(&data) {
+            Ok((w, h, rgba)) => {
+                scene.textures.push(Texture { name: img.name().unwrap_or(&what).to_string(), width: w, height: h, rgba });
+                image_slots.push(Some(scene.textures.len() - 1));
+            }
+            Err(msg) => {
+                scene.warn(format!("{what} could not be decoded ({msg}); using a default"));
+                image_slots.push(None);
+            }
+        }
+    }
+    let tex_ref = |t: gltf::Texture| image_slots.get(t.source().index()).copied().flatten().map(|texture| TextureRef { texture });
+
+    // Materials (index = glTF index; the default material goes last).
+    let mut uses_transform = false;
+    for m in gltf.materials() {
+        let pbr = m.pbr_metallic_roughness();
+        let mut mat = Material {
+            name: m.name().unwrap_or("").to_string(),
+            base_color: Vec4::from_array(pbr.base_color_factor()),
+            base_color_texture: pbr.base_color_texture().and_then(|t| tex_ref(t.texture())),
+            metallic: pbr.metallic_factor(),
+            roughness: pbr.roughness_factor(),
+            metallic_roughness_texture: pbr.metallic_roughness_texture().and_then(|t| tex_ref(t.texture())),
+            normal_texture: m.normal_texture().and_then(|t| tex_ref(t.texture())),
+            normal_scale: m.normal_texture().map(|t| t.scale()).unwrap_or(1.0),
+            emissive: Vec3::from_array(m.emissive_factor()),
+            emissive_texture: m.emissive_texture().and_then(|t| tex_ref(t.texture())),
+            alpha_mode: match m.alpha_mode() {
+                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+                gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+            },
+            double_sided: m.double_sided(),
+            unlit: m.unlit(),
+        };
+        if mat.alpha_mode == AlphaMode::Blend {
+            mat.alpha_mode = AlphaMode::Opaque;
+            scene.warn(format!("material '{}': alpha blending not supported yet, drawn opaque", mat.name));
+        }
+        if pbr.base_color_texture().is_some_and(|t| t.texture_transform().is_some()) {
+            uses_transform = true;
+        }
+        if !mat.base_color.is_finite() {
+            mat.base_color = Vec4::ONE;
+        }
+        scene.materials.push(mat);
+    }
+    if uses_transform {
+        scene.warn("KHR_texture_transform is ignored (not supported yet)");
+    }
+    let default_material = scene.materials.len();
+    scene.materials.push(Material::default());
+
+    // Meshes.
+    for mesh in gltf.meshes() {
+        let mut out = Mesh { name: mesh.name().unwrap_or("").to_string(), primitives: Vec::new() };
+        for prim in mesh.primitives() {
+            if let Some(p) = read_primitive(path, &mut scene, &buffers, &mesh, &prim, default_material)? {
+                out.primitives.push(p);
+            }
+        }
+        scene.meshes.push(out);
+    }
+
+    // Node hierarchy.
+    let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(s) => s.nodes().collect(),
+        None => {
+            let mut is_child = vec![false; gltf.nodes().len()];
+            for n in gltf.nodes() {
+                for c in n.children() {
+                    is_child[c.index()] = true;
+                }
+            }
+            gltf.nodes().filter(|n| !is_child[n.index()]).collect()
+        }
+    };
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    let mut visited = 0usize;
+    while let Some((node, parent, depth)) = stack.pop() {
+        visited += 1;
+        if depth > 256 || visited > 1_000_000 {
+            return Err(corrupt(path, "node hierarchy too deep or cyclic".into()));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * local;
+        if !world.is_finite() {
+            scene.warn(format!("node {} has a non-finite transform; skipped", node.index()));
+            continue;
+        }
+        if let Some(m) = node.mesh() {
+            scene.instances.push(Instance { mesh: m.index(), world_from_model: world });
+        }
+        if let Some(c) = node.camera() {
+            match c.projection() {
+                gltf::camera::Projection::Perspective(p) => {
+                    // Remove scale from the camera transform.
+                    let (_, rot, pos) = world.to_scale_rotation_translation();
+                    scene.cameras.push(Camera {
+                        world_from_view: Mat4::from_rotation_translation(rot, pos),
+                        fov_y: p.yfov().clamp(0.01, 3.1),
+                        near: p.znear().max(1e-6),
+                        far: p.zfar(),
+                    });
+                }
+                gltf::camera::Projection::Orthographic(_) => {
+                    scene.warn(format!("camera {} is orthographic; not supported, skipped", c.index()));
+                }
+            }
+        }
+        if let Some(l) = node.light() {
+            let (_, rot, pos) = world.to_scale_rotation_translation();
+            let dir = (rot * -Vec3::Z).normalize_or_zero();
+            let kind = match l.kind() {
+                gltf::khr_lights_punctual::Kind::Directional => LightKind::Directional,
+                gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
+                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                    LightKind::Spot { inner: inner_cone_angle, outer: outer_cone_angle.max(inner_cone_angle + 1e-4) }
+                }
+            };
+            scene.lights.push(Light {
+                kind,
+                position: pos,
+                direction: dir,
+                color: Vec3::from_array(l.color()),
+                intensity: l.intensity().max(0.0),
+                casts_shadows: kind != LightKind::Point,
+            });
+        }
+        for c in node.children() {
+            stack.push((c, world, depth + 1));
+        }
+    }
+    if scene.instances.is_empty() {
+        scene.warn("the scene has no mesh instances");
+    }
+    Ok(scene)
+}
+
+fn check_accessor(path: &Path, a: &gltf::Accessor) -> Result<(), LoadError> {
+    let elem = a.size();
+    let count = a.count();
+    if let Some(view) = a.view() {
+        let stride = view.stride().unwrap_or(elem);
+        let need = if count == 0 { 0 } else { stride.checked_mul(count - 1).and_then(|x| x.checked_add(elem)) .unwrap_or(usize::MAX) };
+        let end = a.offset().checked_add(need);
+        if end.is_none_or(|e| e > view.length()) || stride < elem {
+            return Err(corrupt(path, format!("accessor {} reads past the end of buffer view {}", a.index(), view.index())));
+        }
+    }
+    if let Some(s) = a.sparse() {
+        let n = s.count();
+        let iv = s.indices().view();
+        let isize = match s.indices().index_type() {
+            gltf::accessor::sparse::IndexType::U8 => 1,
+            gltf::accessor::sparse::IndexType::U16 => 2,
+            gltf::accessor::sparse::IndexType::U32 => 4,
+        };
+        if s.indices().offset() + n * isize > iv.length() || s.values().offset() + n * elem > s.values().view().length() {
+            return Err(corrupt(path, format!("sparse accessor {} reads past the end of its buffer views", a.index())));
+        }
+    }
+    Ok(())
+}
+
+fn read_primitive(
+    path: &Path,
+    scene: &mut Scene,
+    buffers: &[Vec<u8>],
+    mesh: &gltf::Mesh,
+    prim: &gltf::Primitive,
+    default_material: usize,
+) -> Result<Option<Primitive>, LoadError> {
+    use gltf::mesh::Mode;
+    let label = format!("mesh {} primitive {}", mesh.index(), prim.index());
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
+    let Some(positions) = reader.read_positions() else {
+        scene.warn(format!("{label} has no POSITION; skipped"));
+        return Ok(None);
+    };
+    let positions: Vec<Vec3> = positions.map(Vec3::from_array).collect();
+    let n = positions.len();
+    if prim.attributes().any(|(_, a)| a.count() != n) {
+        return Err(corrupt(path, format!("{label}: attribute counts differ")));
+    }
+    let raw_indices: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..n as u32).collect(),
+    };
+    if let Some(bad) = raw_indices.iter().find(|&&i| i as usize >= n) {
+        return Err(corrupt(path, format!("{label}: index {bad} out of range (vertex count {n})")));
+    }
+    let indices: Vec<u32> = match prim.mode() {
+        Mode::Triangles => raw_indices.chunks_exact(3).flatten().copied().collect(),
+        Mode::TriangleStrip => (2..raw_indices.len())
+            .flat_map(|i| {
+                if i % 2 == 0 {
+                    [raw_indices[i - 2], raw_indices[i - 1], raw_indices[i]]
+                } else {
+                    [raw_indices[i - 1], raw_indices[i - 2], raw_indices[i]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (2..raw_indices.len()).flat_map(|i| [raw_indices[0], raw_indices[i - 1], raw_indices[i]]).collect(),
+        other => {
+            scene.warn(format!("{label}: mode {other:?} is not drawn (triangles only)"));
+            return Ok(None);
+        }
+    };
+    // Drop triangles touching non-finite positions.
+    let before = indices.len() / 3;
+    let indices: Vec<u32> = indices
+        .chunks_exact(3)
+        .filter(|t| t.iter().all(|&i| positions[i as usize].is_finite()))
+        .flatten()
+        .copied()
+        .collect();
+    if indices.len() / 3 != before {
+        scene.warn(format!("{label}: {} triangles with non-finite positions dropped", before - indices.len() / 3));
+    }
+    let degenerate = count_degenerate(&positions, &indices);
+    if degenerate > 0 {
+        scene.warn(format!("{label}: {degenerate} zero-area triangles"));
+    }
+    let normals: Vec<Vec3> = match reader.read_normals() {
+        Some(it) => it.map(|v| Vec3::from_array(v).try_normalize().unwrap_or(Vec3::Y)).collect(),
+        None => {
+            scene.warn(format!("{label}: no normals; computed smooth normals"));
+            compute_smooth_normals(&positions, &indices)
+        }
+    };
+    let (uvs, has_uvs): (Vec<Vec2>, bool) = match reader.read_tex_coords(0) {
+        Some(it) => (it.into_f32().map(|v| { let v = Vec2::from_array(v); if v.is_finite() { v } else { Vec2::ZERO } }).collect(), true),
+        None => (vec![Vec2::ZERO; n], false),
+    };
+    let material = prim.material().index().unwrap_or(default_material);
+    let mut p = Primitive { positions, normals, uvs, tangents: Vec::new(), indices, material, has_uvs };
+    let wants_normal_map = scene.materials[material].normal_texture.is_some();
+    match reader.read_tangents() {
+        Some(it) => {
+            p.tangents = it
+                .map(|t| {
+                    let t = Vec4::from_array(t);
+                    if t.is_finite() && t.truncate().length_squared() > 1e-12 {
+                        t.truncate().normalize().extend(if t.w < 0.0 { -1.0 } else { 1.0 })
+                    } else {
+                        Vec4::new(1.0, 0.0, 0.0, 1.0)
+                    }
+                })
+                .collect()
+        }
+        None if wants_normal_map && has_uvs => {
+            if !generate_mikktspace(&mut p) {
+                scene.warn(format!("{label}: MikkTSpace tangent generation failed; normal map may be wrong"));
+            }
+        }
+        None => p.tangents = p.normals.iter().map(|n| fallback_tangent(*n)).collect(),
+    }
+    if wants_normal_map && !has_uvs {
+        scene.warn(format!("{label}: normal map ignored: the primitive has no TEXCOORD_0"));
+        let mut m = scene.materials[material].clone();
+        m.normal_texture = None;
+        m.name = format!("{} (no UVs)", m.name);
+        scene.materials.push(m);
+        p.material = scene.materials.len() - 1;
+    }
+    Ok(Some(p))
+}
+
+/// Resolves a buffer or image URI: a `data:` URI is decoded; anything else must be a relative path
+/// that stays inside `base` (no absolute paths, no `..` escaping, no remote schemes).
+fn read_uri(path: &Path, base: &Path, uri: &str, what: &str) -> Result<Vec<u8>, LoadError> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (_, payload) = rest
+            .split_once(";base64,")
+            .ok_or_else(|| corrupt(path, format!("{what}: data URI is not base64")))?;
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload.trim())
+            .map_err(|e| corrupt(path, format!("{what}: bad base64 in data URI: {e}")));
+    }
+    let refused = || LoadError::OutsideFolder { path: path.into(), what: what.into(), uri: uri.into() };
+    if uri.contains("://") || uri.starts_with('/') || uri.starts_with('\\') || uri.contains(':') {
+        return Err(refused());
+    }
+    let decoded = percent_decode(uri);
+    let rel = Path::new(&decoded);
+    let mut depth = 0i32;
+    for c in rel.components() {
+        match c {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => {
+                depth -= 1;
+                if depth < 0 {
+                    return Err(refused());
+                }
+            }
+            _ => return Err(refused()),
+        }
+    }
+    let full = base.join(rel);
+    // Symbolic links must not lead out either.
+    if let (Ok(canon), Ok(canon_base)) = (full.canonicalize(), base.canonicalize()) {
+        if !canon.starts_with(&canon_base) {
+            return Err(refused());
+        }
+    }
+    std::fs::read(&full).map_err(|e| LoadError::Io { path: full, source: e })
+}
+
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() + 0 && i + 2 <= b.len() - 1 {
+            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
+                out.push(v);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+fn decode_image(data: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(data)).with_guessed_format().map_err(|e| e.to_string())?;
+    let (w, h) = reader.into_dimensions().map_err(|e| e.to_string())?;
+    if w == 0 || h == 0 || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
+        return Err(format!("size {w}x{h} outside 1..={MAX_TEXTURE_SIDE}"));
+    }
+    let img = image::load_from_memory(data).map_err(|e| e.to_string())?;
+    Ok((w, h, img.to_rgba8().into_raw()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percent_decoding() {
+        assert_eq!(percent_decode("a%20b.png"), "a b.png");
+        assert_eq!(percent_decode("100%"), "100%");
+        assert_eq!(percent_decode("%2e%2e/x"), "../x");
+    }
+
+    #[test]
+    fn uri_escape_refused() {
+        let dir = std::env::temp_dir();
+        for uri in ["../secret.bin", "/etc/passwd", "a/../../x", "file:///etc/passwd", "http://x/y", "%2e%2e/x", "C:\\x"] {
+            let r = read_uri(Path::new("m.gltf"), &dir, uri, "buffer 0");
+            assert!(matches!(r, Err(LoadError::OutsideFolder { .. })), "{uri}: {r:?}");
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! The renderer-agnostic CPU scene: meshes, materials, textures, lights, cameras and instances,
+//! loaded from glTF 2.0 or built in code. Repairs (normals, tangents) happen here, with warnings.
+
+pub mod demo;
+pub mod shapes;
+pub mod gltf_load;
+pub mod material;
+pub mod tangents;
+mod types;
+
+pub use gltf_load::{load_gltf, LoadError};
+pub use material::{blinn_phong_params, shade_blinn_phong, BlinnPhong};
+pub use types::*;

@@ -1,0 +1,178 @@
+//! Repairs: normals computed when missing, MikkTSpace tangents generated when a normal map needs
+//! them and the file has none.
+
+use super::Primitive;
+use glam::{Vec2, Vec3, Vec4};
+use std::collections::HashMap;
+
+/// Smooth, area-weighted vertex normals. Vertices that only touch zero-area triangles get +Y.
+pub fn compute_smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut acc = vec![Vec3::ZERO; positions.len()];
+    for tri in indices.chunks_exact(3) {
+        let (a, b, c) = (tri[0] as usize, tri[1] as usize, tri[2] as usize);
+        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
+        if n.is_finite() {
+            acc[a] += n;
+            acc[b] += n;
+            acc[c] += n;
+        }
+    }
+    acc.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect()
+}
+
+/// Counts triangles whose area is zero (or not finite).
+pub fn count_degenerate(positions: &[Vec3], indices: &[u32]) -> usize {
+    indices
+        .chunks_exact(3)
+        .filter(|t| {
+            let (a, b, c) = (positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]);
+            let n = (b - a).cross(c - a);
+            !(n.length_squared() > 0.0) || !n.is_finite()
+        })
+        .count()
+}
+
+struct Unwelded {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    tangents: Vec<Vec4>,
+}
+
+impl mikktspace::Geometry for Unwelded {
+    fn num_faces(&self) -> usize {
+        self.positions.len() / 3
+    }
+    fn num_vertices_of_face(&self, _face: usize) -> usize {
+        3
+    }
+    fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.positions[face * 3 + vert].to_array()
+    }
+    fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.normals[face * 3 + vert].to_array()
+    }
+    fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+        // glTF's v runs down the image while its tangent space's +Y (and the stored-tangent
+        // convention, bitangent = w·(n × t)) points up: flip v so MikkTSpace agrees with it.
+        let uv = self.uvs[face * 3 + vert];
+        [uv.x, 1.0 - uv.y]
+    }
+    fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
+        self.tangents[face * 3 + vert] = Vec4::from_array(tangent);
+    }
+}
+
+/// Generates MikkTSpace tangents (the glTF-specified algorithm) for `p`, with w such that
+/// w·(n × t) points up the image (glTF's convention, as in its sample models); splitting vertices where
+/// the tangent frame differs (UV seams, mirrored halves) and merging identical ones again.
+/// Returns false when generation failed (then tangents are set from the normal alone).
+pub fn generate_mikktspace(p: &mut Primitive) -> bool {
+    let n = p.indices.len();
+    let mut g = Unwelded {
+        positions: Vec::with_capacity(n),
+        normals: Vec::with_capacity(n),
+        uvs: Vec::with_capacity(n),
+        tangents: vec![Vec4::ZERO; n],
+    };
+    for &i in &p.indices {
+        let i = i as usize;
+        g.positions.push(p.positions[i]);
+        g.normals.push(p.normals[i]);
+        g.uvs.push(p.uvs[i]);
+    }
+    let ok = mikktspace::generate_tangents(&mut g);
+    if !ok {
+        p.tangents = p.normals.iter().map(|n| fallback_tangent(*n)).collect();
+        return false;
+    }
+    // Weld identical (position, normal, uv, tangent) vertices back together.
+    let mut map: HashMap<[u32; 12], u32> = HashMap::new();
+    let (mut pos, mut nor, mut uv, mut tan, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for k in 0..n {
+        let mut t = g.tangents[k];
+        if !t.is_finite() || t.truncate().length_squared() < 1e-12 {
+            t = fallback_tangent(g.normals[k]);
+        }
+        let key = [
+            g.positions[k].x.to_bits(),
+            g.positions[k].y.to_bits(),
+            g.positions[k].z.to_bits(),
+            g.normals[k].x.to_bits(),
+            g.normals[k].y.to_bits(),
+            g.normals[k].z.to_bits(),
+            g.uvs[k].x.to_bits(),
+            g.uvs[k].y.to_bits(),
+            t.x.to_bits(),
+            t.y.to_bits(),
+            t.z.to_bits(),
+            t.w.to_bits(),
+        ];
+        let id = *map.entry(key).or_insert_with(|| {
+            pos.push(g.positions[k]);
+            nor.push(g.normals[k]);
+            uv.push(g.uvs[k]);
+            tan.push(t);
+            (pos.len() - 1) as u32
+        });
+        idx.push(id);
+    }
+    p.positions = pos;
+    p.normals = nor;
+    p.uvs = uv;
+    p.tangents = tan;
+    p.indices = idx;
+    true
+}
+
+/// Any unit tangent perpendicular to `n`, sign +1.
+pub fn fallback_tangent(n: Vec3) -> Vec4 {
+    let t = if n.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+    let t = (t - n * n.dot(t)).try_normalize().unwrap_or(Vec3::X);
+    t.extend(1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(mirror: bool) -> Primitive {
+        let u = |x: f32| if mirror { 1.0 - x } else { x };
+        Primitive {
+            positions: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            normals: vec![Vec3::Z; 4],
+            uvs: vec![Vec2::new(u(0.0), 1.0), Vec2::new(u(1.0), 1.0), Vec2::new(u(1.0), 0.0), Vec2::new(u(0.0), 0.0)],
+            tangents: vec![],
+            indices: vec![0, 1, 2, 0, 2, 3],
+            material: 0,
+            has_uvs: true,
+        }
+    }
+
+    #[test]
+    fn tangent_follows_u_and_mirrors_sign() {
+        let mut q = quad(false);
+        assert!(generate_mikktspace(&mut q));
+        for t in &q.tangents {
+            assert!(t.truncate().abs_diff_eq(Vec3::X, 1e-5), "{t}");
+            assert_eq!(t.w, 1.0);
+        }
+        assert_eq!(q.positions.len(), 4, "welded back");
+        let mut m = quad(true);
+        assert!(generate_mikktspace(&mut m));
+        for t in &m.tangents {
+            // u runs along −X: n × t = Z × −X = −Y, but up the image is still +Y: mirrored, w = −1.
+            assert!(t.truncate().abs_diff_eq(-Vec3::X, 1e-5), "{t}");
+            assert_eq!(t.w, -1.0);
+        }
+    }
+
+    #[test]
+    fn smooth_normals_and_degenerates() {
+        let p = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Y * 2.0];
+        let n = compute_smooth_normals(&p, &[0, 1, 2, 2, 2, 3]);
+        assert!(n[0].abs_diff_eq(Vec3::Z, 1e-6));
+        assert_eq!(n[3], Vec3::Y, "only degenerate neighbours");
+        assert_eq!(count_degenerate(&p, &[0, 1, 2, 2, 2, 3]), 1);
+    }
+}

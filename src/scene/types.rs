@@ -1,0 +1,287 @@
+//! Scene data types.
+
+use crate::math::Aabb;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+/// One indexed triangle list with its vertex attributes (all arrays have `positions.len()` items).
+#[derive(Clone, Debug, Default)]
+pub struct Primitive {
+    /// Object-space positions.
+    pub positions: Vec<Vec3>,
+    /// Unit normals.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (TEXCOORD_0); zeros when the source had none.
+    pub uvs: Vec<Vec2>,
+    /// Tangents: xyz unit, w = ±1 bitangent sign (glTF convention).
+    pub tangents: Vec<Vec4>,
+    /// Triangle list indices into the vertex arrays.
+    pub indices: Vec<u32>,
+    /// Index into `Scene::materials`.
+    pub material: usize,
+    /// Whether the source had texture coordinates.
+    pub has_uvs: bool,
+}
+
+impl Primitive {
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Object-space bounds.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.positions.iter().copied())
+    }
+}
+
+/// A mesh: several primitives drawn with one transform.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Name from the file, if any.
+    pub name: String,
+    /// Its primitives.
+    pub primitives: Vec<Primitive>,
+}
+
+/// How a material treats alpha.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha ignored.
+    Opaque,
+    /// Fragments with alpha below the cutoff are discarded.
+    Mask(f32),
+    /// Blended (drawn as opaque for now, with a warning).
+    Blend,
+}
+
+/// A reference to a texture and how it is used.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    /// Index into `Scene::textures`.
+    pub texture: usize,
+}
+
+/// glTF metallic-roughness material (the renderer maps it to Blinn-Phong: see `material.rs`).
+#[derive(Clone, Debug)]
+pub struct Material {
+    /// Name from the file.
+    pub name: String,
+    /// Linear RGBA base colour factor.
+    pub base_color: Vec4,
+    /// sRGB-encoded base colour texture.
+    pub base_color_texture: Option<TextureRef>,
+    /// Metallic factor 0..1.
+    pub metallic: f32,
+    /// Roughness factor 0..1.
+    pub roughness: f32,
+    /// Linear texture: G = roughness, B = metallic.
+    pub metallic_roughness_texture: Option<TextureRef>,
+    /// Tangent-space normal map (linear).
+    pub normal_texture: Option<TextureRef>,
+    /// Scale applied to the normal map's x and y.
+    pub normal_scale: f32,
+    /// Linear emissive factor.
+    pub emissive: Vec3,
+    /// sRGB emissive texture.
+    pub emissive_texture: Option<TextureRef>,
+    /// Alpha handling.
+    pub alpha_mode: AlphaMode,
+    /// Render both faces (and cast from both).
+    pub double_sided: bool,
+    /// KHR_materials_unlit.
+    pub unlit: bool,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            base_color: Vec4::ONE,
+            base_color_texture: None,
+            metallic: 0.0,
+            roughness: 0.6,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            emissive: Vec3::ZERO,
+            emissive_texture: None,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: false,
+            unlit: false,
+        }
+    }
+}
+
+/// An RGBA8 image. Whether it is sRGB-encoded depends on which material slot uses it.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    /// Name or URI.
+    pub name: String,
+    /// Width in pixels (≥ 1).
+    pub width: u32,
+    /// Height in pixels (≥ 1).
+    pub height: u32,
+    /// Row-major RGBA8 pixels, `width * height * 4` bytes.
+    pub rgba: Vec<u8>,
+}
+
+/// Kind of punctual light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Parallel rays along `direction`.
+    Directional,
+    /// Omnidirectional from `position`, 1/r² falloff.
+    Point,
+    /// A cone from `position` along `direction`.
+    Spot {
+        /// Inner cone half-angle (radians): full intensity inside.
+        inner: f32,
+        /// Outer cone half-angle (radians): zero outside.
+        outer: f32,
+    },
+}
+
+/// A light in world space.
+#[derive(Clone, Copy, Debug)]
+pub struct Light {
+    /// Kind.
+    pub kind: LightKind,
+    /// World position (point, spot).
+    pub position: Vec3,
+    /// Unit direction the light travels (directional, spot).
+    pub direction: Vec3,
+    /// Linear colour.
+    pub color: Vec3,
+    /// Intensity I (multiplies colour; 1/r² applies to point and spot).
+    pub intensity: f32,
+    /// Whether it casts shadows (the first casting directional or spot light gets the shadow map).
+    pub casts_shadows: bool,
+}
+
+impl Light {
+    /// A shadow-casting sun travelling along `direction`.
+    pub fn sun(direction: Vec3, intensity: f32) -> Self {
+        Self {
+            kind: LightKind::Directional,
+            position: Vec3::ZERO,
+            direction: direction.try_normalize().unwrap_or(-Vec3::Y),
+            color: Vec3::ONE,
+            intensity,
+            casts_shadows: true,
+        }
+    }
+
+    /// Direction of a sun at `elevation` above the horizon and `azimuth` around +Y (radians),
+    /// pointing from the sun into the scene.
+    pub fn sun_direction(elevation: f32, azimuth: f32) -> Vec3 {
+        let (se, ce) = elevation.sin_cos();
+        let (sa, ca) = azimuth.sin_cos();
+        -Vec3::new(ce * sa, se, ce * ca)
+    }
+}
+
+/// A perspective camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Camera → world (the camera looks down its −Z).
+    pub world_from_view: Mat4,
+    /// Vertical field of view (radians).
+    pub fov_y: f32,
+    /// Near plane distance.
+    pub near: f32,
+    /// Far plane distance; `None` for an infinite reversed-z projection.
+    pub far: Option<f32>,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `target` (Y up; Z up if looking straight down or up).
+    pub fn look_at(eye: Vec3, target: Vec3, fov_y: f32, near: f32) -> Self {
+        let d = (target - eye).normalize_or_zero();
+        let up = if d.cross(Vec3::Y).length_squared() < 1e-8 { Vec3::Z } else { Vec3::Y };
+        Self {
+            world_from_view: Mat4::look_at_rh(eye, target, up).inverse(),
+            fov_y,
+            near,
+            far: None,
+        }
+    }
+
+    /// World → view.
+    pub fn view_from_world(&self) -> Mat4 {
+        self.world_from_view.inverse()
+    }
+
+    /// Eye position in world space.
+    pub fn position(&self) -> Vec3 {
+        self.world_from_view.w_axis.truncate()
+    }
+}
+
+/// A placed mesh.
+#[derive(Clone, Copy, Debug)]
+pub struct Instance {
+    /// Index into `Scene::meshes`.
+    pub mesh: usize,
+    /// Model → world.
+    pub world_from_model: Mat4,
+}
+
+/// A scene ready to render.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// Name (file name or "demo").
+    pub name: String,
+    /// Meshes.
+    pub meshes: Vec<Mesh>,
+    /// Materials (at least one).
+    pub materials: Vec<Material>,
+    /// Textures.
+    pub textures: Vec<Texture>,
+    /// Placed meshes (flattened node hierarchy).
+    pub instances: Vec<Instance>,
+    /// Lights (world space).
+    pub lights: Vec<Light>,
+    /// Cameras from the file (world space).
+    pub cameras: Vec<Camera>,
+    /// Repairs and unsupported features met while loading.
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// World-space bounds of all instances.
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for inst in &self.instances {
+            for p in &self.meshes[inst.mesh].primitives {
+                b = b.union(&p.bounds().transformed(&inst.world_from_model));
+            }
+        }
+        b
+    }
+
+    /// Total triangles drawn (instances counted).
+    pub fn triangle_count(&self) -> usize {
+        self.instances
+            .iter()
+            .map(|i| self.meshes[i.mesh].primitives.iter().map(|p| p.triangle_count()).sum::<usize>())
+            .sum()
+    }
+
+    /// Records a warning (also logged).
+    pub fn warn(&mut self, msg: impl Into<String>) {
+        let m = msg.into();
+        log::warn!("{}: {m}", self.name);
+        self.warnings.push(m);
+    }
+
+    /// A camera that frames the bounds from the front-right, above.
+    pub fn default_camera(&self, aspect: f32) -> Camera {
+        let b = self.bounds();
+        let (center, radius) = if b.is_empty() { (Vec3::ZERO, 1.0) } else { (b.center(), (b.diagonal() * 0.5).max(1e-6)) };
+        let fov_y = 45f32.to_radians();
+        let fov_min = if aspect < 1.0 { 2.0 * ((fov_y * 0.5).tan() * aspect).atan() } else { fov_y };
+        let dist = radius / (fov_min * 0.5).sin() * 1.05;
+        let dir = Vec3::new(0.55, 0.45, 1.0).normalize();
+        Camera::look_at(center + dir * dist, center, fov_y, (dist - radius).max(dist * 1e-3) * 0.5)
+    }
+}
