@@ -161,13 +161,31 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>) -> f32 {
     if kernel == 0 {
         return compare_texel(vec2<i32>(floor(p_texel)), depth, size);
     }
+    let half = (kernel - 1) / 2;
     var sum = 0.0;
-    let half = f32(kernel - 1) * 0.5;
-    for (var y = 0; y < kernel; y++) {
-        for (var x = 0; x < kernel; x++) {
-            let o = vec2<f32>(f32(x) - half, f32(y) - half);
-            sum += bilinear_compare(p_texel + o, depth, size);
+    if frame.modes.z == 1u {
+        // Hardware bilinear comparisons, one per tap.
+        for (var y = -half; y <= half; y++) {
+            for (var x = -half; x <= half; x++) {
+                sum += bilinear_compare(p_texel + vec2<f32>(f32(x), f32(y)), depth, size);
+            }
         }
+        return sum / f32(kernel * kernel);
+    }
+    // By hand: the kernel x kernel bilinear taps at one-texel spacing cover (kernel+1)^2 texels;
+    // each texel's weight is separable, wx[i] = (1-fx)[i < kernel] + fx[i > 0], so every texel is
+    // compared once (16 loads for 3x3 taps instead of 36).
+    let t = p_texel - vec2<f32>(0.5);
+    let base = vec2<i32>(floor(t)) - vec2<i32>(half);
+    let f = t - floor(t);
+    for (var j = 0; j <= kernel; j++) {
+        let wy = select(0.0, 1.0 - f.y, j < kernel) + select(0.0, f.y, j > 0);
+        var row = 0.0;
+        for (var i = 0; i <= kernel; i++) {
+            let wx = select(0.0, 1.0 - f.x, i < kernel) + select(0.0, f.x, i > 0);
+            row += wx * compare_texel(base + vec2<i32>(i, j), depth, size);
+        }
+        sum += wy * row;
     }
     return sum / f32(kernel * kernel);
 }

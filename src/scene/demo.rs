@@ -11,6 +11,9 @@ pub const DEMO_SUN_ELEVATION_DEG: f32 = 28.0;
 /// Default sun azimuth of the demo (degrees around +Y from +Z).
 pub const DEMO_SUN_AZIMUTH_DEG: f32 = 60.0;
 
+/// Intensity of the demo's sun.
+pub const DEMO_SUN_INTENSITY: f32 = 1.7;
+
 /// A checkerboard RGBA texture (sRGB colours `a` and `b`), `cells` squares per side.
 pub fn checker_texture(size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> Texture {
     let mut rgba = Vec::with_capacity((size * size * 4) as usize);
@@ -76,7 +79,7 @@ pub fn demo_scene() -> Scene {
         colored(Vec3::new(0.6, 0.55, 0.3), 0.6),
         Mat4::from_translation(Vec3::new(0.5, 0.4, 4.0)),
     );
-    let gold = Material { name: "gold".into(), base_color: Vec3::new(0.9, 0.65, 0.2).extend(1.0), metallic: 1.0, roughness: 0.35, ..Default::default() };
+    let gold = Material { name: "gold".into(), base_color: Vec3::new(0.9, 0.65, 0.2).extend(1.0), metallic: 0.8, roughness: 0.35, ..Default::default() };
     add_object(&mut s, "sphere", uv_sphere(1.0, 48, 24), gold, Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)));
     add_object(
         &mut s,
@@ -104,7 +107,7 @@ pub fn demo_scene() -> Scene {
     );
     s.lights.push(Light::sun(
         Light::sun_direction(DEMO_SUN_ELEVATION_DEG.to_radians(), DEMO_SUN_AZIMUTH_DEG.to_radians()),
-        3.0,
+        DEMO_SUN_INTENSITY,
     ));
     s.cameras.push(Camera::look_at(Vec3::new(7.0, 5.5, 11.0), Vec3::new(0.0, 0.8, 0.0), 45f32.to_radians(), 0.1));
     s

@@ -1,0 +1,213 @@
+//! Argument parsing (clap) and turning arguments into a scene and a view.
+
+use crate::render::{Pcf, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};
+use crate::scene::{demo::demo_scene, load_gltf, Camera, Scene};
+use anyhow::{anyhow, bail};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use glam::Vec3;
+use std::path::PathBuf;
+
+/// umbra: real-time shadow-mapping renderer (Vulkan).
+#[derive(Parser, Debug)]
+#[command(name = "umbra", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a scene (the built-in demo without SCENE) to a PNG.
+    Render(RenderArgs),
+}
+
+/// `umbra render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// glTF 2.0 file (.gltf or .glb); the built-in demo scene when omitted.
+    pub scene: Option<PathBuf>,
+    /// Output PNG.
+    #[arg(short, long, default_value = "umbra.png")]
+    pub output: PathBuf,
+    /// View and shadow options.
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Enable the Khronos validation layer (also UMBRA_VALIDATION=1).
+    #[arg(long)]
+    pub validation: bool,
+    /// Render this many frames and report median times (the image is the last frame).
+    #[arg(long, default_value_t = 1)]
+    pub repeat: usize,
+}
+
+/// What to show.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ViewArg {
+    /// Shaded image.
+    Lit,
+    /// Sun visibility alone.
+    Shadow,
+    /// World normals after normal mapping.
+    Normals,
+    /// The shadow map.
+    ShadowMap,
+}
+
+/// PCF kernels.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum PcfArg {
+    /// Single nearest comparison.
+    None,
+    /// One bilinear 2×2 comparison.
+    #[value(name = "2x2")]
+    P2x2,
+    /// 3×3 bilinear taps.
+    #[value(name = "3x3")]
+    P3x3,
+    /// 5×5 bilinear taps.
+    #[value(name = "5x5")]
+    P5x5,
+}
+
+/// View options shared by the subcommands.
+#[derive(Args, Debug, Clone)]
+pub struct ViewArgs {
+    /// Image size WxH.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Use the glTF camera with this index.
+    #[arg(long)]
+    pub camera: Option<usize>,
+    /// Camera position X,Y,Z (with --target).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Point looked at X,Y,Z (with --eye).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Direction the sun's light travels X,Y,Z (e.g. -1,-1,0).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub sun_dir: Option<Vec3>,
+    /// Output: lit, shadow (visibility), normals, shadow-map.
+    #[arg(long = "view", value_enum, default_value = "lit")]
+    pub mode: ViewArg,
+    /// Shadow-map size in texels.
+    #[arg(long, default_value_t = 2048)]
+    pub shadow_map: u32,
+    /// Shadow-map depth format.
+    #[arg(long, value_parser = ["d32", "d16"], default_value = "d32")]
+    pub shadow_format: String,
+    /// PCF kernel.
+    #[arg(long, value_enum, default_value = "3x3")]
+    pub pcf: PcfArg,
+    /// Constant depth bias (depth-format units).
+    #[arg(long, default_value_t = ShadowSettings::default().constant_bias, allow_hyphen_values = true)]
+    pub bias_constant: f32,
+    /// Slope-scaled depth bias.
+    #[arg(long, default_value_t = ShadowSettings::default().slope_bias, allow_hyphen_values = true)]
+    pub bias_slope: f32,
+    /// Normal-offset bias in shadow texels.
+    #[arg(long, default_value_t = ShadowSettings::default().normal_offset, allow_hyphen_values = true)]
+    pub normal_offset: f32,
+    /// Fit the light frustum to the camera view or the whole scene.
+    #[arg(long, value_parser = ["camera", "scene"], default_value = "camera")]
+    pub fit: String,
+    /// Do not snap the light frustum to whole texels.
+    #[arg(long)]
+    pub no_snap: bool,
+    /// Disable shadows.
+    #[arg(long)]
+    pub no_shadows: bool,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WxH"))?;
+    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    if w == 0 || h == 0 {
+        return Err(format!("size {w}x{h} must be at least 1x1"));
+    }
+    if w > crate::render::renderer::MAX_SIDE || h > crate::render::renderer::MAX_SIDE {
+        return Err(format!("size {w}x{h} exceeds {0}x{0}", crate::render::renderer::MAX_SIDE));
+    }
+    Ok((w, h))
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!("'{s}' is not X,Y,Z"));
+    }
+    let mut v = [0.0f32; 3];
+    for (i, p) in parts.iter().enumerate() {
+        v[i] = p.trim().parse().map_err(|_| format!("'{p}' is not a number"))?;
+        if !v[i].is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+    }
+    Ok(Vec3::from_array(v))
+}
+
+/// Loads SCENE or builds the demo.
+pub fn load_scene(path: Option<&PathBuf>) -> anyhow::Result<Scene> {
+    match path {
+        Some(p) => Ok(load_gltf(p)?),
+        None => Ok(demo_scene()),
+    }
+}
+
+/// Builds the view from arguments.
+pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
+    let aspect = a.size.0 as f32 / a.size.1 as f32;
+    let camera: Camera = match (a.eye, a.target, a.camera) {
+        (Some(eye), Some(target), _) => {
+            if (target - eye).length_squared() == 0.0 {
+                bail!("--eye and --target must differ");
+            }
+            let b = scene.bounds();
+            let near = if b.is_empty() { 0.01 } else { (b.diagonal() * 1e-4).max(1e-4) };
+            Camera::look_at(eye, target, 45f32.to_radians(), near)
+        }
+        (Some(_), None, _) | (None, Some(_), _) => bail!("--eye and --target go together"),
+        (None, None, Some(i)) => *scene
+            .cameras
+            .get(i)
+            .ok_or_else(|| anyhow!("--camera {i}: the scene has {} camera(s)", scene.cameras.len()))?,
+        (None, None, None) => scene.cameras.first().copied().unwrap_or_else(|| scene.default_camera(aspect)),
+    };
+    let mut v = View::new(camera);
+    v.sun_direction = match a.sun_dir {
+        Some(d) if d.length_squared() == 0.0 => bail!("--sun-dir must not be zero"),
+        d => d,
+    };
+    v.mode = match a.mode {
+        ViewArg::Lit => ViewMode::Lit,
+        ViewArg::Shadow => ViewMode::Shadow,
+        ViewArg::Normals => ViewMode::Normals,
+        ViewArg::ShadowMap => ViewMode::ShadowMap,
+    };
+    if !(16..=16384).contains(&a.shadow_map) {
+        bail!("--shadow-map {} must be within 16..16384", a.shadow_map);
+    }
+    v.shadow = ShadowSettings {
+        enabled: !a.no_shadows,
+        map_size: a.shadow_map,
+        format: if a.shadow_format == "d16" { ShadowFormat::D16 } else { ShadowFormat::D32 },
+        pcf: match a.pcf {
+            PcfArg::None => Pcf::None,
+            PcfArg::P2x2 => Pcf::P2x2,
+            PcfArg::P3x3 => Pcf::P3x3,
+            PcfArg::P5x5 => Pcf::P5x5,
+        },
+        constant_bias: a.bias_constant,
+        slope_bias: a.bias_slope,
+        normal_offset: a.normal_offset,
+        fit: if a.fit == "scene" { ShadowFit::Scene } else { ShadowFit::Camera },
+        snap: !a.no_snap,
+    };
+    Ok(v)
+}

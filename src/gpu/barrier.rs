@@ -1,0 +1,105 @@
+//! Image barriers from a small table of named accesses (synchronization2).
+
+use ash::vk;
+
+/// How an image is about to be (or was last) used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    /// Contents undefined (first use, or discard).
+    Undefined,
+    /// Copy/blit source.
+    TransferSrc,
+    /// Copy/blit/clear destination.
+    TransferDst,
+    /// Colour attachment write.
+    ColorAttachment,
+    /// Depth attachment read/write (tests and writes).
+    DepthAttachment,
+    /// Sampled in a fragment shader (colour textures).
+    FragmentSampled,
+    /// A depth image sampled in a fragment shader (shadow map lookups).
+    DepthFragmentSampled,
+    /// Presented to a swapchain.
+    Present,
+}
+
+/// (stage, access, layout) for an access.
+pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout) {
+    use vk::AccessFlags2 as A;
+    use vk::PipelineStageFlags2 as S;
+    match a {
+        Access::Undefined => (S::NONE, A::NONE, vk::ImageLayout::UNDEFINED),
+        Access::TransferSrc => (S::ALL_TRANSFER, A::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+        Access::TransferDst => (S::ALL_TRANSFER, A::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+        Access::ColorAttachment => (
+            S::COLOR_ATTACHMENT_OUTPUT,
+            A::COLOR_ATTACHMENT_WRITE | A::COLOR_ATTACHMENT_READ,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+        ),
+        Access::DepthAttachment => (
+            S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
+            A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+        ),
+        Access::FragmentSampled => (S::FRAGMENT_SHADER, A::SHADER_SAMPLED_READ, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+        Access::DepthFragmentSampled => (S::FRAGMENT_SHADER, A::SHADER_SAMPLED_READ, vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL),
+        Access::Present => (S::NONE, A::NONE, vk::ImageLayout::PRESENT_SRC_KHR),
+    }
+}
+
+/// Records one image barrier from `from` to `to` over the given mip levels.
+/// `src_stage_override` lets a swapchain transition wait at the acquire semaphore's stage.
+pub fn image_barrier(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    aspect: vk::ImageAspectFlags,
+    mips: std::ops::Range<u32>,
+    from: Access,
+    to: Access,
+) {
+    let (src_stage, src_access, old_layout) = access_info(from);
+    let (dst_stage, dst_access, new_layout) = access_info(to);
+    // Reads need no availability; only writes are made available.
+    let src_access = src_access
+        & (vk::AccessFlags2::TRANSFER_WRITE
+            | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
+            | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE);
+    let src_stage = if from == Access::Present { vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT } else { src_stage };
+    let barrier = vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(if to == Access::Present { vk::PipelineStageFlags2::NONE } else { dst_stage })
+        .dst_access_mask(dst_access)
+        .old_layout(if from == Access::Present { vk::ImageLayout::UNDEFINED } else { old_layout })
+        .new_layout(new_layout)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(vk::ImageSubresourceRange {
+            aspect_mask: aspect,
+            base_mip_level: mips.start,
+            level_count: mips.end - mips.start,
+            base_array_layer: 0,
+            layer_count: 1,
+        });
+    let barriers = [barrier];
+    let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+    unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_layouts_and_stages() {
+        assert_eq!(access_info(Access::Undefined).2, vk::ImageLayout::UNDEFINED);
+        assert_eq!(access_info(Access::DepthFragmentSampled).2, vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL);
+        assert!(access_info(Access::DepthAttachment).0.contains(vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS));
+        assert!(access_info(Access::FragmentSampled).1.contains(vk::AccessFlags2::SHADER_SAMPLED_READ));
+        for a in [Access::TransferDst, Access::ColorAttachment, Access::DepthAttachment] {
+            assert_ne!(access_info(a).1, vk::AccessFlags2::NONE, "{a:?} must carry an access");
+        }
+    }
+}

@@ -1,0 +1,505 @@
+//! The Vulkan context. Drop order, written down: wait idle → allocator → command pool → device →
+//! debug messenger → instance.
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::{c_void, CStr, CString};
+use std::mem::ManuallyDrop;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// Errors from the GPU layer.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// The Vulkan loader library could not be opened.
+    #[error("no Vulkan loader found ({0}); install one: apt-get install libvulkan1 mesa-vulkan-drivers")]
+    NoLoader(String),
+    /// No physical device qualifies.
+    #[error("no suitable Vulkan device: {0}")]
+    NoDevice(String),
+    /// Validation was required but the Khronos layer is not installed.
+    #[error("the Khronos validation layer (VK_LAYER_KHRONOS_validation) is not installed: apt-get install vulkan-validationlayers")]
+    NoValidationLayer,
+    /// A Vulkan call failed.
+    #[error("Vulkan call {call} failed: {result:?}")]
+    Vk {
+        /// What was called.
+        call: &'static str,
+        /// The result code.
+        result: vk::Result,
+    },
+    /// Memory allocation failed.
+    #[error("GPU memory allocation failed for {name}: {message}")]
+    Alloc {
+        /// Allocation name.
+        name: String,
+        /// Allocator message.
+        message: String,
+    },
+    /// A request outside what the device supports.
+    #[error("{0}")]
+    Unsupported(String),
+}
+
+/// Maps a `vk::Result` error to [`GpuError::Vk`] with the call's name.
+pub trait VkCheck<T> {
+    /// Attaches the call's name.
+    fn vk(self, call: &'static str) -> Result<T, GpuError>;
+}
+
+impl<T> VkCheck<T> for Result<T, vk::Result> {
+    fn vk(self, call: &'static str) -> Result<T, GpuError> {
+        self.map_err(|result| GpuError::Vk { call, result })
+    }
+}
+
+/// Whether to enable the Khronos validation layer (with synchronization validation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Validation {
+    /// Never.
+    Off,
+    /// When the layer is installed.
+    IfAvailable,
+    /// Always; creating the context fails without the layer.
+    Required,
+}
+
+/// How to create a context.
+#[derive(Clone, Debug)]
+pub struct ContextDesc {
+    /// Validation layer policy. `UMBRA_VALIDATION=1` turns `Off` into `Required`.
+    pub validation: Validation,
+    /// Substring of the device name to pick (case-insensitive); `UMBRA_DEVICE` is used when `None`.
+    pub device: Option<String>,
+    /// Extra instance extensions (surface extensions for a window).
+    pub instance_extensions: Vec<CString>,
+    /// Enable VK_KHR_swapchain on the device.
+    pub swapchain: bool,
+}
+
+impl Default for ContextDesc {
+    fn default() -> Self {
+        Self { validation: Validation::Off, device: None, instance_extensions: Vec::new(), swapchain: false }
+    }
+}
+
+/// Validation messages received, counted by severity.
+#[derive(Default, Debug)]
+pub struct ValidationLog {
+    warnings: AtomicUsize,
+    errors: AtomicUsize,
+    messages: Mutex<Vec<String>>,
+}
+
+impl ValidationLog {
+    /// Number of warning-or-error messages so far.
+    pub fn problem_count(&self) -> usize {
+        self.warnings.load(Ordering::SeqCst) + self.errors.load(Ordering::SeqCst)
+    }
+
+    /// The warning and error messages so far.
+    pub fn messages(&self) -> Vec<String> {
+        self.messages.lock().map(|m| m.clone()).unwrap_or_default()
+    }
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    kind: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    let msg = if data.is_null() || (*data).p_message.is_null() {
+        String::from("(no message)")
+    } else {
+        CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
+    };
+    let log = user as *const ValidationLog;
+    let problem = severity.intersects(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR);
+    if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+        log::error!("vulkan {kind:?}: {msg}");
+        if !log.is_null() {
+            (*log).errors.fetch_add(1, Ordering::SeqCst);
+        }
+    } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+        log::warn!("vulkan {kind:?}: {msg}");
+        if !log.is_null() {
+            (*log).warnings.fetch_add(1, Ordering::SeqCst);
+        }
+    } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::INFO) {
+        log::debug!("vulkan {kind:?}: {msg}");
+    } else {
+        log::trace!("vulkan {kind:?}: {msg}");
+    }
+    if problem && !log.is_null() {
+        if let Ok(mut m) = (*log).messages.lock() {
+            m.push(msg);
+        }
+    }
+    vk::FALSE
+}
+
+/// Owns the Vulkan instance, device, queue and allocator. Share it as `Arc<Context>`.
+pub struct Context {
+    /// Loader entry points.
+    pub entry: ash::Entry,
+    /// The instance.
+    pub instance: ash::Instance,
+    /// The chosen physical device.
+    pub physical: vk::PhysicalDevice,
+    /// The logical device.
+    pub device: ash::Device,
+    /// The graphics queue (also used for transfers).
+    pub queue: vk::Queue,
+    /// Its family index.
+    pub queue_family: u32,
+    /// Device properties.
+    pub properties: vk::PhysicalDeviceProperties,
+    /// Device name.
+    pub device_name: String,
+    /// Whether sampler anisotropy is enabled.
+    pub anisotropy: bool,
+    /// Valid bits of timestamps on the queue (0 = no timestamps).
+    pub timestamp_valid_bits: u32,
+    /// Validation messages (all zero when validation is off).
+    pub validation_log: Arc<ValidationLog>,
+    /// Whether the validation layer is on.
+    pub validation_enabled: bool,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    command_pool: Mutex<vk::CommandPool>,
+    debug_utils: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    debug_device: Option<ash::ext::debug_utils::Device>,
+}
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+fn score(kind: vk::PhysicalDeviceType) -> u32 {
+    match kind {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 4,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 3,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        vk::PhysicalDeviceType::CPU => 1,
+        _ => 0,
+    }
+}
+
+impl Context {
+    /// Creates a context: loads Vulkan, picks a device (explicit choice, then discrete > integrated
+    /// > CPU), enables dynamic rendering, synchronization2 and depth clamp.
+    pub fn new(desc: &ContextDesc) -> Result<Arc<Context>, GpuError> {
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| GpuError::NoLoader(e.to_string()))?;
+        let mut validation = desc.validation;
+        if validation == Validation::Off && std::env::var("UMBRA_VALIDATION").is_ok_and(|v| v == "1") {
+            validation = Validation::Required;
+        }
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }.vk("vkEnumerateInstanceLayerProperties")?;
+        let has_layer = layers.iter().any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
+        let enable_validation = match validation {
+            Validation::Off => false,
+            Validation::IfAvailable => has_layer,
+            Validation::Required => {
+                if !has_layer {
+                    return Err(GpuError::NoValidationLayer);
+                }
+                true
+            }
+        };
+        let exts = unsafe { entry.enumerate_instance_extension_properties(None) }.vk("vkEnumerateInstanceExtensionProperties")?;
+        let has_ext = |name: &CStr| exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == name));
+        let has_debug_utils = has_ext(ash::ext::debug_utils::NAME);
+        let mut ext_names: Vec<*const i8> = desc.instance_extensions.iter().map(|e| e.as_ptr()).collect();
+        for e in &desc.instance_extensions {
+            if !has_ext(e) {
+                return Err(GpuError::Unsupported(format!("instance extension {} is not available", e.to_string_lossy())));
+            }
+        }
+        if has_debug_utils {
+            ext_names.push(ash::ext::debug_utils::NAME.as_ptr());
+        }
+        let layer_names: Vec<*const i8> = if enable_validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"umbra")
+            .engine_name(c"umbra")
+            .api_version(vk::API_VERSION_1_3);
+        let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
+        let log = Arc::new(ValidationLog::default());
+        let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::INFO,
+            )
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(debug_callback))
+            .user_data(Arc::as_ptr(&log) as *mut c_void);
+        let mut info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_extension_names(&ext_names)
+            .enabled_layer_names(&layer_names);
+        if enable_validation {
+            info = info.push_next(&mut validation_features);
+        }
+        // A copy for the instance's pNext chain (push_next rewrites its pNext), so that messages
+        // from instance creation and destruction are caught too.
+        let mut chained_messenger_info = messenger_info;
+        if has_debug_utils {
+            info = info.push_next(&mut chained_messenger_info);
+        }
+        let instance = unsafe { entry.create_instance(&info, None) }.vk("vkCreateInstance")?;
+        let debug_utils = if has_debug_utils {
+            let du = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            let m = unsafe { du.create_debug_utils_messenger(&messenger_info, None) };
+            match m {
+                Ok(m) => Some((du, m)),
+                Err(e) => {
+                    unsafe { instance.destroy_instance(None) };
+                    return Err(GpuError::Vk { call: "vkCreateDebugUtilsMessengerEXT", result: e });
+                }
+            }
+        } else {
+            None
+        };
+        let picked = pick_device(&instance, desc);
+        let (physical, queue_family, anisotropy) = match picked {
+            Ok(p) => p,
+            Err(e) => {
+                unsafe {
+                    if let Some((du, m)) = &debug_utils {
+                        du.destroy_debug_utils_messenger(*m, None);
+                    }
+                    instance.destroy_instance(None);
+                }
+                return Err(e);
+            }
+        };
+        let properties = unsafe { instance.get_physical_device_properties(physical) };
+        let device_name = properties.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let qf_props = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        let timestamp_valid_bits = qf_props[queue_family as usize].timestamp_valid_bits;
+
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+        let core = vk::PhysicalDeviceFeatures::default().depth_clamp(true).sampler_anisotropy(anisotropy);
+        let mut device_exts: Vec<*const i8> = Vec::new();
+        if desc.swapchain {
+            device_exts.push(ash::khr::swapchain::NAME.as_ptr());
+        }
+        let dinfo = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_features(&core)
+            .enabled_extension_names(&device_exts)
+            .push_next(&mut f13);
+        let device = match unsafe { instance.create_device(physical, &dinfo, None) } {
+            Ok(d) => d,
+            Err(e) => {
+                unsafe {
+                    if let Some((du, m)) = &debug_utils {
+                        du.destroy_debug_utils_messenger(*m, None);
+                    }
+                    instance.destroy_instance(None);
+                }
+                return Err(GpuError::Vk { call: "vkCreateDevice", result: e });
+            }
+        };
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| GpuError::Alloc { name: "allocator".into(), message: e.to_string() })?;
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let command_pool = unsafe { device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
+        let debug_device = debug_utils.as_ref().map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+        log::info!("Vulkan device: {device_name} (validation {})", if enable_validation { "on" } else { "off" });
+        Ok(Arc::new(Context {
+            entry,
+            instance,
+            physical,
+            device,
+            queue,
+            queue_family,
+            properties,
+            device_name,
+            anisotropy,
+            timestamp_valid_bits,
+            validation_log: log,
+            validation_enabled: enable_validation,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            command_pool: Mutex::new(command_pool),
+            debug_utils,
+            debug_device,
+        }))
+    }
+
+    /// The memory allocator.
+    pub fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
+        self.allocator.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Gives a Vulkan object a debug name (no-op without debug utils).
+    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+        if let Some(d) = &self.debug_device {
+            if let Ok(c) = CString::new(name) {
+                let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&c);
+                unsafe {
+                    let _ = d.set_debug_utils_object_name(&info);
+                }
+            }
+        }
+    }
+
+    /// Opens a labelled region in a command buffer (no-op without debug utils).
+    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+        if let (Some(d), Ok(c)) = (&self.debug_device, CString::new(name)) {
+            let label = vk::DebugUtilsLabelEXT::default().label_name(&c);
+            unsafe { d.cmd_begin_debug_utils_label(cmd, &label) };
+        }
+    }
+
+    /// Closes the region opened by `begin_label`.
+    pub fn end_label(&self, cmd: vk::CommandBuffer) {
+        if let Some(d) = &self.debug_device {
+            unsafe { d.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+
+    /// Allocates a primary command buffer from the context's pool.
+    pub fn allocate_command_buffer(&self) -> Result<vk::CommandBuffer, GpuError> {
+        let pool = self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(*pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        Ok(unsafe { self.device.allocate_command_buffers(&info) }.vk("vkAllocateCommandBuffers")?[0])
+    }
+
+    /// Frees a command buffer from `allocate_command_buffer` (it must not be in flight).
+    pub fn free_command_buffer(&self, cmd: vk::CommandBuffer) {
+        let pool = self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
+        unsafe { self.device.free_command_buffers(*pool, &[cmd]) };
+    }
+
+    /// Records `f` into a one-time command buffer, submits it and waits for it to finish.
+    pub fn immediate<R>(&self, f: impl FnOnce(vk::CommandBuffer) -> R) -> Result<R, GpuError> {
+        let cmd = self.allocate_command_buffer()?;
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        let result = unsafe {
+            self.device.begin_command_buffer(cmd, &begin).vk("vkBeginCommandBuffer")?;
+            let r = f(cmd);
+            self.device.end_command_buffer(cmd).vk("vkEndCommandBuffer")?;
+            self.submit_and_wait(cmd)?;
+            r
+        };
+        self.free_command_buffer(cmd);
+        Ok(result)
+    }
+
+    /// Submits one command buffer and blocks until it completes.
+    pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<(), GpuError> {
+        unsafe {
+            let fence = self.device.create_fence(&vk::FenceCreateInfo::default(), None).vk("vkCreateFence")?;
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+            let r = self.device.queue_submit2(self.queue, &submit, fence).vk("vkQueueSubmit2");
+            let w = if r.is_ok() { self.device.wait_for_fences(&[fence], true, u64::MAX).vk("vkWaitForFences") } else { Ok(()) };
+            self.device.destroy_fence(fence, None);
+            r.and(w)
+        }
+    }
+
+    /// Format features (optimal tiling) of `format`.
+    pub fn format_features(&self, format: vk::Format) -> vk::FormatFeatureFlags {
+        unsafe { self.instance.get_physical_device_format_properties(self.physical, format) }.optimal_tiling_features
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            ManuallyDrop::drop(&mut self.allocator);
+            let pool = *self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
+            self.device.destroy_command_pool(pool, None);
+            self.device.destroy_device(None);
+            if let Some((du, m)) = &self.debug_utils {
+                du.destroy_debug_utils_messenger(*m, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+fn pick_device(instance: &ash::Instance, desc: &ContextDesc) -> Result<(vk::PhysicalDevice, u32, bool), GpuError> {
+    let devices = unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+    if devices.is_empty() {
+        return Err(GpuError::NoDevice(
+            "the Vulkan loader found no device; install a driver (apt-get install mesa-vulkan-drivers for lavapipe)".into(),
+        ));
+    }
+    let wanted = desc.device.clone().or_else(|| std::env::var("UMBRA_DEVICE").ok().filter(|s| !s.is_empty()));
+    let mut reasons = Vec::new();
+    let mut best: Option<(u32, vk::PhysicalDevice, u32, bool)> = None;
+    for pd in devices {
+        let props = unsafe { instance.get_physical_device_properties(pd) };
+        let name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        if let Some(w) = &wanted {
+            if !name.to_lowercase().contains(&w.to_lowercase()) {
+                reasons.push(format!("{name}: not matching '{w}'"));
+                continue;
+            }
+        }
+        let mut missing = Vec::new();
+        if props.api_version < vk::API_VERSION_1_3 {
+            missing.push("Vulkan 1.3".to_string());
+        }
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+        unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+        let core = f2.features;
+        if f13.dynamic_rendering == vk::FALSE {
+            missing.push("dynamicRendering".into());
+        }
+        if f13.synchronization2 == vk::FALSE {
+            missing.push("synchronization2".into());
+        }
+        if core.depth_clamp == vk::FALSE {
+            missing.push("depthClamp".into());
+        }
+        let qf = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+        let family = qf.iter().position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS));
+        if family.is_none() {
+            missing.push("a graphics queue".into());
+        }
+        let d32 = unsafe { instance.get_physical_device_format_properties(pd, vk::Format::D32_SFLOAT) }.optimal_tiling_features;
+        if !d32.contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE) {
+            missing.push("D32_SFLOAT depth attachment + sampling".into());
+        }
+        if desc.swapchain {
+            let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+            if !exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == ash::khr::swapchain::NAME)) {
+                missing.push("VK_KHR_swapchain".into());
+            }
+        }
+        if !missing.is_empty() {
+            reasons.push(format!("{name}: missing {}", missing.join(", ")));
+            continue;
+        }
+        let s = score(props.device_type);
+        if best.as_ref().is_none_or(|b| s > b.0) {
+            best = Some((s, pd, family.unwrap_or(0) as u32, core.sampler_anisotropy == vk::TRUE));
+        }
+    }
+    best.map(|(_, pd, f, a)| (pd, f, a)).ok_or_else(|| GpuError::NoDevice(reasons.join("; ")))
+}

@@ -1,0 +1,163 @@
+//! Per-frame planning on the CPU: which lights shade, which one gets the shadow map, the fitted
+//! light projection, the camera projection, and the frame uniform block.
+
+use super::settings::{ShadowFit, View};
+use super::uniforms::{FrameUniform, LightUniform, MAX_LIGHTS};
+use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
+use crate::math::shadow_fit::{fit_directional, fit_spot, CameraFrustum, DirectionalFitInput};
+use crate::math::Aabb;
+use crate::scene::{Camera, Light, LightKind, Scene};
+use glam::{Mat4, Vec3, Vec4};
+
+/// Elevation of the default sun used when a scene has no light (degrees).
+pub const DEFAULT_SUN_ELEVATION_DEG: f32 = 50.0;
+/// Azimuth of the default sun (degrees).
+pub const DEFAULT_SUN_AZIMUTH_DEG: f32 = 35.0;
+/// Intensity of the default sun.
+pub const DEFAULT_SUN_INTENSITY: f32 = 1.7;
+
+/// The lights a view is shaded with: the scene's, or the default sun; `sun_direction` overrides
+/// the first directional light's direction.
+pub fn effective_lights(scene: &Scene, view: &View) -> Vec<Light> {
+    let mut lights = scene.lights.clone();
+    if lights.is_empty() {
+        lights.push(Light::sun(
+            Light::sun_direction(DEFAULT_SUN_ELEVATION_DEG.to_radians(), DEFAULT_SUN_AZIMUTH_DEG.to_radians()),
+            DEFAULT_SUN_INTENSITY,
+        ));
+    }
+    if let Some(d) = view.sun_direction.and_then(|d| d.try_normalize()) {
+        if let Some(l) = lights.iter_mut().find(|l| l.kind == LightKind::Directional) {
+            l.direction = d;
+        } else {
+            lights.insert(0, Light::sun(d, DEFAULT_SUN_INTENSITY));
+        }
+    }
+    lights.truncate(MAX_LIGHTS);
+    lights
+}
+
+/// Camera projection (reversed-z; infinite when the camera has no far plane).
+pub fn camera_projection(camera: &Camera, aspect: f32) -> Mat4 {
+    match camera.far {
+        Some(f) if f > camera.near => perspective_reversed(camera.fov_y, aspect, camera.near, f),
+        _ => perspective_infinite_reversed(camera.fov_y, aspect, camera.near),
+    }
+}
+
+/// The frustum used to fit shadows: far = the camera's far, or the farthest scene corner.
+pub fn fitting_frustum(camera: &Camera, aspect: f32, bounds: &Aabb) -> CameraFrustum {
+    let eye = camera.position();
+    let far_scene = bounds.corners().iter().map(|c| c.distance(eye)).fold(0.0f32, f32::max);
+    let far = camera.far.unwrap_or(far_scene).min(far_scene.max(camera.near * 2.0));
+    CameraFrustum { view_from_world: camera.view_from_world(), fov_y: camera.fov_y, aspect, near: camera.near, far: far.max(camera.near * 1.01) }
+}
+
+/// The result of planning a frame.
+#[derive(Clone, Debug)]
+pub struct FramePlan {
+    /// The uniform block for the camera pass.
+    pub uniform: FrameUniform,
+    /// Lights shading this frame.
+    pub lights: Vec<Light>,
+    /// Index of the light with the shadow map, if any.
+    pub shadow_light: Option<usize>,
+    /// World → light clip of the shadow map.
+    pub light_clip_from_world: Mat4,
+    /// World size of a shadow texel (directional) or per unit distance (spot).
+    pub texel_world: f32,
+    /// The camera's world → clip.
+    pub clip_from_world: Mat4,
+}
+
+/// Plans a frame for `view` of a scene with `bounds`, rendered at `aspect`.
+pub fn plan_frame(scene: &Scene, bounds: &Aabb, view: &View, aspect: f32, hw_compare: bool) -> FramePlan {
+    let lights = effective_lights(scene, view);
+    let proj = camera_projection(&view.camera, aspect);
+    let clip_from_world = proj * view.camera.view_from_world();
+    let shadow_light = lights.iter().position(|l| l.casts_shadows && l.kind != LightKind::Point && l.intensity > 0.0);
+    let mut light_clip_from_world = Mat4::IDENTITY;
+    let mut texel_world = 0.0;
+    let size = view.shadow.map_size.max(1);
+    if let Some(i) = shadow_light {
+        let l = &lights[i];
+        match l.kind {
+            LightKind::Directional => {
+                let fit_cam = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
+                let camera = match view.shadow.fit {
+                    ShadowFit::Camera => Some(fitting_frustum(fit_cam, aspect, bounds)),
+                    ShadowFit::Scene => None,
+                };
+                let fit = fit_directional(&DirectionalFitInput {
+                    direction: l.direction,
+                    scene_bounds: *bounds,
+                    camera,
+                    map_size: size,
+                    snap: view.shadow.snap,
+                });
+                light_clip_from_world = fit.light_clip_from_world;
+                texel_world = fit.texel_world;
+            }
+            LightKind::Spot { outer, .. } => {
+                let (m, tan_half) = fit_spot(l.position, l.direction, outer, bounds);
+                light_clip_from_world = m;
+                texel_world = 2.0 * tan_half / size as f32;
+            }
+            LightKind::Point => {}
+        }
+    }
+    let mut u = FrameUniform {
+        clip_from_world,
+        light_clip_from_world,
+        camera_position: view.camera.position().extend(1.0),
+        ambient: view.ambient.extend(0.0),
+        shadow: Vec4::new(
+            size as f32,
+            view.shadow.normal_offset,
+            texel_world,
+            if view.shadow.enabled && shadow_light.is_some() { 1.0 } else { 0.0 },
+        ),
+        shadow_light: shadow_light.map(|i| lights[i].position.extend(i as f32)).unwrap_or(Vec4::new(0.0, 0.0, 0.0, -1.0)),
+        modes: [view.mode.shader_value(), view.shadow.pcf.taps(), hw_compare as u32, lights.len() as u32],
+        lights: [LightUniform::default(); MAX_LIGHTS],
+    };
+    if shadow_light.is_none() {
+        // No light index matches: w = a value no loop index reaches.
+        u.shadow_light.w = MAX_LIGHTS as f32 + 1.0;
+    }
+    for (i, l) in lights.iter().enumerate() {
+        let (kind, cone) = match l.kind {
+            LightKind::Directional => (0.0, Vec4::ZERO),
+            LightKind::Point => (1.0, Vec4::ZERO),
+            LightKind::Spot { inner, outer } => (2.0, Vec4::new(inner.cos(), outer.cos(), 0.0, 0.0)),
+        };
+        u.lights[i] = LightUniform {
+            position: l.position.extend(kind),
+            direction: l.direction.normalize_or(Vec3::NEG_Y).extend(0.0),
+            color: (l.color * l.intensity).extend(0.0),
+            cone,
+        };
+    }
+    FramePlan { uniform: u, lights, shadow_light, light_clip_from_world, texel_world, clip_from_world }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::demo::demo_scene;
+
+    #[test]
+    fn default_sun_and_override() {
+        let mut s = demo_scene();
+        s.lights.clear();
+        let mut v = View::new(s.default_camera(1.5));
+        let p = plan_frame(&s, &s.bounds(), &v, 1.5, false);
+        assert_eq!(p.lights.len(), 1);
+        assert_eq!(p.shadow_light, Some(0));
+        assert!(p.texel_world > 0.0);
+        v.sun_direction = Some(Vec3::new(0.0, -1.0, 0.0));
+        let p = plan_frame(&s, &s.bounds(), &v, 1.5, false);
+        assert_eq!(p.lights[0].direction, Vec3::NEG_Y);
+        assert_eq!(p.uniform.modes[3], 1);
+    }
+}

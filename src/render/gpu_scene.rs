@@ -1,0 +1,228 @@
+//! A scene uploaded to the GPU: one position stream (shared by the shadow pass), one attribute
+//! stream, one index buffer, textures with mipmaps, and a descriptor set per material.
+
+use super::uniforms::MaterialUniform;
+use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::shaders::{scene as sh, set_layout};
+use crate::gpu::{Buffer, Image};
+use crate::math::Aabb;
+use crate::scene::{AlphaMode, Scene};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec4};
+use gpu_allocator::MemoryLocation;
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// Non-position vertex attributes, interleaved (locations 1–3 of the camera pass).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct VertexAttributes {
+    /// Object-space normal.
+    pub normal: [f32; 3],
+    /// TEXCOORD_0.
+    pub uv: [f32; 2],
+    /// Tangent with bitangent sign in w.
+    pub tangent: [f32; 4],
+}
+
+/// One indexed draw (a primitive of an instance).
+#[derive(Clone, Copy, Debug)]
+pub struct Draw {
+    /// First index in the index buffer.
+    pub first_index: u32,
+    /// Index count.
+    pub index_count: u32,
+    /// Added to each index.
+    pub vertex_offset: i32,
+    /// Material index (= descriptor set index).
+    pub material: usize,
+    /// Model → world.
+    pub world_from_model: Mat4,
+    /// World-space bounds (for culling).
+    pub world_bounds: Aabb,
+    /// Draw both faces.
+    pub double_sided: bool,
+}
+
+/// The GPU copy of a scene.
+pub struct GpuScene {
+    ctx: Arc<Context>,
+    /// Positions (vec3 f32), binding 0 of both passes.
+    pub positions: Buffer,
+    /// Attributes, binding 1 of the camera pass.
+    pub attributes: Buffer,
+    /// u32 indices.
+    pub indices: Buffer,
+    /// Draws.
+    pub draws: Vec<Draw>,
+    /// Descriptor set layout of group 1 (material).
+    pub material_layout: vk::DescriptorSetLayout,
+    /// One set per material.
+    pub material_sets: Vec<vk::DescriptorSet>,
+    /// World bounds.
+    pub bounds: Aabb,
+    /// Triangles drawn per frame.
+    pub triangles: usize,
+    pool: vk::DescriptorPool,
+    sampler: vk::Sampler,
+    _material_buffers: Vec<Buffer>,
+    _textures: Vec<Image>,
+}
+
+impl GpuScene {
+    /// Uploads `scene`.
+    pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self, GpuError> {
+        // Geometry: one entry per mesh primitive, shared by all instances.
+        let mut positions: Vec<[f32; 3]> = Vec::new();
+        let mut attrs: Vec<VertexAttributes> = Vec::new();
+        let mut indices: Vec<u32> = Vec::new();
+        let mut ranges: Vec<Vec<(u32, u32, i32, usize, Aabb)>> = Vec::new();
+        for mesh in &scene.meshes {
+            let mut r = Vec::new();
+            for p in &mesh.primitives {
+                let first = indices.len() as u32;
+                let base = positions.len() as i32;
+                positions.extend(p.positions.iter().map(|v| v.to_array()));
+                for i in 0..p.positions.len() {
+                    attrs.push(VertexAttributes {
+                        normal: p.normals.get(i).copied().unwrap_or(glam::Vec3::Y).to_array(),
+                        uv: p.uvs.get(i).copied().unwrap_or_default().to_array(),
+                        tangent: p.tangents.get(i).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0)).to_array(),
+                    });
+                }
+                indices.extend_from_slice(&p.indices);
+                r.push((first, p.indices.len() as u32, base, p.material.min(scene.materials.len().saturating_sub(1)), p.bounds()));
+            }
+            ranges.push(r);
+        }
+        let mut draws = Vec::new();
+        let mut triangles = 0;
+        for inst in &scene.instances {
+            for &(first_index, index_count, vertex_offset, material, b) in &ranges[inst.mesh] {
+                if index_count == 0 {
+                    continue;
+                }
+                triangles += index_count as usize / 3;
+                draws.push(Draw {
+                    first_index,
+                    index_count,
+                    vertex_offset,
+                    material,
+                    world_from_model: inst.world_from_model,
+                    world_bounds: b.transformed(&inst.world_from_model),
+                    double_sided: scene.materials.get(material).is_some_and(|m| m.double_sided),
+                });
+            }
+        }
+        let vb = vk::BufferUsageFlags::VERTEX_BUFFER;
+        let pos_buf = Buffer::device_local_with_data(ctx, "positions", vb, bytemuck::cast_slice(&positions))?;
+        let attr_buf = Buffer::device_local_with_data(ctx, "attributes", vb, bytemuck::cast_slice(&attrs))?;
+        let idx_buf = Buffer::device_local_with_data(ctx, "indices", vk::BufferUsageFlags::INDEX_BUFFER, bytemuck::cast_slice(&indices))?;
+
+        // Textures, created per (image, colour space) actually used.
+        let mut textures: Vec<Image> = Vec::new();
+        let mut tex_index: HashMap<(usize, bool), usize> = HashMap::new();
+        let white_srgb = Image::texture_rgba8(ctx, "default white sRGB", 1, 1, &[255; 4], true)?;
+        let white_linear = Image::texture_rgba8(ctx, "default white", 1, 1, &[255; 4], false)?;
+        let flat_normal = Image::texture_rgba8(ctx, "default flat normal", 1, 1, &[128, 128, 255, 255], false)?;
+        textures.extend([white_srgb, white_linear, flat_normal]);
+        let mut get_tex = |t: Option<crate::scene::TextureRef>, srgb: bool, fallback: usize, textures: &mut Vec<Image>| -> Result<vk::ImageView, GpuError> {
+            let Some(t) = t.filter(|t| t.texture < scene.textures.len()) else { return Ok(textures[fallback].view) };
+            if let Some(&i) = tex_index.get(&(t.texture, srgb)) {
+                return Ok(textures[i].view);
+            }
+            let src = &scene.textures[t.texture];
+            let img = Image::texture_rgba8(ctx, &src.name, src.width, src.height, &src.rgba, srgb)?;
+            textures.push(img);
+            tex_index.insert((t.texture, srgb), textures.len() - 1);
+            Ok(textures[textures.len() - 1].view)
+        };
+
+        let material_layout = set_layout(ctx, sh::BINDINGS, 1, "material set layout")?;
+        let n = scene.materials.len().max(1) as u32;
+        let pool_sizes = [
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 4 * n },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: n },
+        ];
+        let pool = unsafe {
+            ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(n).pool_sizes(&pool_sizes), None)
+        }
+        .vk("vkCreateDescriptorPool")?;
+        let sampler_info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
+            .address_mode_u(vk::SamplerAddressMode::REPEAT)
+            .address_mode_v(vk::SamplerAddressMode::REPEAT)
+            .address_mode_w(vk::SamplerAddressMode::REPEAT)
+            .anisotropy_enable(ctx.anisotropy)
+            .max_anisotropy(if ctx.anisotropy { 8.0f32.min(ctx.properties.limits.max_sampler_anisotropy) } else { 1.0 })
+            .max_lod(vk::LOD_CLAMP_NONE);
+        let sampler = unsafe { ctx.device.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
+        ctx.set_name(sampler, "material sampler");
+
+        let layouts = vec![material_layout; n as usize];
+        let sets = unsafe { ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts)) }
+            .vk("vkAllocateDescriptorSets")?;
+        let mut material_buffers = Vec::new();
+        for (i, m) in scene.materials.iter().enumerate() {
+            let u = MaterialUniform {
+                base_color: m.base_color,
+                emissive: m.emissive.extend(m.normal_scale),
+                params: Vec4::new(m.metallic, m.roughness, m.normal_texture.is_some() as u32 as f32, m.unlit as u32 as f32),
+                extra: Vec4::new(if let AlphaMode::Mask(c) = m.alpha_mode { c.max(1e-6) } else { 0.0 }, 0.0, 0.0, 0.0),
+            };
+            let mut buf = Buffer::new(ctx, &format!("material {i} '{}'", m.name), std::mem::size_of::<MaterialUniform>() as u64, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)?;
+            buf.write(0, bytemuck::bytes_of(&u))?;
+            let base = get_tex(m.base_color_texture, true, 0, &mut textures)?;
+            let normal = get_tex(m.normal_texture, false, 2, &mut textures)?;
+            let mr = get_tex(m.metallic_roughness_texture, false, 1, &mut textures)?;
+            let emissive = get_tex(m.emissive_texture, true, 0, &mut textures)?;
+            let buf_info = [vk::DescriptorBufferInfo { buffer: buf.raw, offset: 0, range: vk::WHOLE_SIZE }];
+            let img = |v| [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: v, image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL }];
+            let (i_base, i_normal, i_mr, i_em) = (img(base), img(normal), img(mr), img(emissive));
+            let samp = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
+            let set = sets[i];
+            let w = |b: &crate::gpu::shaders::ReflectedBinding| vk::WriteDescriptorSet::default().dst_set(set).dst_binding(b.binding).descriptor_type(b.descriptor_type());
+            let writes = [
+                w(&sh::MATERIAL).buffer_info(&buf_info),
+                w(&sh::BASE_COLOR_TEX).image_info(&i_base),
+                w(&sh::NORMAL_TEX).image_info(&i_normal),
+                w(&sh::METAL_ROUGH_TEX).image_info(&i_mr),
+                w(&sh::EMISSIVE_TEX).image_info(&i_em),
+                w(&sh::MATERIAL_SAMPLER).image_info(&samp),
+            ];
+            unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+            material_buffers.push(buf);
+        }
+        Ok(Self {
+            ctx: ctx.clone(),
+            positions: pos_buf,
+            attributes: attr_buf,
+            indices: idx_buf,
+            draws,
+            material_layout,
+            material_sets: sets,
+            bounds: scene.bounds(),
+            triangles,
+            pool,
+            sampler,
+            _material_buffers: material_buffers,
+            _textures: textures,
+        })
+    }
+}
+
+impl Drop for GpuScene {
+    fn drop(&mut self) {
+        unsafe {
+            let d = &self.ctx.device;
+            let _ = d.device_wait_idle();
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_sampler(self.sampler, None);
+            d.destroy_descriptor_set_layout(self.material_layout, None);
+        }
+    }
+}

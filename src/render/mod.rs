@@ -1,0 +1,13 @@
+//! Rendering: one module per pass, the per-frame plan, and the offscreen renderer.
+
+pub mod camera_pass;
+pub mod frame;
+pub mod gpu_scene;
+pub mod pipeline;
+pub mod renderer;
+pub mod settings;
+pub mod shadow_pass;
+pub mod uniforms;
+
+pub use renderer::{FrameStats, RenderedFrame, Renderer};
+pub use settings::{Pcf, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};

@@ -1,0 +1,145 @@
+//! What a frame is rendered with: view, shadow and output settings.
+
+use crate::scene::Camera;
+use glam::Vec3;
+
+/// What the camera pass writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ViewMode {
+    /// The shaded image.
+    #[default]
+    Lit,
+    /// The shadowed light's visibility term alone (the factor the lit image multiplies by):
+    /// 255 where lit, 0 where blocked or facing away, grey in filtered penumbrae.
+    Shadow,
+    /// World normals after normal mapping, encoded n·0.5+0.5.
+    Normals,
+    /// The shadow map itself (grey = depth, reversed-z: white is near the light).
+    ShadowMap,
+}
+
+impl ViewMode {
+    /// Shader constant.
+    pub fn shader_value(self) -> u32 {
+        match self {
+            ViewMode::Lit | ViewMode::ShadowMap => 0,
+            ViewMode::Shadow => 1,
+            ViewMode::Normals => 2,
+        }
+    }
+}
+
+/// Shadow-map filtering kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pcf {
+    /// One nearest-texel comparison.
+    None,
+    /// One bilinear 2×2 comparison.
+    P2x2,
+    /// 3×3 bilinear taps at one-texel spacing (a 4×4-texel footprint).
+    P3x3,
+    /// 5×5 bilinear taps (a 6×6-texel footprint).
+    P5x5,
+}
+
+impl Pcf {
+    /// Bilinear taps per side (0 for nearest).
+    pub fn taps(self) -> u32 {
+        match self {
+            Pcf::None => 0,
+            Pcf::P2x2 => 1,
+            Pcf::P3x3 => 3,
+            Pcf::P5x5 => 5,
+        }
+    }
+}
+
+/// Depth format of the shadow map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadowFormat {
+    /// 32-bit float (default).
+    D32,
+    /// 16-bit unorm.
+    D16,
+}
+
+/// How the directional light's frustum is fitted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadowFit {
+    /// To the camera frustum ∩ scene bounds (receivers), extended to all casters.
+    Camera,
+    /// To the whole scene bounds.
+    Scene,
+}
+
+/// Shadow settings. Biases are in the units named; the defaults were chosen by the acne and
+/// peter-panning tests (`tests/gpu_shadows.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowSettings {
+    /// Shadows on or off.
+    pub enabled: bool,
+    /// Map size in texels (square).
+    pub map_size: u32,
+    /// Depth format.
+    pub format: ShadowFormat,
+    /// Filter.
+    pub pcf: Pcf,
+    /// Constant depth bias, in units of the depth format's minimum resolvable difference, applied
+    /// away from the light (the sign flip for reversed-z is handled internally).
+    pub constant_bias: f32,
+    /// Slope-scaled depth bias (multiplies the caster's depth slope), away from the light.
+    pub slope_bias: f32,
+    /// Normal-offset bias in shadow texels (scaled by the texel's world size and sin θ).
+    pub normal_offset: f32,
+    /// Frustum fitting.
+    pub fit: ShadowFit,
+    /// Snap the fitted frustum to whole texels (stable under camera motion).
+    pub snap: bool,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            map_size: 2048,
+            format: ShadowFormat::D32,
+            pcf: Pcf::P3x3,
+            constant_bias: 1.0,
+            slope_bias: 1.5,
+            normal_offset: 1.5,
+            fit: ShadowFit::Camera,
+            snap: true,
+        }
+    }
+}
+
+/// Everything that decides one frame's pixels besides the scene.
+#[derive(Clone, Debug)]
+pub struct View {
+    /// The camera.
+    pub camera: Camera,
+    /// Override for the direction of the scene's first directional light (or the default sun).
+    pub sun_direction: Option<Vec3>,
+    /// Output.
+    pub mode: ViewMode,
+    /// Shadow settings.
+    pub shadow: ShadowSettings,
+    /// Ambient intensity Ia.
+    pub ambient: Vec3,
+    /// Fit the light frustum to this camera instead of `camera` (for stability tests).
+    pub shadow_fit_camera: Option<Camera>,
+}
+
+impl View {
+    /// A view through `camera` with default settings.
+    pub fn new(camera: Camera) -> Self {
+        Self {
+            camera,
+            sun_direction: None,
+            mode: ViewMode::Lit,
+            shadow: ShadowSettings::default(),
+            ambient: Vec3::splat(0.12),
+            shadow_fit_camera: None,
+        }
+    }
+}

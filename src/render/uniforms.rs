@@ -1,0 +1,104 @@
+//! `#[repr(C)]` mirrors of the shader structs; sizes are checked at compile time against the sizes
+//! naga computed from the WGSL (see `build.rs`).
+
+use crate::gpu::shaders;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec4};
+
+/// Most lights the camera pass shades.
+pub const MAX_LIGHTS: usize = 8;
+
+/// One light as the shader sees it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct LightUniform {
+    /// xyz position, w kind (0 directional, 1 point, 2 spot).
+    pub position: Vec4,
+    /// xyz unit direction of travel.
+    pub direction: Vec4,
+    /// rgb colour × intensity.
+    pub color: Vec4,
+    /// x cos(inner), y cos(outer).
+    pub cone: Vec4,
+}
+
+/// Per-frame constants of the camera pass (`Frame` in scene.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniform {
+    /// World → clip (camera).
+    pub clip_from_world: Mat4,
+    /// World → clip (shadowed light).
+    pub light_clip_from_world: Mat4,
+    /// Camera position.
+    pub camera_position: Vec4,
+    /// Ambient intensity Ia.
+    pub ambient: Vec4,
+    /// x map size, y normal offset (texels), z texel world size (or per unit distance), w enabled.
+    pub shadow: Vec4,
+    /// xyz shadowed light position, w its index.
+    pub shadow_light: Vec4,
+    /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
+    pub modes: [u32; 4],
+    /// Lights.
+    pub lights: [LightUniform; MAX_LIGHTS],
+}
+
+/// Material constants (`Material` in scene.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct MaterialUniform {
+    /// Base colour factor.
+    pub base_color: Vec4,
+    /// rgb emissive, w normal scale.
+    pub emissive: Vec4,
+    /// x metallic, y roughness, z has normal map, w unlit.
+    pub params: Vec4,
+    /// x alpha cutoff.
+    pub extra: Vec4,
+}
+
+/// Per-draw immediates of the camera pass.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SceneImmediates {
+    /// Model → world.
+    pub world_from_model: Mat4,
+    /// Normal matrix column 0; w = sign of the determinant.
+    pub normal_x: Vec4,
+    /// Normal matrix column 1.
+    pub normal_y: Vec4,
+    /// Normal matrix column 2.
+    pub normal_z: Vec4,
+}
+
+/// Per-draw immediates of the shadow pass.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ShadowImmediates {
+    /// World → light clip.
+    pub light_clip_from_world: Mat4,
+    /// Model → world.
+    pub world_from_model: Mat4,
+}
+
+const _: () = assert!(std::mem::size_of::<FrameUniform>() == shaders::scene::FRAME.size as usize);
+const _: () = assert!(std::mem::size_of::<MaterialUniform>() == shaders::scene::MATERIAL.size as usize);
+const _: () = assert!(std::mem::size_of::<SceneImmediates>() == shaders::scene::IMMEDIATE_SIZE as usize);
+const _: () = assert!(std::mem::size_of::<ShadowImmediates>() == shaders::shadow::IMMEDIATE_SIZE as usize);
+
+impl SceneImmediates {
+    /// Immediates for a model transform (normal matrix = inverse transpose of its 3×3).
+    pub fn new(world_from_model: Mat4) -> Self {
+        let m3 = glam::Mat3::from_mat4(world_from_model);
+        let det = m3.determinant();
+        let nm = if det.abs() > 1e-30 { m3.inverse().transpose() } else { m3 };
+        let sign = if det < 0.0 { -1.0 } else { 1.0 };
+        Self {
+            world_from_model,
+            normal_x: nm.x_axis.extend(sign),
+            normal_y: nm.y_axis.extend(0.0),
+            normal_z: nm.z_axis.extend(0.0),
+        }
+    }
+}
