@@ -40,6 +40,8 @@ struct Frame {
     shadow: vec4<f32>,
     // xyz: shadowed light position (spot), w: index of the shadowed light
     shadow_light: vec4<f32>,
+    // x: constant bias in shadow texels, applied towards the light
+    bias: vec4<f32>,
     // x: view mode, y: PCF kernel width in bilinear taps (0 = single nearest compare),
     // z: 1 if hardware linear comparison filtering is used, w: number of lights
     modes: vec4<u32>,
@@ -143,7 +145,8 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>) -> f32 {
     // grazing angles where acne appears.
     let cos_theta = clamp(dot(ng, l), 0.0, 1.0);
     let sin_theta = sqrt(1.0 - cos_theta * cos_theta);
-    let offset = ng * (frame.shadow.y * texel_world * sin_theta);
+    // Constant bias: towards the light by a number of texels (so it scales with texel size).
+    let offset = ng * (frame.shadow.y * texel_world * sin_theta) + l * (frame.bias.x * texel_world);
     let lc = frame.light_clip_from_world * vec4<f32>(p + offset, 1.0);
     if lc.w <= 0.0 {
         return 1.0;

@@ -104,7 +104,7 @@ pub struct ViewArgs {
     /// PCF kernel.
     #[arg(long, value_enum, default_value = "3x3")]
     pub pcf: PcfArg,
-    /// Constant depth bias (depth-format units).
+    /// Constant bias in shadow texels (receiver moved towards the light).
     #[arg(long, default_value_t = ShadowSettings::default().constant_bias, allow_hyphen_values = true)]
     pub bias_constant: f32,
     /// Slope-scaled depth bias.

@@ -118,6 +118,7 @@ pub fn plan_frame(scene: &Scene, bounds: &Aabb, view: &View, aspect: f32, hw_com
             if view.shadow.enabled && shadow_light.is_some() { 1.0 } else { 0.0 },
         ),
         shadow_light: shadow_light.map(|i| lights[i].position.extend(i as f32)).unwrap_or(Vec4::new(0.0, 0.0, 0.0, -1.0)),
+        bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
         modes: [view.mode.shader_value(), view.shadow.pcf.taps(), hw_compare as u32, lights.len() as u32],
         lights: [LightUniform::default(); MAX_LIGHTS],
     };

@@ -84,10 +84,11 @@ pub struct ShadowSettings {
     pub format: ShadowFormat,
     /// Filter.
     pub pcf: Pcf,
-    /// Constant depth bias, in units of the depth format's minimum resolvable difference, applied
-    /// away from the light (the sign flip for reversed-z is handled internally).
+    /// Constant bias in shadow texels: the receiver's lookup point moves this many texel widths
+    /// towards the light (so the bias follows the texel's world size).
     pub constant_bias: f32,
-    /// Slope-scaled depth bias (multiplies the caster's depth slope), away from the light.
+    /// Slope-scaled depth bias (hardware, multiplies the caster's depth slope), applied away from
+    /// the light (negated internally for reversed-z).
     pub slope_bias: f32,
     /// Normal-offset bias in shadow texels (scaled by the texel's world size and sin θ).
     pub normal_offset: f32,

@@ -132,8 +132,9 @@ impl ShadowPass {
             if draw && !scene.draws.is_empty() {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
                 set_viewport(&self.ctx, cmd, map.extent);
-                // Reversed-z: "away from the light" is towards smaller depth, so both factors are negated.
-                d.cmd_set_depth_bias(cmd, -s.constant_bias, 0.0, -s.slope_bias);
+                // Reversed-z: "away from the light" is towards smaller depth, so the factor is negated.
+                // The constant bias is applied on the receiver side, in texels (camera pass).
+                d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
                 d.cmd_bind_vertex_buffers(cmd, 0, &[scene.positions.raw], &[0]);
                 d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
                 for dr in &scene.draws {

@@ -38,6 +38,8 @@ pub struct FrameUniform {
     pub shadow: Vec4,
     /// xyz shadowed light position, w its index.
     pub shadow_light: Vec4,
+    /// x constant bias in shadow texels (towards the light).
+    pub bias: Vec4,
     /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
     pub modes: [u32; 4],
     /// Lights.

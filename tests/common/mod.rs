@@ -1,0 +1,83 @@
+//! Helpers shared by the GPU tests: a validated context, projection of world points to pixels,
+//! image statistics and artifact output.
+#![allow(dead_code)]
+
+use glam::{Mat4, Vec3, Vec4};
+use std::path::PathBuf;
+use std::sync::Arc;
+use umbra::gpu::{Context, ContextDesc, Validation};
+
+/// A context with the Khronos validation layer (synchronization validation on). Fails if the
+/// layer is missing: GPU tests never run unvalidated.
+pub fn context() -> Arc<Context> {
+    Context::new(&ContextDesc { validation: Validation::Required, ..Default::default() })
+        .unwrap_or_else(|e| panic!("cannot create a validated Vulkan context: {e}"))
+}
+
+/// Fails the test if the validation layer reported any warning or error.
+pub fn assert_validation_clean(ctx: &Context) {
+    assert!(ctx.validation_enabled, "validation layer not enabled");
+    let n = ctx.validation_log.problem_count();
+    assert_eq!(n, 0, "validation messages: {:#?}", ctx.validation_log.messages());
+}
+
+/// Folder for test artifacts (images), under target/.
+pub fn out_dir() -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("umbra-test-output");
+    std::fs::create_dir_all(&d).ok();
+    d
+}
+
+/// Saves an image artifact and returns its path.
+pub fn save(img: &image::RgbaImage, name: &str) -> PathBuf {
+    let p = out_dir().join(name);
+    img.save(&p).expect("save artifact");
+    p
+}
+
+/// Pixel (x right, y down) of a world point under `clip_from_world`, if in front of the camera.
+pub fn project(clip_from_world: &Mat4, p: Vec3, w: u32, h: u32) -> Option<(f32, f32)> {
+    let c = *clip_from_world * Vec4::new(p.x, p.y, p.z, 1.0);
+    if c.w <= 0.0 {
+        return None;
+    }
+    let n = c.truncate() / c.w;
+    Some(((n.x * 0.5 + 0.5) * w as f32, (0.5 - n.y * 0.5) * h as f32))
+}
+
+/// The world-space ray through the centre of pixel (x, y).
+pub fn pixel_ray(clip_from_world: &Mat4, x: u32, y: u32, w: u32, h: u32) -> (Vec3, Vec3) {
+    let inv = clip_from_world.inverse();
+    let nx = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
+    let ny = 1.0 - (y as f32 + 0.5) / h as f32 * 2.0;
+    // Reversed-z: depth 1 is the near plane, small depth is far away.
+    let a = inv * Vec4::new(nx, ny, 1.0, 1.0);
+    let b = inv * Vec4::new(nx, ny, 0.01, 1.0);
+    let a = a.truncate() / a.w;
+    let b = b.truncate() / b.w;
+    (a, (b - a).normalize())
+}
+
+/// sRGB byte → linear.
+pub fn srgb_to_linear(b: u8) -> f32 {
+    let c = b as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Linear → sRGB byte.
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    255.0 * if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// The corpus folder: UMBRA_GLTF_CORPUS, else ../shared/gltf beside the checkout.
+pub fn corpus() -> PathBuf {
+    if let Ok(p) = std::env::var("UMBRA_GLTF_CORPUS") {
+        return PathBuf::from(p);
+    }
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/gltf")
+}
