@@ -133,17 +133,43 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
                 _ => {}
             }
         }
-        writeln!(code, "    /// `{}`: group {}, binding {}.", name.to_lowercase(), b.group, b.binding).unwrap();
+        writeln!(
+            code,
+            "    /// `{}`: group {}, binding {}.",
+            name.to_lowercase(),
+            b.group,
+            b.binding
+        )
+        .unwrap();
         writeln!(code, "    pub const {name}: ReflectedBinding = ReflectedBinding {{ name: \"{}\", group: {}, binding: {}, kind: {kind}, size: {size}, vertex: {vertex}, fragment: {fragment} }};", name.to_lowercase(), b.group, b.binding).unwrap();
         bindings.push(name);
     }
     writeln!(code, "    /// Every resource binding of the module.").unwrap();
-    writeln!(code, "    pub const BINDINGS: &[ReflectedBinding] = &[{}];", bindings.join(", ")).unwrap();
-    writeln!(code, "    /// Size in bytes of the immediate (push-constant) block, 0 if none.").unwrap();
-    writeln!(code, "    pub const IMMEDIATE_SIZE: u32 = {immediate_size};").unwrap();
+    writeln!(
+        code,
+        "    pub const BINDINGS: &[ReflectedBinding] = &[{}];",
+        bindings.join(", ")
+    )
+    .unwrap();
+    writeln!(
+        code,
+        "    /// Size in bytes of the immediate (push-constant) block, 0 if none."
+    )
+    .unwrap();
+    writeln!(
+        code,
+        "    pub const IMMEDIATE_SIZE: u32 = {immediate_size};"
+    )
+    .unwrap();
     for ep in &module.entry_points {
         writeln!(code, "    /// Entry point `{}`.", ep.name).unwrap();
-        writeln!(code, "    pub const ENTRY_{}: &std::ffi::CStr = c\"{}\";", ep.name.to_uppercase(), ep.name).unwrap();
+        writeln!(
+            code,
+            "    pub const ENTRY_{}: &std::ffi::CStr = c\"{}\";",
+            ep.name.to_uppercase(),
+            ep.name
+        )
+        .unwrap();
     }
     writeln!(code, "}}").unwrap();
     Ok(code)

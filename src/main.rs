@@ -7,7 +7,9 @@ use umbra::gpu::{Context, ContextDesc, Validation};
 use umbra::render::Renderer;
 
 fn main() {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).format_timestamp(None).init();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+        .format_timestamp(None)
+        .init();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(a) => render(a),
@@ -20,13 +22,17 @@ fn main() {
 }
 
 fn render(a: RenderArgs) -> anyhow::Result<()> {
-    let scene = load_scene(a.scene.as_ref())?;
+    let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
     for w in &scene.warnings {
         eprintln!("warning: {}: {w}", scene.name);
     }
     let view = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
-        validation: if a.validation { Validation::Required } else { Validation::Off },
+        validation: if a.validation {
+            Validation::Required
+        } else {
+            Validation::Off
+        },
         device: a.device.clone(),
         ..Default::default()
     })?;
@@ -38,7 +44,10 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         frames.push(renderer.render(&view, w, h)?);
     }
     let frame = frames.pop().expect("one frame");
-    frame.image.save(&a.output).with_context(|| format!("writing {}", a.output.display()))?;
+    frame
+        .image
+        .save(&a.output)
+        .with_context(|| format!("writing {}", a.output.display()))?;
     let mut all: Vec<_> = frames.iter().map(|f| f.stats.clone()).collect();
     all.push(frame.stats.clone());
     let median = |f: &dyn Fn(&umbra::render::FrameStats) -> Option<f64>| -> Option<f64> {
@@ -48,17 +57,27 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     };
     let wall = median(&|s| Some(s.wall_ms)).unwrap_or(0.0);
     let gpu = match (median(&|s| s.gpu_shadow_ms), median(&|s| s.gpu_camera_ms)) {
-        (Some(a), Some(b)) => format!("GPU {:.1} ms (shadow {a:.1} + camera {b:.1})", median(&|s| Some(s.gpu_shadow_ms? + s.gpu_camera_ms?)).unwrap_or(a + b)),
+        (Some(a), Some(b)) => format!(
+            "GPU {:.1} ms (shadow {a:.1} + camera {b:.1})",
+            median(&|s| Some(s.gpu_shadow_ms? + s.gpu_camera_ms?)).unwrap_or(a + b)
+        ),
         _ => "GPU time n/a".into(),
     };
     let s = &frame.stats;
-    let what = if n > 1 { format!("median of {n} frames: ") } else { String::new() };
+    let what = if n > 1 {
+        format!("median of {n} frames: ")
+    } else {
+        String::new()
+    };
     println!(
         "rendered {} ({} triangles, {} casters drawn) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
         scene.name, s.triangles, s.casters_drawn, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
     );
     if ctx.validation_log.problem_count() > 0 {
-        anyhow::bail!("{} validation message(s) of warning or error severity", ctx.validation_log.problem_count());
+        anyhow::bail!(
+            "{} validation message(s) of warning or error severity",
+            ctx.validation_log.problem_count()
+        );
     }
     Ok(())
 }

@@ -7,7 +7,9 @@ use common::*;
 use glam::{Mat4, Quat, Vec3};
 use umbra::render::{Renderer, View, ViewMode};
 use umbra::scene::shapes::{add_object, colored, plane, quad};
-use umbra::scene::{blinn_phong_params, demo::demo_scene, shade_blinn_phong, Camera, Light, Material, Scene};
+use umbra::scene::{
+    blinn_phong_params, demo::demo_scene, shade_blinn_phong, Camera, Light, Material, Scene,
+};
 
 #[test]
 fn demo_scene_renders_with_shadows() {
@@ -20,7 +22,11 @@ fn demo_scene_renders_with_shadows() {
     assert_eq!(f.image.dimensions(), (320, 180));
     assert!(f.stats.casters_drawn > 0);
     // Not blank: many distinct colours, a bright lit ground and dark shadows both present.
-    let lum: Vec<f32> = f.image.pixels().map(|p| 0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32).collect();
+    let lum: Vec<f32> = f
+        .image
+        .pixels()
+        .map(|p| 0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32)
+        .collect();
     let bright = lum.iter().filter(|&&l| l > 150.0).count();
     let dark = lum.iter().filter(|&&l| l < 60.0).count();
     assert!(bright > 5000 && dark > 2000, "bright {bright} dark {dark}");
@@ -35,16 +41,39 @@ fn demo_scene_renders_with_shadows() {
 }
 
 fn unlit(rgb: Vec3) -> Material {
-    Material { unlit: true, ..colored(rgb, 1.0) }
+    Material {
+        unlit: true,
+        ..colored(rgb, 1.0)
+    }
 }
 
 #[test]
 fn y_up_and_x_right_conventions() {
     // Camera at the origin looking down −Z, horizon in the middle of the image.
-    let mut s = Scene { name: "conventions".into(), ..Default::default() };
-    add_object(&mut s, "up", quad(1.0, 1.0), unlit(Vec3::new(1.0, 0.0, 0.0)), Mat4::from_translation(Vec3::new(0.0, 2.0, -6.0)));
-    add_object(&mut s, "left", quad(1.0, 1.0), unlit(Vec3::new(0.0, 1.0, 0.0)), Mat4::from_translation(Vec3::new(-2.5, 0.0, -6.0)));
-    let cam = Camera::look_at(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), 60f32.to_radians(), 0.1);
+    let mut s = Scene {
+        name: "conventions".into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "up",
+        quad(1.0, 1.0),
+        unlit(Vec3::new(1.0, 0.0, 0.0)),
+        Mat4::from_translation(Vec3::new(0.0, 2.0, -6.0)),
+    );
+    add_object(
+        &mut s,
+        "left",
+        quad(1.0, 1.0),
+        unlit(Vec3::new(0.0, 1.0, 0.0)),
+        Mat4::from_translation(Vec3::new(-2.5, 0.0, -6.0)),
+    );
+    let cam = Camera::look_at(
+        Vec3::ZERO,
+        Vec3::new(0.0, 0.0, -1.0),
+        60f32.to_radians(),
+        0.1,
+    );
     let ctx = context();
     let mut r = Renderer::new(&ctx, &s).unwrap();
     let f = r.render(&View::new(cam), 200, 100).unwrap();
@@ -52,28 +81,62 @@ fn y_up_and_x_right_conventions() {
     let (mut red_top, mut red_bottom, mut green_left, mut green_right) = (0, 0, 0, 0);
     for (x, y, p) in f.image.enumerate_pixels() {
         if p[0] > 200 && p[1] < 50 {
-            if y < 50 { red_top += 1 } else { red_bottom += 1 }
+            if y < 50 {
+                red_top += 1
+            } else {
+                red_bottom += 1
+            }
         }
         if p[1] > 200 && p[0] < 50 {
-            if x < 100 { green_left += 1 } else { green_right += 1 }
+            if x < 100 {
+                green_left += 1
+            } else {
+                green_right += 1
+            }
         }
     }
     // Single-sided quads facing the camera are drawn, so the winding convention holds too.
-    assert!(red_top > 50 && red_bottom == 0, "red quad above the horizon: top {red_top} bottom {red_bottom}");
-    assert!(green_left > 50 && green_right == 0, "green quad on the left: left {green_left} right {green_right}");
+    assert!(
+        red_top > 50 && red_bottom == 0,
+        "red quad above the horizon: top {red_top} bottom {red_bottom}"
+    );
+    assert!(
+        green_left > 50 && green_right == 0,
+        "green quad on the left: left {green_left} right {green_right}"
+    );
     // The same quads seen from behind are culled (back faces).
-    let behind = Camera::look_at(Vec3::new(0.0, 0.0, -12.0), Vec3::new(0.0, 0.0, -6.0), 60f32.to_radians(), 0.1);
+    let behind = Camera::look_at(
+        Vec3::new(0.0, 0.0, -12.0),
+        Vec3::new(0.0, 0.0, -6.0),
+        60f32.to_radians(),
+        0.1,
+    );
     let f = r.render(&View::new(behind), 200, 100).unwrap();
-    let coloured = f.image.pixels().filter(|p| p[0] > 200 || p[1] > 200).count();
-    assert_eq!(coloured, 0, "back faces of single-sided quads must be culled");
+    let coloured = f
+        .image
+        .pixels()
+        .filter(|p| p[0] > 200 || p[1] > 200)
+        .count();
+    assert_eq!(
+        coloured, 0,
+        "back faces of single-sided quads must be culled"
+    );
     assert_validation_clean(&ctx);
 }
 
 #[test]
 fn lit_surface_matches_blinn_phong_on_cpu() {
     let base = Vec3::new(0.5, 0.4, 0.3);
-    let mut s = Scene { name: "blinn-phong".into(), ..Default::default() };
-    let mat = Material { base_color: base.extend(1.0), metallic: 0.0, roughness: 0.6, ..Default::default() };
+    let mut s = Scene {
+        name: "blinn-phong".into(),
+        ..Default::default()
+    };
+    let mat = Material {
+        base_color: base.extend(1.0),
+        metallic: 0.0,
+        roughness: 0.6,
+        ..Default::default()
+    };
     add_object(&mut s, "wall", quad(40.0, 40.0), mat, Mat4::IDENTITY);
     let light_dir = Vec3::new(0.3, -0.4, -1.0).normalize();
     s.lights.push(Light::sun(light_dir, 1.3));
@@ -91,24 +154,42 @@ fn lit_surface_matches_blinn_phong_on_cpu() {
         let (o, d) = pixel_ray(&f.plan.clip_from_world, px, py, w, h);
         let p = o + d * (-o.z / d.z);
         let v = (eye - p).normalize();
-        let lin = m.ka * view.ambient + shade_blinn_phong(&m, Vec3::Z, -light_dir, v, Vec3::splat(1.3), 1.0);
+        let lin = m.ka * view.ambient
+            + shade_blinn_phong(&m, Vec3::Z, -light_dir, v, Vec3::splat(1.3), 1.0);
         let got = f.image.get_pixel(px, py);
         for c in 0..3 {
             let expect = linear_to_srgb(lin[c]);
             worst = worst.max((got[c] as f32 - expect).abs());
         }
     }
-    assert!(worst <= 2.0, "GPU differs from the CPU Blinn-Phong by {worst} sRGB levels (bound 2)");
+    assert!(
+        worst <= 2.0,
+        "GPU differs from the CPU Blinn-Phong by {worst} sRGB levels (bound 2)"
+    );
     assert_validation_clean(&ctx);
 }
 
 #[test]
 fn ground_lit_by_default_sun_when_scene_has_no_light() {
-    let mut s = Scene { name: "no light".into(), ..Default::default() };
-    add_object(&mut s, "ground", plane(10.0, 1.0), colored(Vec3::ONE, 1.0), Mat4::from_quat(Quat::IDENTITY));
+    let mut s = Scene {
+        name: "no light".into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "ground",
+        plane(10.0, 1.0),
+        colored(Vec3::ONE, 1.0),
+        Mat4::from_quat(Quat::IDENTITY),
+    );
     let ctx = context();
     let mut r = Renderer::new(&ctx, &s).unwrap();
-    let cam = Camera::look_at(Vec3::new(0.0, 5.0, 5.0), Vec3::ZERO, 45f32.to_radians(), 0.1);
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 5.0, 5.0),
+        Vec3::ZERO,
+        45f32.to_radians(),
+        0.1,
+    );
     let f = r.render(&View::new(cam), 64, 64).unwrap();
     let c = f.image.get_pixel(32, 32);
     assert!(c[0] > 120, "default sun should light the ground: {c:?}");

@@ -32,9 +32,24 @@ fn box_aabb() -> Aabb {
 
 fn caster_scene(light: Light, half: Vec3) -> Scene {
     CASTER_HALF.with(|c| c.set(half));
-    let mut s = Scene { name: "caster on plane".into(), ..Default::default() };
-    add_object(&mut s, "ground", plane(60.0, 1.0), colored(Vec3::splat(0.8), 1.0), Mat4::IDENTITY);
-    add_object(&mut s, "caster", cuboid(half), colored(Vec3::new(0.7, 0.2, 0.1), 1.0), Mat4::from_translation(Vec3::Y * half.y));
+    let mut s = Scene {
+        name: "caster on plane".into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "ground",
+        plane(60.0, 1.0),
+        colored(Vec3::splat(0.8), 1.0),
+        Mat4::IDENTITY,
+    );
+    add_object(
+        &mut s,
+        "caster",
+        cuboid(half),
+        colored(Vec3::new(0.7, 0.2, 0.1), 1.0),
+        Mat4::from_translation(Vec3::Y * half.y),
+    );
     s.lights.push(light);
     s
 }
@@ -76,17 +91,37 @@ struct Judged {
     exact_shadowed: usize,
 }
 
-fn judge(frame: &umbra::render::RenderedFrame, light: &Light, band: f32) -> (Judged, image::RgbaImage) {
+fn judge(
+    frame: &umbra::render::RenderedFrame,
+    light: &Light,
+    band: f32,
+) -> (Judged, image::RgbaImage) {
     let m = frame.plan.clip_from_world;
     let mut diff = frame.image.clone();
-    let mut j = Judged { judged: 0, false_shadow: 0, false_light: 0, exact_shadowed: 0 };
+    let mut j = Judged {
+        judged: 0,
+        false_shadow: 0,
+        false_light: 0,
+        exact_shadowed: 0,
+    };
     for y in 1..H - 1 {
         for x in 1..W - 1 {
-            let Some(g) = ground_point(&m, x, y) else { continue };
+            let Some(g) = ground_point(&m, x, y) else {
+                continue;
+            };
             let vis = exact_visible(light, g);
             // Edge band: world offsets of `band` and the neighbouring pixels' ground points.
             let mut edge = false;
-            for (dx, dz) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0), (0.7, 0.7), (-0.7, 0.7), (0.7, -0.7), (-0.7, -0.7)] {
+            for (dx, dz) in [
+                (1.0, 0.0),
+                (-1.0, 0.0),
+                (0.0, 1.0),
+                (0.0, -1.0),
+                (0.7, 0.7),
+                (-0.7, 0.7),
+                (0.7, -0.7),
+                (-0.7, -0.7),
+            ] {
                 if exact_visible(light, g + Vec3::new(dx * band, 0.0, dz * band)) != vis {
                     edge = true;
                 }
@@ -127,7 +162,12 @@ fn shadow_view(camera: Camera) -> View {
 /// on that side are in view.
 fn camera_on_shadow_side(light_dir: Vec3) -> Camera {
     let h = Vec3::new(light_dir.x, 0.0, light_dir.z).normalize_or(Vec3::Z);
-    Camera::look_at(h * 8.0 + Vec3::new(2.0, 10.0, 0.0), h * 2.0, 55f32.to_radians(), 0.1)
+    Camera::look_at(
+        h * 8.0 + Vec3::new(2.0, 10.0, 0.0),
+        h * 2.0,
+        55f32.to_radians(),
+        0.1,
+    )
 }
 
 #[test]
@@ -143,8 +183,16 @@ fn box_shadow_matches_geometry_at_80_45_15_degrees() {
         let (j, diff) = judge(&f, &light, band);
         save(&f.image, &format!("box_shadow_{elevation}.png"));
         save(&diff, &format!("box_shadow_{elevation}_diff.png"));
-        assert!(j.judged > (W * H / 3) as usize, "too few judged pixels at {elevation}°: {}", j.judged);
-        assert!(j.exact_shadowed > 60, "the shadow must be in view at {elevation}°: {}", j.exact_shadowed);
+        assert!(
+            j.judged > (W * H / 3) as usize,
+            "too few judged pixels at {elevation}°: {}",
+            j.judged
+        );
+        assert!(
+            j.exact_shadowed > 60,
+            "the shadow must be in view at {elevation}°: {}",
+            j.exact_shadowed
+        );
         assert_eq!(
             (j.false_shadow, j.false_light),
             (0, 0),
@@ -158,13 +206,27 @@ fn box_shadow_matches_geometry_at_80_45_15_degrees() {
 #[test]
 fn no_acne_on_a_plane_from_10_to_90_degrees() {
     let ctx = context();
-    let mut s = Scene { name: "plane".into(), ..Default::default() };
-    add_object(&mut s, "ground", plane(60.0, 1.0), colored(Vec3::splat(0.8), 1.0), Mat4::IDENTITY);
+    let mut s = Scene {
+        name: "plane".into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "ground",
+        plane(60.0, 1.0),
+        colored(Vec3::splat(0.8), 1.0),
+        Mat4::IDENTITY,
+    );
     let mut r = Renderer::new(&ctx, &s).unwrap();
     for elevation in (10..=90).step_by(10) {
         for azimuth in [0.0f32, 0.9] {
             let dir = Light::sun_direction((elevation as f32).to_radians(), azimuth);
-            let mut view = shadow_view(Camera::look_at(Vec3::new(5.0, 6.0, 12.0), Vec3::ZERO, 60f32.to_radians(), 0.1));
+            let mut view = shadow_view(Camera::look_at(
+                Vec3::new(5.0, 6.0, 12.0),
+                Vec3::ZERO,
+                60f32.to_radians(),
+                0.1,
+            ));
             view.sun_direction = Some(dir);
             let f = r.render(&view, W, H).unwrap();
             let m = f.plan.clip_from_world;
@@ -201,17 +263,30 @@ fn shadow_touches_the_casters_base_within_two_texels() {
         let light = Light::sun(Light::sun_direction(elevation.to_radians(), 0.0), 2.0);
         let scene = caster_scene(light, half);
         let mut r = Renderer::new(&ctx, &scene).unwrap();
-        let camera = Camera::look_at(Vec3::new(1.0, 5.0, -7.0), Vec3::new(0.0, 0.0, -1.0), 55f32.to_radians(), 0.1);
+        let camera = Camera::look_at(
+            Vec3::new(1.0, 5.0, -7.0),
+            Vec3::new(0.0, 0.0, -1.0),
+            55f32.to_radians(),
+            0.1,
+        );
         let f = r.render(&shadow_view(camera), W, H).unwrap();
         let texel = f.plan.texel_world;
         let m = f.plan.clip_from_world;
         let mut checked = 0;
         for k in -12..=12 {
             let p = Vec3::new(k as f32 * 0.1, 0.0, -(half.z + 2.0 * texel));
-            assert!(!exact_visible(&light, p), "test point must be in the exact shadow");
-            let Some((px, py)) = project(&m, p, W, H) else { continue };
+            assert!(
+                !exact_visible(&light, p),
+                "test point must be in the exact shadow"
+            );
+            let Some((px, py)) = project(&m, p, W, H) else {
+                continue;
+            };
             let (px, py) = (px as u32, py as u32);
-            if px >= W || py >= H || ground_point(&m, px, py).is_none_or(|g| g.distance(p) > 2.0 * texel) {
+            if px >= W
+                || py >= H
+                || ground_point(&m, px, py).is_none_or(|g| g.distance(p) > 2.0 * texel)
+            {
                 continue;
             }
             checked += 1;
@@ -219,15 +294,25 @@ fn shadow_touches_the_casters_base_within_two_texels() {
             if v >= 128 {
                 save(&f.image, &format!("peter_panning_{elevation}.png"));
             }
-            assert!(v < 128, "peter-panning at {elevation}°: {p} ({:.1} texels behind the base) is lit ({v})", 2.0);
+            assert!(
+                v < 128,
+                "peter-panning at {elevation}°: {p} ({:.1} texels behind the base) is lit ({v})",
+                2.0
+            );
         }
-        assert!(checked >= 10, "too few base points in view at {elevation}°: {checked}");
+        assert!(
+            checked >= 10,
+            "too few base points in view at {elevation}°: {checked}"
+        );
     }
     assert_validation_clean(&ctx);
 }
 
 fn count_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
-    a.pixels().zip(b.pixels()).filter(|(p, q)| p[0].abs_diff(q[0]) > 8).count()
+    a.pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| p[0].abs_diff(q[0]) > 8)
+        .count()
 }
 
 #[test]
@@ -240,7 +325,11 @@ fn sub_texel_camera_motion_leaves_shadows_unchanged_when_snapped() {
     let mut changed = [0usize; 2];
     for (i, snap) in [true, false].into_iter().enumerate() {
         let mut view = shadow_view(camera);
-        view.shadow = ShadowSettings { snap, map_size: 512, ..Default::default() };
+        view.shadow = ShadowSettings {
+            snap,
+            map_size: 512,
+            ..Default::default()
+        };
         let base = r.render(&view, W, H).unwrap();
         let texel = base.plan.texel_world;
         for step in 1..=6 {
@@ -255,8 +344,17 @@ fn sub_texel_camera_motion_leaves_shadows_unchanged_when_snapped() {
     }
     let total = (W * H * 6) as usize;
     // Snapped: identical up to a stated tiny count; unsnapped: visibly shimmering.
-    assert!(changed[0] <= total / 10000, "snapped fit changed {} of {total} pixels", changed[0]);
-    assert!(changed[1] > changed[0] + 50, "unsnapped fit should shimmer: {} vs snapped {}", changed[1], changed[0]);
+    assert!(
+        changed[0] <= total / 10000,
+        "snapped fit changed {} of {total} pixels",
+        changed[0]
+    );
+    assert!(
+        changed[1] > changed[0] + 50,
+        "unsnapped fit should shimmer: {} vs snapped {}",
+        changed[1],
+        changed[0]
+    );
     assert_validation_clean(&ctx);
 }
 
@@ -265,7 +363,10 @@ fn spot_light_shadow_matches_geometry() {
     let ctx = context();
     let pos = Vec3::new(-4.0, 6.0, -3.0);
     let light = Light {
-        kind: LightKind::Spot { inner: 0.5, outer: 0.8 },
+        kind: LightKind::Spot {
+            inner: 0.5,
+            outer: 0.8,
+        },
         position: pos,
         direction: (Vec3::new(1.0, 0.0, 1.0) - pos).normalize(),
         color: Vec3::ONE,
@@ -274,14 +375,28 @@ fn spot_light_shadow_matches_geometry() {
     };
     let scene = box_scene(light);
     let mut r = Renderer::new(&ctx, &scene).unwrap();
-    let view = shadow_view(Camera::look_at(Vec3::new(9.0, 8.0, 9.0), Vec3::new(1.5, 0.0, 1.5), 55f32.to_radians(), 0.1));
+    let view = shadow_view(Camera::look_at(
+        Vec3::new(9.0, 8.0, 9.0),
+        Vec3::new(1.5, 0.0, 1.5),
+        55f32.to_radians(),
+        0.1,
+    ));
     let f = r.render(&view, W, H).unwrap();
     // Texel size grows with distance; judge with the texel at the farthest shadow point (~12 units).
     let band = EDGE_TEXELS * f.plan.texel_world * 12.0;
     let (j, diff) = judge(&f, &light, band);
     save(&f.image, "spot_shadow.png");
     save(&diff, "spot_shadow_diff.png");
-    assert!(j.exact_shadowed > 200, "spot shadow in view: {}", j.exact_shadowed);
-    assert_eq!((j.false_shadow, j.false_light), (0, 0), "spot misclassified (of {} judged)", j.judged);
+    assert!(
+        j.exact_shadowed > 200,
+        "spot shadow in view: {}",
+        j.exact_shadowed
+    );
+    assert_eq!(
+        (j.false_shadow, j.false_light),
+        (0, 0),
+        "spot misclassified (of {} judged)",
+        j.judged
+    );
     assert_validation_clean(&ctx);
 }

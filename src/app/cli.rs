@@ -122,17 +122,31 @@ pub struct ViewArgs {
     /// Disable shadows.
     #[arg(long)]
     pub no_shadows: bool,
+    /// Add a ground plane under the model (to see its shadow).
+    #[arg(long)]
+    pub ground: bool,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WxH"))?;
-    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
-    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not WxH"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad height in '{s}'"))?;
     if w == 0 || h == 0 {
         return Err(format!("size {w}x{h} must be at least 1x1"));
     }
     if w > crate::render::renderer::MAX_SIDE || h > crate::render::renderer::MAX_SIDE {
-        return Err(format!("size {w}x{h} exceeds {0}x{0}", crate::render::renderer::MAX_SIDE));
+        return Err(format!(
+            "size {w}x{h} exceeds {0}x{0}",
+            crate::render::renderer::MAX_SIDE
+        ));
     }
     Ok((w, h))
 }
@@ -144,7 +158,10 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
     }
     let mut v = [0.0f32; 3];
     for (i, p) in parts.iter().enumerate() {
-        v[i] = p.trim().parse().map_err(|_| format!("'{p}' is not a number"))?;
+        v[i] = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' is not a number"))?;
         if !v[i].is_finite() {
             return Err(format!("'{p}' is not finite"));
         }
@@ -152,12 +169,16 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::from_array(v))
 }
 
-/// Loads SCENE or builds the demo.
-pub fn load_scene(path: Option<&PathBuf>) -> anyhow::Result<Scene> {
-    match path {
-        Some(p) => Ok(load_gltf(p)?),
-        None => Ok(demo_scene()),
+/// Loads SCENE or builds the demo; adds a ground plane when asked.
+pub fn load_scene(path: Option<&PathBuf>, ground: bool) -> anyhow::Result<Scene> {
+    let mut s = match path {
+        Some(p) => load_gltf(p)?,
+        None => demo_scene(),
+    };
+    if ground {
+        crate::scene::shapes::add_ground(&mut s);
     }
+    Ok(s)
 }
 
 /// Builds the view from arguments.
@@ -169,15 +190,25 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
                 bail!("--eye and --target must differ");
             }
             let b = scene.bounds();
-            let near = if b.is_empty() { 0.01 } else { (b.diagonal() * 1e-4).max(1e-4) };
+            let near = if b.is_empty() {
+                0.01
+            } else {
+                (b.diagonal() * 1e-4).max(1e-4)
+            };
             Camera::look_at(eye, target, 45f32.to_radians(), near)
         }
         (Some(_), None, _) | (None, Some(_), _) => bail!("--eye and --target go together"),
-        (None, None, Some(i)) => *scene
+        (None, None, Some(i)) => *scene.cameras.get(i).ok_or_else(|| {
+            anyhow!(
+                "--camera {i}: the scene has {} camera(s)",
+                scene.cameras.len()
+            )
+        })?,
+        (None, None, None) => scene
             .cameras
-            .get(i)
-            .ok_or_else(|| anyhow!("--camera {i}: the scene has {} camera(s)", scene.cameras.len()))?,
-        (None, None, None) => scene.cameras.first().copied().unwrap_or_else(|| scene.default_camera(aspect)),
+            .first()
+            .copied()
+            .unwrap_or_else(|| scene.default_camera(aspect)),
     };
     let mut v = View::new(camera);
     v.sun_direction = match a.sun_dir {
@@ -196,7 +227,11 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     v.shadow = ShadowSettings {
         enabled: !a.no_shadows,
         map_size: a.shadow_map,
-        format: if a.shadow_format == "d16" { ShadowFormat::D16 } else { ShadowFormat::D32 },
+        format: if a.shadow_format == "d16" {
+            ShadowFormat::D16
+        } else {
+            ShadowFormat::D32
+        },
         pcf: match a.pcf {
             PcfArg::None => Pcf::None,
             PcfArg::P2x2 => Pcf::P2x2,
@@ -206,7 +241,11 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         constant_bias: a.bias_constant,
         slope_bias: a.bias_slope,
         normal_offset: a.normal_offset,
-        fit: if a.fit == "scene" { ShadowFit::Scene } else { ShadowFit::Camera },
+        fit: if a.fit == "scene" {
+            ShadowFit::Scene
+        } else {
+            ShadowFit::Camera
+        },
         snap: !a.no_snap,
     };
     Ok(v)

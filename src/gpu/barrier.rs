@@ -29,8 +29,16 @@ pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk:
     use vk::PipelineStageFlags2 as S;
     match a {
         Access::Undefined => (S::NONE, A::NONE, vk::ImageLayout::UNDEFINED),
-        Access::TransferSrc => (S::ALL_TRANSFER, A::TRANSFER_READ, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
-        Access::TransferDst => (S::ALL_TRANSFER, A::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+        Access::TransferSrc => (
+            S::ALL_TRANSFER,
+            A::TRANSFER_READ,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        ),
+        Access::TransferDst => (
+            S::ALL_TRANSFER,
+            A::TRANSFER_WRITE,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+        ),
         Access::ColorAttachment => (
             S::COLOR_ATTACHMENT_OUTPUT,
             A::COLOR_ATTACHMENT_WRITE | A::COLOR_ATTACHMENT_READ,
@@ -41,8 +49,16 @@ pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk:
             A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
             vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
         ),
-        Access::FragmentSampled => (S::FRAGMENT_SHADER, A::SHADER_SAMPLED_READ, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
-        Access::DepthFragmentSampled => (S::FRAGMENT_SHADER, A::SHADER_SAMPLED_READ, vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL),
+        Access::FragmentSampled => (
+            S::FRAGMENT_SHADER,
+            A::SHADER_SAMPLED_READ,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        ),
+        Access::DepthFragmentSampled => (
+            S::FRAGMENT_SHADER,
+            A::SHADER_SAMPLED_READ,
+            vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
+        ),
         Access::Present => (S::NONE, A::NONE, vk::ImageLayout::PRESENT_SRC_KHR),
     }
 }
@@ -65,13 +81,25 @@ pub fn image_barrier(
         & (vk::AccessFlags2::TRANSFER_WRITE
             | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
             | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE);
-    let src_stage = if from == Access::Present { vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT } else { src_stage };
+    let src_stage = if from == Access::Present {
+        vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT
+    } else {
+        src_stage
+    };
     let barrier = vk::ImageMemoryBarrier2::default()
         .src_stage_mask(src_stage)
         .src_access_mask(src_access)
-        .dst_stage_mask(if to == Access::Present { vk::PipelineStageFlags2::NONE } else { dst_stage })
+        .dst_stage_mask(if to == Access::Present {
+            vk::PipelineStageFlags2::NONE
+        } else {
+            dst_stage
+        })
         .dst_access_mask(dst_access)
-        .old_layout(if from == Access::Present { vk::ImageLayout::UNDEFINED } else { old_layout })
+        .old_layout(if from == Access::Present {
+            vk::ImageLayout::UNDEFINED
+        } else {
+            old_layout
+        })
         .new_layout(new_layout)
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
@@ -95,11 +123,26 @@ mod tests {
     #[test]
     fn table_layouts_and_stages() {
         assert_eq!(access_info(Access::Undefined).2, vk::ImageLayout::UNDEFINED);
-        assert_eq!(access_info(Access::DepthFragmentSampled).2, vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL);
-        assert!(access_info(Access::DepthAttachment).0.contains(vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS));
-        assert!(access_info(Access::FragmentSampled).1.contains(vk::AccessFlags2::SHADER_SAMPLED_READ));
-        for a in [Access::TransferDst, Access::ColorAttachment, Access::DepthAttachment] {
-            assert_ne!(access_info(a).1, vk::AccessFlags2::NONE, "{a:?} must carry an access");
+        assert_eq!(
+            access_info(Access::DepthFragmentSampled).2,
+            vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL
+        );
+        assert!(access_info(Access::DepthAttachment)
+            .0
+            .contains(vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS));
+        assert!(access_info(Access::FragmentSampled)
+            .1
+            .contains(vk::AccessFlags2::SHADER_SAMPLED_READ));
+        for a in [
+            Access::TransferDst,
+            Access::ColorAttachment,
+            Access::DepthAttachment,
+        ] {
+            assert_ne!(
+                access_info(a).1,
+                vk::AccessFlags2::NONE,
+                "{a:?} must carry an access"
+            );
         }
     }
 }

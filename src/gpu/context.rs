@@ -12,7 +12,9 @@ use std::sync::{Arc, Mutex};
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
     /// The Vulkan loader library could not be opened.
-    #[error("no Vulkan loader found ({0}); install one: apt-get install libvulkan1 mesa-vulkan-drivers")]
+    #[error(
+        "no Vulkan loader found ({0}); install one: apt-get install libvulkan1 mesa-vulkan-drivers"
+    )]
     NoLoader(String),
     /// No physical device qualifies.
     #[error("no suitable Vulkan device: {0}")]
@@ -79,7 +81,12 @@ pub struct ContextDesc {
 
 impl Default for ContextDesc {
     fn default() -> Self {
-        Self { validation: Validation::Off, device: None, instance_extensions: Vec::new(), swapchain: false }
+        Self {
+            validation: Validation::Off,
+            device: None,
+            instance_extensions: Vec::new(),
+            swapchain: false,
+        }
     }
 }
 
@@ -112,10 +119,15 @@ unsafe extern "system" fn debug_callback(
     let msg = if data.is_null() || (*data).p_message.is_null() {
         String::from("(no message)")
     } else {
-        CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
+        CStr::from_ptr((*data).p_message)
+            .to_string_lossy()
+            .into_owned()
     };
     let log = user as *const ValidationLog;
-    let problem = severity.intersects(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR);
+    let problem = severity.intersects(
+        vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
+            | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+    );
     if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
         log::error!("vulkan {kind:?}: {msg}");
         if !log.is_null() {
@@ -189,11 +201,16 @@ impl Context {
     pub fn new(desc: &ContextDesc) -> Result<Arc<Context>, GpuError> {
         let entry = unsafe { ash::Entry::load() }.map_err(|e| GpuError::NoLoader(e.to_string()))?;
         let mut validation = desc.validation;
-        if validation == Validation::Off && std::env::var("UMBRA_VALIDATION").is_ok_and(|v| v == "1") {
+        if validation == Validation::Off
+            && std::env::var("UMBRA_VALIDATION").is_ok_and(|v| v == "1")
+        {
             validation = Validation::Required;
         }
-        let layers = unsafe { entry.enumerate_instance_layer_properties() }.vk("vkEnumerateInstanceLayerProperties")?;
-        let has_layer = layers.iter().any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }
+            .vk("vkEnumerateInstanceLayerProperties")?;
+        let has_layer = layers
+            .iter()
+            .any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
         let enable_validation = match validation {
             Validation::Off => false,
             Validation::IfAvailable => has_layer,
@@ -204,25 +221,41 @@ impl Context {
                 true
             }
         };
-        let exts = unsafe { entry.enumerate_instance_extension_properties(None) }.vk("vkEnumerateInstanceExtensionProperties")?;
-        let has_ext = |name: &CStr| exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == name));
+        let exts = unsafe { entry.enumerate_instance_extension_properties(None) }
+            .vk("vkEnumerateInstanceExtensionProperties")?;
+        let has_ext = |name: &CStr| {
+            exts.iter()
+                .any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == name))
+        };
         let has_debug_utils = has_ext(ash::ext::debug_utils::NAME);
-        let mut ext_names: Vec<*const i8> = desc.instance_extensions.iter().map(|e| e.as_ptr()).collect();
+        let mut ext_names: Vec<*const i8> = desc
+            .instance_extensions
+            .iter()
+            .map(|e| e.as_ptr())
+            .collect();
         for e in &desc.instance_extensions {
             if !has_ext(e) {
-                return Err(GpuError::Unsupported(format!("instance extension {} is not available", e.to_string_lossy())));
+                return Err(GpuError::Unsupported(format!(
+                    "instance extension {} is not available",
+                    e.to_string_lossy()
+                )));
             }
         }
         if has_debug_utils {
             ext_names.push(ash::ext::debug_utils::NAME.as_ptr());
         }
-        let layer_names: Vec<*const i8> = if enable_validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
+        let layer_names: Vec<*const i8> = if enable_validation {
+            vec![VALIDATION_LAYER.as_ptr()]
+        } else {
+            vec![]
+        };
         let app = vk::ApplicationInfo::default()
             .application_name(c"umbra")
             .engine_name(c"umbra")
             .api_version(vk::API_VERSION_1_3);
         let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
-        let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
+        let mut validation_features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
         let log = Arc::new(ValidationLog::default());
         let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
             .message_severity(
@@ -258,7 +291,10 @@ impl Context {
                 Ok(m) => Some((du, m)),
                 Err(e) => {
                     unsafe { instance.destroy_instance(None) };
-                    return Err(GpuError::Vk { call: "vkCreateDebugUtilsMessengerEXT", result: e });
+                    return Err(GpuError::Vk {
+                        call: "vkCreateDebugUtilsMessengerEXT",
+                        result: e,
+                    });
                 }
             }
         } else {
@@ -278,14 +314,23 @@ impl Context {
             }
         };
         let properties = unsafe { instance.get_physical_device_properties(physical) };
-        let device_name = properties.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let device_name = properties
+            .device_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         let qf_props = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let timestamp_valid_bits = qf_props[queue_family as usize].timestamp_valid_bits;
 
         let priorities = [1.0f32];
-        let queue_info = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
-        let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
-        let core = vk::PhysicalDeviceFeatures::default().depth_clamp(true).sampler_anisotropy(anisotropy);
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .synchronization2(true);
+        let core = vk::PhysicalDeviceFeatures::default()
+            .depth_clamp(true)
+            .sampler_anisotropy(anisotropy);
         let mut device_exts: Vec<*const i8> = Vec::new();
         if desc.swapchain {
             device_exts.push(ash::khr::swapchain::NAME.as_ptr());
@@ -304,7 +349,10 @@ impl Context {
                     }
                     instance.destroy_instance(None);
                 }
-                return Err(GpuError::Vk { call: "vkCreateDevice", result: e });
+                return Err(GpuError::Vk {
+                    call: "vkCreateDevice",
+                    result: e,
+                });
             }
         };
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -316,13 +364,22 @@ impl Context {
             buffer_device_address: false,
             allocation_sizes: Default::default(),
         })
-        .map_err(|e| GpuError::Alloc { name: "allocator".into(), message: e.to_string() })?;
+        .map_err(|e| GpuError::Alloc {
+            name: "allocator".into(),
+            message: e.to_string(),
+        })?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        let command_pool = unsafe { device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
-        let debug_device = debug_utils.as_ref().map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
-        log::info!("Vulkan device: {device_name} (validation {})", if enable_validation { "on" } else { "off" });
+        let command_pool =
+            unsafe { device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
+        let debug_device = debug_utils
+            .as_ref()
+            .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+        log::info!(
+            "Vulkan device: {device_name} (validation {})",
+            if enable_validation { "on" } else { "off" }
+        );
         Ok(Arc::new(Context {
             entry,
             instance,
@@ -352,7 +409,9 @@ impl Context {
     pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
         if let Some(d) = &self.debug_device {
             if let Ok(c) = CString::new(name) {
-                let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&c);
+                let info = vk::DebugUtilsObjectNameInfoEXT::default()
+                    .object_handle(handle)
+                    .object_name(&c);
                 unsafe {
                     let _ = d.set_debug_utils_object_name(&info);
                 }
@@ -382,7 +441,10 @@ impl Context {
             .command_pool(*pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
-        Ok(unsafe { self.device.allocate_command_buffers(&info) }.vk("vkAllocateCommandBuffers")?[0])
+        Ok(
+            unsafe { self.device.allocate_command_buffers(&info) }
+                .vk("vkAllocateCommandBuffers")?[0],
+        )
     }
 
     /// Frees a command buffer from `allocate_command_buffer` (it must not be in flight).
@@ -394,11 +456,16 @@ impl Context {
     /// Records `f` into a one-time command buffer, submits it and waits for it to finish.
     pub fn immediate<R>(&self, f: impl FnOnce(vk::CommandBuffer) -> R) -> Result<R, GpuError> {
         let cmd = self.allocate_command_buffer()?;
-        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         let result = unsafe {
-            self.device.begin_command_buffer(cmd, &begin).vk("vkBeginCommandBuffer")?;
+            self.device
+                .begin_command_buffer(cmd, &begin)
+                .vk("vkBeginCommandBuffer")?;
             let r = f(cmd);
-            self.device.end_command_buffer(cmd).vk("vkEndCommandBuffer")?;
+            self.device
+                .end_command_buffer(cmd)
+                .vk("vkEndCommandBuffer")?;
             self.submit_and_wait(cmd)?;
             r
         };
@@ -409,11 +476,23 @@ impl Context {
     /// Submits one command buffer and blocks until it completes.
     pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<(), GpuError> {
         unsafe {
-            let fence = self.device.create_fence(&vk::FenceCreateInfo::default(), None).vk("vkCreateFence")?;
+            let fence = self
+                .device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+                .vk("vkCreateFence")?;
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
             let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-            let r = self.device.queue_submit2(self.queue, &submit, fence).vk("vkQueueSubmit2");
-            let w = if r.is_ok() { self.device.wait_for_fences(&[fence], true, u64::MAX).vk("vkWaitForFences") } else { Ok(()) };
+            let r = self
+                .device
+                .queue_submit2(self.queue, &submit, fence)
+                .vk("vkQueueSubmit2");
+            let w = if r.is_ok() {
+                self.device
+                    .wait_for_fences(&[fence], true, u64::MAX)
+                    .vk("vkWaitForFences")
+            } else {
+                Ok(())
+            };
             self.device.destroy_fence(fence, None);
             r.and(w)
         }
@@ -421,7 +500,11 @@ impl Context {
 
     /// Format features (optimal tiling) of `format`.
     pub fn format_features(&self, format: vk::Format) -> vk::FormatFeatureFlags {
-        unsafe { self.instance.get_physical_device_format_properties(self.physical, format) }.optimal_tiling_features
+        unsafe {
+            self.instance
+                .get_physical_device_format_properties(self.physical, format)
+        }
+        .optimal_tiling_features
     }
 }
 
@@ -441,19 +524,29 @@ impl Drop for Context {
     }
 }
 
-fn pick_device(instance: &ash::Instance, desc: &ContextDesc) -> Result<(vk::PhysicalDevice, u32, bool), GpuError> {
-    let devices = unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+fn pick_device(
+    instance: &ash::Instance,
+    desc: &ContextDesc,
+) -> Result<(vk::PhysicalDevice, u32, bool), GpuError> {
+    let devices =
+        unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
     if devices.is_empty() {
         return Err(GpuError::NoDevice(
             "the Vulkan loader found no device; install a driver (apt-get install mesa-vulkan-drivers for lavapipe)".into(),
         ));
     }
-    let wanted = desc.device.clone().or_else(|| std::env::var("UMBRA_DEVICE").ok().filter(|s| !s.is_empty()));
+    let wanted = desc
+        .device
+        .clone()
+        .or_else(|| std::env::var("UMBRA_DEVICE").ok().filter(|s| !s.is_empty()));
     let mut reasons = Vec::new();
     let mut best: Option<(u32, vk::PhysicalDevice, u32, bool)> = None;
     for pd in devices {
         let props = unsafe { instance.get_physical_device_properties(pd) };
-        let name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = props
+            .device_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         if let Some(w) = &wanted {
             if !name.to_lowercase().contains(&w.to_lowercase()) {
                 reasons.push(format!("{name}: not matching '{w}'"));
@@ -478,17 +571,28 @@ fn pick_device(instance: &ash::Instance, desc: &ContextDesc) -> Result<(vk::Phys
             missing.push("depthClamp".into());
         }
         let qf = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-        let family = qf.iter().position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS));
+        let family = qf
+            .iter()
+            .position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS));
         if family.is_none() {
             missing.push("a graphics queue".into());
         }
-        let d32 = unsafe { instance.get_physical_device_format_properties(pd, vk::Format::D32_SFLOAT) }.optimal_tiling_features;
-        if !d32.contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE) {
+        let d32 =
+            unsafe { instance.get_physical_device_format_properties(pd, vk::Format::D32_SFLOAT) }
+                .optimal_tiling_features;
+        if !d32.contains(
+            vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT
+                | vk::FormatFeatureFlags::SAMPLED_IMAGE,
+        ) {
             missing.push("D32_SFLOAT depth attachment + sampling".into());
         }
         if desc.swapchain {
-            let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
-            if !exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == ash::khr::swapchain::NAME)) {
+            let exts =
+                unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+            if !exts.iter().any(|e| {
+                e.extension_name_as_c_str()
+                    .is_ok_and(|n| n == ash::khr::swapchain::NAME)
+            }) {
                 missing.push("VK_KHR_swapchain".into());
             }
         }
@@ -498,8 +602,14 @@ fn pick_device(instance: &ash::Instance, desc: &ContextDesc) -> Result<(vk::Phys
         }
         let s = score(props.device_type);
         if best.as_ref().is_none_or(|b| s > b.0) {
-            best = Some((s, pd, family.unwrap_or(0) as u32, core.sampler_anisotropy == vk::TRUE));
+            best = Some((
+                s,
+                pd,
+                family.unwrap_or(0) as u32,
+                core.sampler_anisotropy == vk::TRUE,
+            ));
         }
     }
-    best.map(|(_, pd, f, a)| (pd, f, a)).ok_or_else(|| GpuError::NoDevice(reasons.join("; ")))
+    best.map(|(_, pd, f, a)| (pd, f, a))
+        .ok_or_else(|| GpuError::NoDevice(reasons.join("; ")))
 }

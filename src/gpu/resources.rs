@@ -19,21 +19,48 @@ pub struct Buffer {
 
 impl Buffer {
     /// Creates a named buffer in `location`.
-    pub fn new(ctx: &Arc<Context>, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Self, GpuError> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Self, GpuError> {
         let size = size.max(4);
-        let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
         let raw = unsafe { ctx.device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
         let allocation = ctx
             .allocator()
-            .allocate(&AllocationCreateDesc { name, requirements, location, linear: true, allocation_scheme: AllocationScheme::GpuAllocatorManaged })
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
             .map_err(|e| {
                 unsafe { ctx.device.destroy_buffer(raw, None) };
-                GpuError::Alloc { name: name.into(), message: e.to_string() }
+                GpuError::Alloc {
+                    name: name.into(),
+                    message: e.to_string(),
+                }
             })?;
-        unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.vk("vkBindBufferMemory")?;
+        unsafe {
+            ctx.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        }
+        .vk("vkBindBufferMemory")?;
         ctx.set_name(raw, name);
-        Ok(Self { ctx: ctx.clone(), raw, size, allocation: Some(allocation) })
+        Ok(Self {
+            ctx: ctx.clone(),
+            raw,
+            size,
+            allocation: Some(allocation),
+        })
     }
 
     /// The mapped bytes of a host-visible buffer.
@@ -43,23 +70,51 @@ impl Buffer {
 
     /// Writes `data` at `offset` into a host-visible buffer.
     pub fn write(&mut self, offset: usize, data: &[u8]) -> Result<(), GpuError> {
-        let m = self.mapped().ok_or_else(|| GpuError::Unsupported("buffer is not host visible".into()))?;
+        let m = self
+            .mapped()
+            .ok_or_else(|| GpuError::Unsupported("buffer is not host visible".into()))?;
         let end = offset + data.len();
         if end > m.len() {
-            return Err(GpuError::Unsupported(format!("write of {} bytes at {offset} past buffer end {}", data.len(), m.len())));
+            return Err(GpuError::Unsupported(format!(
+                "write of {} bytes at {offset} past buffer end {}",
+                data.len(),
+                m.len()
+            )));
         }
         m[offset..end].copy_from_slice(data);
         Ok(())
     }
 
     /// A device-local buffer filled with `data` through a staging buffer.
-    pub fn device_local_with_data(ctx: &Arc<Context>, name: &str, usage: vk::BufferUsageFlags, data: &[u8]) -> Result<Self, GpuError> {
-        let mut staging = Buffer::new(ctx, &format!("{name} staging"), data.len() as u64, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
+    pub fn device_local_with_data(
+        ctx: &Arc<Context>,
+        name: &str,
+        usage: vk::BufferUsageFlags,
+        data: &[u8],
+    ) -> Result<Self, GpuError> {
+        let mut staging = Buffer::new(
+            ctx,
+            &format!("{name} staging"),
+            data.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
         staging.write(0, data)?;
-        let buf = Buffer::new(ctx, name, data.len() as u64, usage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly)?;
+        let buf = Buffer::new(
+            ctx,
+            name,
+            data.len() as u64,
+            usage | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
         ctx.immediate(|cmd| unsafe {
-            let region = [vk::BufferCopy { src_offset: 0, dst_offset: 0, size: data.len().max(4) as u64 }];
-            ctx.device.cmd_copy_buffer(cmd, staging.raw, buf.raw, &region);
+            let region = [vk::BufferCopy {
+                src_offset: 0,
+                dst_offset: 0,
+                size: data.len().max(4) as u64,
+            }];
+            ctx.device
+                .cmd_copy_buffer(cmd, staging.raw, buf.raw, &region);
         })?;
         Ok(buf)
     }
@@ -105,7 +160,11 @@ impl Image {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
-            .extent(vk::Extent3D { width: extent.width.max(1), height: extent.height.max(1), depth: 1 })
+            .extent(vk::Extent3D {
+                width: extent.width.max(1),
+                height: extent.height.max(1),
+                depth: 1,
+            })
             .mip_levels(mip_levels.max(1))
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -117,34 +176,84 @@ impl Image {
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
         let allocation = ctx
             .allocator()
-            .allocate(&AllocationCreateDesc { name, requirements, location: MemoryLocation::GpuOnly, linear: false, allocation_scheme: AllocationScheme::GpuAllocatorManaged })
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location: MemoryLocation::GpuOnly,
+                linear: false,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
             .map_err(|e| {
                 unsafe { ctx.device.destroy_image(raw, None) };
-                GpuError::Alloc { name: name.into(), message: e.to_string() }
+                GpuError::Alloc {
+                    name: name.into(),
+                    message: e.to_string(),
+                }
             })?;
-        unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }.vk("vkBindImageMemory")?;
+        unsafe {
+            ctx.device
+                .bind_image_memory(raw, allocation.memory(), allocation.offset())
+        }
+        .vk("vkBindImageMemory")?;
         let aspect = match format {
-            vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => vk::ImageAspectFlags::DEPTH,
+            vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => {
+                vk::ImageAspectFlags::DEPTH
+            }
             _ => vk::ImageAspectFlags::COLOR,
         };
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(format)
-            .subresource_range(vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: mip_levels.max(1), base_array_layer: 0, layer_count: 1 });
-        let view = unsafe { ctx.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
+            .subresource_range(vk::ImageSubresourceRange {
+                aspect_mask: aspect,
+                base_mip_level: 0,
+                level_count: mip_levels.max(1),
+                base_array_layer: 0,
+                layer_count: 1,
+            });
+        let view =
+            unsafe { ctx.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
         ctx.set_name(raw, name);
         ctx.set_name(view, name);
-        Ok(Self { ctx: ctx.clone(), raw, view, format, extent, mip_levels: mip_levels.max(1), aspect, allocation: Some(allocation) })
+        Ok(Self {
+            ctx: ctx.clone(),
+            raw,
+            view,
+            format,
+            extent,
+            mip_levels: mip_levels.max(1),
+            aspect,
+            allocation: Some(allocation),
+        })
     }
 
     /// A sampled RGBA8 texture with a full mip chain generated by blits (a single level where the
     /// format cannot be blitted with linear filtering). Left in `FragmentSampled` layout.
-    pub fn texture_rgba8(ctx: &Arc<Context>, name: &str, width: u32, height: u32, rgba: &[u8], srgb: bool) -> Result<Self, GpuError> {
-        let format = if srgb { vk::Format::R8G8B8A8_SRGB } else { vk::Format::R8G8B8A8_UNORM };
+    pub fn texture_rgba8(
+        ctx: &Arc<Context>,
+        name: &str,
+        width: u32,
+        height: u32,
+        rgba: &[u8],
+        srgb: bool,
+    ) -> Result<Self, GpuError> {
+        let format = if srgb {
+            vk::Format::R8G8B8A8_SRGB
+        } else {
+            vk::Format::R8G8B8A8_UNORM
+        };
         let feats = ctx.format_features(format);
-        let can_blit = feats.contains(vk::FormatFeatureFlags::BLIT_SRC | vk::FormatFeatureFlags::BLIT_DST | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
-        let mips = if can_blit { 32 - width.max(height).max(1).leading_zeros() } else { 1 };
+        let can_blit = feats.contains(
+            vk::FormatFeatureFlags::BLIT_SRC
+                | vk::FormatFeatureFlags::BLIT_DST
+                | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
+        );
+        let mips = if can_blit {
+            32 - width.max(height).max(1).leading_zeros()
+        } else {
+            1
+        };
         let extent = vk::Extent2D { width, height };
         let img = Image::new(
             ctx,
@@ -152,32 +261,105 @@ impl Image {
             format,
             extent,
             mips,
-            vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageUsageFlags::SAMPLED
+                | vk::ImageUsageFlags::TRANSFER_DST
+                | vk::ImageUsageFlags::TRANSFER_SRC,
         )?;
-        let mut staging = Buffer::new(ctx, &format!("{name} staging"), rgba.len() as u64, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
+        let mut staging = Buffer::new(
+            ctx,
+            &format!("{name} staging"),
+            rgba.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
         staging.write(0, rgba)?;
         let d = &ctx.device;
         ctx.immediate(|cmd| unsafe {
-            image_barrier(d, cmd, img.raw, vk::ImageAspectFlags::COLOR, 0..mips, Access::Undefined, Access::TransferDst);
+            image_barrier(
+                d,
+                cmd,
+                img.raw,
+                vk::ImageAspectFlags::COLOR,
+                0..mips,
+                Access::Undefined,
+                Access::TransferDst,
+            );
             let region = [vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 })
-                .image_extent(vk::Extent3D { width, height, depth: 1 })];
-            d.cmd_copy_buffer_to_image(cmd, staging.raw, img.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &region);
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D {
+                    width,
+                    height,
+                    depth: 1,
+                })];
+            d.cmd_copy_buffer_to_image(
+                cmd,
+                staging.raw,
+                img.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+            );
             let (mut w, mut h) = (width as i32, height as i32);
             for level in 1..mips {
-                image_barrier(d, cmd, img.raw, vk::ImageAspectFlags::COLOR, level - 1..level, Access::TransferDst, Access::TransferSrc);
+                image_barrier(
+                    d,
+                    cmd,
+                    img.raw,
+                    vk::ImageAspectFlags::COLOR,
+                    level - 1..level,
+                    Access::TransferDst,
+                    Access::TransferSrc,
+                );
                 let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
                 let blit = [vk::ImageBlit::default()
-                    .src_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: level - 1, base_array_layer: 0, layer_count: 1 })
+                    .src_subresource(vk::ImageSubresourceLayers {
+                        aspect_mask: vk::ImageAspectFlags::COLOR,
+                        mip_level: level - 1,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    })
                     .src_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }])
-                    .dst_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: level, base_array_layer: 0, layer_count: 1 })
+                    .dst_subresource(vk::ImageSubresourceLayers {
+                        aspect_mask: vk::ImageAspectFlags::COLOR,
+                        mip_level: level,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    })
                     .dst_offsets([vk::Offset3D::default(), vk::Offset3D { x: nw, y: nh, z: 1 }])];
-                d.cmd_blit_image(cmd, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, img.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &blit, vk::Filter::LINEAR);
-                image_barrier(d, cmd, img.raw, vk::ImageAspectFlags::COLOR, level - 1..level, Access::TransferSrc, Access::FragmentSampled);
+                d.cmd_blit_image(
+                    cmd,
+                    img.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    img.raw,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &blit,
+                    vk::Filter::LINEAR,
+                );
+                image_barrier(
+                    d,
+                    cmd,
+                    img.raw,
+                    vk::ImageAspectFlags::COLOR,
+                    level - 1..level,
+                    Access::TransferSrc,
+                    Access::FragmentSampled,
+                );
                 w = nw;
                 h = nh;
             }
-            image_barrier(d, cmd, img.raw, vk::ImageAspectFlags::COLOR, mips - 1..mips, Access::TransferDst, Access::FragmentSampled);
+            image_barrier(
+                d,
+                cmd,
+                img.raw,
+                vk::ImageAspectFlags::COLOR,
+                mips - 1..mips,
+                Access::TransferDst,
+                Access::FragmentSampled,
+            );
         })?;
         Ok(img)
     }

@@ -43,7 +43,12 @@ mod tests {
     #[test]
     fn endpoints_tangents_and_de_casteljau() {
         let c = CubicBezier {
-            p: [Vec3::ZERO, Vec3::new(1.0, 2.0, 0.0), Vec3::new(3.0, 2.0, 1.0), Vec3::new(4.0, 0.0, 0.0)],
+            p: [
+                Vec3::ZERO,
+                Vec3::new(1.0, 2.0, 0.0),
+                Vec3::new(3.0, 2.0, 1.0),
+                Vec3::new(4.0, 0.0, 0.0),
+            ],
         };
         assert_eq!(c.eval(0.0), c.p[0]);
         assert!(c.eval(1.0).abs_diff_eq(c.p[3], 1e-6));

@@ -13,7 +13,10 @@ pub struct Aabb {
 
 impl Aabb {
     /// The empty box (the identity of `union`).
-    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
 
     /// A box from two corners.
     pub fn new(min: Vec3, max: Vec3) -> Self {
@@ -44,12 +47,18 @@ impl Aabb {
 
     /// The smallest box holding both.
     pub fn union(&self, o: &Aabb) -> Aabb {
-        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+        Aabb {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
     }
 
     /// The overlap of two boxes (may be empty).
     pub fn intersection(&self, o: &Aabb) -> Aabb {
-        Aabb { min: self.min.max(o.min), max: self.max.min(o.max) }
+        Aabb {
+            min: self.min.max(o.min),
+            max: self.max.min(o.max),
+        }
     }
 
     /// Centre point.
@@ -111,7 +120,9 @@ mod tests {
         assert!(Aabb::EMPTY.is_empty());
         assert_eq!(Aabb::EMPTY.union(&a), a);
         assert_eq!(a.intersection(&b), Aabb::new(Vec3::splat(0.5), Vec3::ONE));
-        assert!(a.intersection(&Aabb::new(Vec3::splat(3.0), Vec3::splat(4.0))).is_empty());
+        assert!(a
+            .intersection(&Aabb::new(Vec3::splat(3.0), Vec3::splat(4.0)))
+            .is_empty());
         assert!(a.overlaps(&b));
         // A flat box is not empty.
         assert!(!Aabb::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0)).is_empty());

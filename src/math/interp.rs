@@ -37,7 +37,8 @@ pub fn perturb_normal(n: Vec3, t: Vec3, sign: f32, tn: Vec3) -> Vec3 {
     (t * tn.x + b * tn.y + n * tn.z).normalize_or_zero()
 }
 
-/// Tangent-space normal of a height field h(u, v) from its slopes (∂h/∂u, ∂h/∂v) and a strength.
+/// Tangent-space normal of a height field from its slopes along the tangent-space x and y axes
+/// and a strength: n ∝ (−∂h/∂x, −∂h/∂y, 1). (For glTF, y runs up the image, i.e. along −v.)
 pub fn normal_from_height_slope(dh_du: f32, dh_dv: f32, strength: f32) -> Vec3 {
     Vec3::new(-dh_du * strength, -dh_dv * strength, 1.0).normalize()
 }
@@ -70,7 +71,11 @@ mod tests {
         let attr = perspective_correct(bary, Vec3::new(w0, w1, 1.0), [0.0f32, 1.0, 0.0]);
         assert!((attr - 0.25).abs() < 1e-6, "{attr}");
         // Equal w gives plain linear interpolation.
-        let attr = perspective_correct(Vec3::new(0.2, 0.3, 0.5), Vec3::splat(2.0), [1.0f32, 2.0, 3.0]);
+        let attr = perspective_correct(
+            Vec3::new(0.2, 0.3, 0.5),
+            Vec3::splat(2.0),
+            [1.0f32, 2.0, 3.0],
+        );
         assert!((attr - (0.2 + 0.6 + 1.5)).abs() < 1e-6);
     }
 

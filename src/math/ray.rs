@@ -17,7 +17,11 @@ pub struct Ray {
 impl Ray {
     /// A ray from `origin` along `dir`.
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        Self { origin, dir, inv_dir: Vec3::ONE / dir }
+        Self {
+            origin,
+            dir,
+            inv_dir: Vec3::ONE / dir,
+        }
     }
 
     /// The point at parameter `t`.
@@ -39,7 +43,14 @@ pub struct TriangleHit {
 
 /// Möller–Trumbore: the hit of `ray` with triangle (a, b, c) for t in (t_min, t_max), both faces.
 /// Rays parallel to the triangle's plane (|det| below a relative epsilon) miss. Edges count as hits.
-pub fn ray_triangle(ray: &Ray, a: Vec3, b: Vec3, c: Vec3, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+pub fn ray_triangle(
+    ray: &Ray,
+    a: Vec3,
+    b: Vec3,
+    c: Vec3,
+    t_min: f32,
+    t_max: f32,
+) -> Option<TriangleHit> {
     let e1 = b - a;
     let e2 = c - a;
     let p = ray.dir.cross(e2);
@@ -132,11 +143,20 @@ mod tests {
     #[test]
     fn parallel_and_behind() {
         let r = Ray::new(Vec3::new(0.2, 0.2, 0.0), Vec3::X);
-        assert!(ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(), "in-plane ray");
+        assert!(
+            ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(),
+            "in-plane ray"
+        );
         let r = Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::X);
-        assert!(ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(), "parallel above");
+        assert!(
+            ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(),
+            "parallel above"
+        );
         let r = Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::Z);
-        assert!(ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(), "behind origin");
+        assert!(
+            ray_triangle(&r, A, B, C, 0.0, f32::INFINITY).is_none(),
+            "behind origin"
+        );
         // Limited range.
         let r = Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
         assert!(ray_triangle(&r, A, B, C, 0.0, 0.5).is_none());

@@ -24,7 +24,7 @@ pub fn rotation_z(angle: f32) -> Mat3 {
 /// R = cos θ I + (1 − cos θ) k kᵀ + sin θ [k]×. A zero axis gives the identity.
 pub fn rodrigues(axis: Vec3, angle: f32) -> Mat3 {
     let len = axis.length();
-    if !(len > 0.0) || !len.is_finite() {
+    if len.is_nan() || len <= 0.0 || !len.is_finite() {
         return Mat3::IDENTITY;
     }
     let k = axis / len;

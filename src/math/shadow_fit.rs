@@ -34,7 +34,10 @@ impl CameraFrustum {
         let tx = ty * self.aspect;
         let mut out = [Vec3::ZERO; 8];
         for (i, d) in [self.near, self.far].into_iter().enumerate() {
-            for (j, (sx, sy)) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].into_iter().enumerate() {
+            for (j, (sx, sy)) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
+                .into_iter()
+                .enumerate()
+            {
                 let p = Vec3::new(sx * tx * d, sy * ty * d, -d);
                 out[i * 4 + j] = world_from_view.transform_point3(p);
             }
@@ -88,12 +91,30 @@ fn clip_polygon(poly: &[Vec3], plane: Plane) -> Vec<Vec3> {
 
 fn box_planes(b: &Aabb) -> [Plane; 6] {
     [
-        Plane { n: Vec3::X, d: -b.min.x },
-        Plane { n: -Vec3::X, d: b.max.x },
-        Plane { n: Vec3::Y, d: -b.min.y },
-        Plane { n: -Vec3::Y, d: b.max.y },
-        Plane { n: Vec3::Z, d: -b.min.z },
-        Plane { n: -Vec3::Z, d: b.max.z },
+        Plane {
+            n: Vec3::X,
+            d: -b.min.x,
+        },
+        Plane {
+            n: -Vec3::X,
+            d: b.max.x,
+        },
+        Plane {
+            n: Vec3::Y,
+            d: -b.min.y,
+        },
+        Plane {
+            n: -Vec3::Y,
+            d: b.max.y,
+        },
+        Plane {
+            n: Vec3::Z,
+            d: -b.min.z,
+        },
+        Plane {
+            n: -Vec3::Z,
+            d: b.max.z,
+        },
     ]
 }
 
@@ -204,7 +225,8 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
     let mut recv = if receivers_world.is_empty() {
         scene_l
     } else {
-        Aabb::from_points(receivers_world.iter().map(|p| view.transform_point3(*p))).intersection(&scene_l)
+        Aabb::from_points(receivers_world.iter().map(|p| view.transform_point3(*p)))
+            .intersection(&scene_l)
     };
     if recv.is_empty() {
         recv = scene_l;
@@ -212,7 +234,9 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
     let size = input.map_size.max(1) as f32;
     // Guard against a degenerate (flat or point) receiver set.
     let min_extent = (scene.diagonal() * 1e-4).max(1e-4);
-    let raw = (recv.max.x - recv.min.x).max(recv.max.y - recv.min.y).max(min_extent);
+    let raw = (recv.max.x - recv.min.x)
+        .max(recv.max.y - recv.min.y)
+        .max(min_extent);
     let cx = 0.5 * (recv.min.x + recv.max.x);
     let cy = 0.5 * (recv.min.y + recv.max.y);
     // z: from the farthest receiver to the caster nearest the light (light looks down −z).
@@ -243,7 +267,10 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
     DirectionalFit {
         light_view_from_world: view,
         light_clip_from_world: proj * view,
-        light_box: Aabb::new(Vec3::new(lo_x, lo_y, zf), Vec3::new(lo_x + extent, lo_y + extent, zn)),
+        light_box: Aabb::new(
+            Vec3::new(lo_x, lo_y, zf),
+            Vec3::new(lo_x + extent, lo_y + extent, zn),
+        ),
         texel_world: texel,
     }
 }
@@ -251,7 +278,12 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
 /// A spot light's shadow projection: reversed-z infinite perspective from `position` along
 /// `direction`, field of view the outer cone plus a margin. Returns (clip_from_world, tan of half
 /// fov): a texel at distance d is `2 * d * tan_half / map_size` wide.
-pub fn fit_spot(position: Vec3, direction: Vec3, outer_cone: f32, scene_bounds: &Aabb) -> (Mat4, f32) {
+pub fn fit_spot(
+    position: Vec3,
+    direction: Vec3,
+    outer_cone: f32,
+    scene_bounds: &Aabb,
+) -> (Mat4, f32) {
     let d = direction.try_normalize().unwrap_or(-Vec3::Y);
     let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
     let view = Mat4::look_to_rh(position, d, up);
@@ -325,7 +357,12 @@ mod tests {
             // Every receiver point lands inside the light's clip box.
             for p in frustum_box_intersection(&cam, &scene()) {
                 let q = project(&fit.light_clip_from_world, p);
-                assert!(q.x.abs() <= 1.0 + 1e-4 && q.y.abs() <= 1.0 + 1e-4 && (0.0..=1.0).contains(&q.z), "{q}");
+                assert!(
+                    q.x.abs() <= 1.0 + 1e-4
+                        && q.y.abs() <= 1.0 + 1e-4
+                        && (0.0..=1.0).contains(&q.z),
+                    "{q}"
+                );
             }
             // Every scene corner (potential caster) is at depth <= 1 or clamps there; the ones
             // that can shade receivers are inside the depth range.
@@ -351,13 +388,20 @@ mod tests {
             let moved = fit_directional(&DirectionalFitInput {
                 direction: dir,
                 scene_bounds: scene(),
-                camera: Some(camera(Vec3::new(3.0 + dx, 4.0, 9.0), Vec3::new(dx, 0.0, 0.0))),
+                camera: Some(camera(
+                    Vec3::new(3.0 + dx, 4.0, 9.0),
+                    Vec3::new(dx, 0.0, 0.0),
+                )),
                 map_size: 1024,
                 snap: true,
             });
             assert_eq!(moved.texel_world, base.texel_world);
             let shift = (moved.light_box.min - base.light_box.min) / base.texel_world;
-            assert!((shift.x - shift.x.round()).abs() < 1e-2 && (shift.y - shift.y.round()).abs() < 1e-2, "{shift}");
+            assert!(
+                (shift.x - shift.x.round()).abs() < 1e-2
+                    && (shift.y - shift.y.round()).abs() < 1e-2,
+                "{shift}"
+            );
         }
     }
 

@@ -22,7 +22,10 @@ pub fn effective_lights(scene: &Scene, view: &View) -> Vec<Light> {
     let mut lights = scene.lights.clone();
     if lights.is_empty() {
         lights.push(Light::sun(
-            Light::sun_direction(DEFAULT_SUN_ELEVATION_DEG.to_radians(), DEFAULT_SUN_AZIMUTH_DEG.to_radians()),
+            Light::sun_direction(
+                DEFAULT_SUN_ELEVATION_DEG.to_radians(),
+                DEFAULT_SUN_AZIMUTH_DEG.to_radians(),
+            ),
             DEFAULT_SUN_INTENSITY,
         ));
     }
@@ -48,9 +51,22 @@ pub fn camera_projection(camera: &Camera, aspect: f32) -> Mat4 {
 /// The frustum used to fit shadows: far = the camera's far, or the farthest scene corner.
 pub fn fitting_frustum(camera: &Camera, aspect: f32, bounds: &Aabb) -> CameraFrustum {
     let eye = camera.position();
-    let far_scene = bounds.corners().iter().map(|c| c.distance(eye)).fold(0.0f32, f32::max);
-    let far = camera.far.unwrap_or(far_scene).min(far_scene.max(camera.near * 2.0));
-    CameraFrustum { view_from_world: camera.view_from_world(), fov_y: camera.fov_y, aspect, near: camera.near, far: far.max(camera.near * 1.01) }
+    let far_scene = bounds
+        .corners()
+        .iter()
+        .map(|c| c.distance(eye))
+        .fold(0.0f32, f32::max);
+    let far = camera
+        .far
+        .unwrap_or(far_scene)
+        .min(far_scene.max(camera.near * 2.0));
+    CameraFrustum {
+        view_from_world: camera.view_from_world(),
+        fov_y: camera.fov_y,
+        aspect,
+        near: camera.near,
+        far: far.max(camera.near * 1.01),
+    }
 }
 
 /// The result of planning a frame.
@@ -71,11 +87,19 @@ pub struct FramePlan {
 }
 
 /// Plans a frame for `view` of a scene with `bounds`, rendered at `aspect`.
-pub fn plan_frame(scene: &Scene, bounds: &Aabb, view: &View, aspect: f32, hw_compare: bool) -> FramePlan {
+pub fn plan_frame(
+    scene: &Scene,
+    bounds: &Aabb,
+    view: &View,
+    aspect: f32,
+    hw_compare: bool,
+) -> FramePlan {
     let lights = effective_lights(scene, view);
     let proj = camera_projection(&view.camera, aspect);
     let clip_from_world = proj * view.camera.view_from_world();
-    let shadow_light = lights.iter().position(|l| l.casts_shadows && l.kind != LightKind::Point && l.intensity > 0.0);
+    let shadow_light = lights
+        .iter()
+        .position(|l| l.casts_shadows && l.kind != LightKind::Point && l.intensity > 0.0);
     let mut light_clip_from_world = Mat4::IDENTITY;
     let mut texel_world = 0.0;
     let size = view.shadow.map_size.max(1);
@@ -115,11 +139,22 @@ pub fn plan_frame(scene: &Scene, bounds: &Aabb, view: &View, aspect: f32, hw_com
             size as f32,
             view.shadow.normal_offset,
             texel_world,
-            if view.shadow.enabled && shadow_light.is_some() { 1.0 } else { 0.0 },
+            if view.shadow.enabled && shadow_light.is_some() {
+                1.0
+            } else {
+                0.0
+            },
         ),
-        shadow_light: shadow_light.map(|i| lights[i].position.extend(i as f32)).unwrap_or(Vec4::new(0.0, 0.0, 0.0, -1.0)),
+        shadow_light: shadow_light
+            .map(|i| lights[i].position.extend(i as f32))
+            .unwrap_or(Vec4::new(0.0, 0.0, 0.0, -1.0)),
         bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
-        modes: [view.mode.shader_value(), view.shadow.pcf.taps(), hw_compare as u32, lights.len() as u32],
+        modes: [
+            view.mode.shader_value(),
+            view.shadow.pcf.taps(),
+            hw_compare as u32,
+            lights.len() as u32,
+        ],
         lights: [LightUniform::default(); MAX_LIGHTS],
     };
     if shadow_light.is_none() {
@@ -130,7 +165,9 @@ pub fn plan_frame(scene: &Scene, bounds: &Aabb, view: &View, aspect: f32, hw_com
         let (kind, cone) = match l.kind {
             LightKind::Directional => (0.0, Vec4::ZERO),
             LightKind::Point => (1.0, Vec4::ZERO),
-            LightKind::Spot { inner, outer } => (2.0, Vec4::new(inner.cos(), outer.cos(), 0.0, 0.0)),
+            LightKind::Spot { inner, outer } => {
+                (2.0, Vec4::new(inner.cos(), outer.cos(), 0.0, 0.0))
+            }
         };
         u.lights[i] = LightUniform {
             position: l.position.extend(kind),
@@ -139,7 +176,14 @@ pub fn plan_frame(scene: &Scene, bounds: &Aabb, view: &View, aspect: f32, hw_com
             cone,
         };
     }
-    FramePlan { uniform: u, lights, shadow_light, light_clip_from_world, texel_world, clip_from_world }
+    FramePlan {
+        uniform: u,
+        lights,
+        shadow_light,
+        light_clip_from_world,
+        texel_world,
+        clip_from_world,
+    }
 }
 
 #[cfg(test)]

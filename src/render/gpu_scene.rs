@@ -26,6 +26,9 @@ pub struct VertexAttributes {
     pub tangent: [f32; 4],
 }
 
+/// (first index, index count, vertex offset, material, object bounds) of one uploaded primitive.
+type PrimitiveRange = (u32, u32, i32, usize, Aabb);
+
 /// One indexed draw (a primitive of an instance).
 #[derive(Clone, Copy, Debug)]
 pub struct Draw {
@@ -77,7 +80,7 @@ impl GpuScene {
         let mut positions: Vec<[f32; 3]> = Vec::new();
         let mut attrs: Vec<VertexAttributes> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
-        let mut ranges: Vec<Vec<(u32, u32, i32, usize, Aabb)>> = Vec::new();
+        let mut ranges: Vec<Vec<PrimitiveRange>> = Vec::new();
         for mesh in &scene.meshes {
             let mut r = Vec::new();
             for p in &mesh.primitives {
@@ -86,13 +89,29 @@ impl GpuScene {
                 positions.extend(p.positions.iter().map(|v| v.to_array()));
                 for i in 0..p.positions.len() {
                     attrs.push(VertexAttributes {
-                        normal: p.normals.get(i).copied().unwrap_or(glam::Vec3::Y).to_array(),
+                        normal: p
+                            .normals
+                            .get(i)
+                            .copied()
+                            .unwrap_or(glam::Vec3::Y)
+                            .to_array(),
                         uv: p.uvs.get(i).copied().unwrap_or_default().to_array(),
-                        tangent: p.tangents.get(i).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0)).to_array(),
+                        tangent: p
+                            .tangents
+                            .get(i)
+                            .copied()
+                            .unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0))
+                            .to_array(),
                     });
                 }
                 indices.extend_from_slice(&p.indices);
-                r.push((first, p.indices.len() as u32, base, p.material.min(scene.materials.len().saturating_sub(1)), p.bounds()));
+                r.push((
+                    first,
+                    p.indices.len() as u32,
+                    base,
+                    p.material.min(scene.materials.len().saturating_sub(1)),
+                    p.bounds(),
+                ));
             }
             ranges.push(r);
         }
@@ -111,24 +130,47 @@ impl GpuScene {
                     material,
                     world_from_model: inst.world_from_model,
                     world_bounds: b.transformed(&inst.world_from_model),
-                    double_sided: scene.materials.get(material).is_some_and(|m| m.double_sided),
+                    double_sided: scene
+                        .materials
+                        .get(material)
+                        .is_some_and(|m| m.double_sided),
                 });
             }
         }
         let vb = vk::BufferUsageFlags::VERTEX_BUFFER;
-        let pos_buf = Buffer::device_local_with_data(ctx, "positions", vb, bytemuck::cast_slice(&positions))?;
-        let attr_buf = Buffer::device_local_with_data(ctx, "attributes", vb, bytemuck::cast_slice(&attrs))?;
-        let idx_buf = Buffer::device_local_with_data(ctx, "indices", vk::BufferUsageFlags::INDEX_BUFFER, bytemuck::cast_slice(&indices))?;
+        let pos_buf =
+            Buffer::device_local_with_data(ctx, "positions", vb, bytemuck::cast_slice(&positions))?;
+        let attr_buf =
+            Buffer::device_local_with_data(ctx, "attributes", vb, bytemuck::cast_slice(&attrs))?;
+        let idx_buf = Buffer::device_local_with_data(
+            ctx,
+            "indices",
+            vk::BufferUsageFlags::INDEX_BUFFER,
+            bytemuck::cast_slice(&indices),
+        )?;
 
         // Textures, created per (image, colour space) actually used.
         let mut textures: Vec<Image> = Vec::new();
         let mut tex_index: HashMap<(usize, bool), usize> = HashMap::new();
         let white_srgb = Image::texture_rgba8(ctx, "default white sRGB", 1, 1, &[255; 4], true)?;
         let white_linear = Image::texture_rgba8(ctx, "default white", 1, 1, &[255; 4], false)?;
-        let flat_normal = Image::texture_rgba8(ctx, "default flat normal", 1, 1, &[128, 128, 255, 255], false)?;
+        let flat_normal = Image::texture_rgba8(
+            ctx,
+            "default flat normal",
+            1,
+            1,
+            &[128, 128, 255, 255],
+            false,
+        )?;
         textures.extend([white_srgb, white_linear, flat_normal]);
-        let mut get_tex = |t: Option<crate::scene::TextureRef>, srgb: bool, fallback: usize, textures: &mut Vec<Image>| -> Result<vk::ImageView, GpuError> {
-            let Some(t) = t.filter(|t| t.texture < scene.textures.len()) else { return Ok(textures[fallback].view) };
+        let mut get_tex = |t: Option<crate::scene::TextureRef>,
+                           srgb: bool,
+                           fallback: usize,
+                           textures: &mut Vec<Image>|
+         -> Result<vk::ImageView, GpuError> {
+            let Some(t) = t.filter(|t| t.texture < scene.textures.len()) else {
+                return Ok(textures[fallback].view);
+            };
             if let Some(&i) = tex_index.get(&(t.texture, srgb)) {
                 return Ok(textures[i].view);
             }
@@ -142,12 +184,26 @@ impl GpuScene {
         let material_layout = set_layout(ctx, sh::BINDINGS, 1, "material set layout")?;
         let n = scene.materials.len().max(1) as u32;
         let pool_sizes = [
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 4 * n },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: n },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                descriptor_count: n,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::SAMPLED_IMAGE,
+                descriptor_count: 4 * n,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::SAMPLER,
+                descriptor_count: n,
+            },
         ];
         let pool = unsafe {
-            ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(n).pool_sizes(&pool_sizes), None)
+            ctx.device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(n)
+                    .pool_sizes(&pool_sizes),
+                None,
+            )
         }
         .vk("vkCreateDescriptorPool")?;
         let sampler_info = vk::SamplerCreateInfo::default()
@@ -158,34 +214,84 @@ impl GpuScene {
             .address_mode_v(vk::SamplerAddressMode::REPEAT)
             .address_mode_w(vk::SamplerAddressMode::REPEAT)
             .anisotropy_enable(ctx.anisotropy)
-            .max_anisotropy(if ctx.anisotropy { 8.0f32.min(ctx.properties.limits.max_sampler_anisotropy) } else { 1.0 })
+            .max_anisotropy(if ctx.anisotropy {
+                8.0f32.min(ctx.properties.limits.max_sampler_anisotropy)
+            } else {
+                1.0
+            })
             .max_lod(vk::LOD_CLAMP_NONE);
-        let sampler = unsafe { ctx.device.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
+        let sampler =
+            unsafe { ctx.device.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
         ctx.set_name(sampler, "material sampler");
 
         let layouts = vec![material_layout; n as usize];
-        let sets = unsafe { ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts)) }
-            .vk("vkAllocateDescriptorSets")?;
+        let sets = unsafe {
+            ctx.device.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+        }
+        .vk("vkAllocateDescriptorSets")?;
         let mut material_buffers = Vec::new();
         for (i, m) in scene.materials.iter().enumerate() {
             let u = MaterialUniform {
                 base_color: m.base_color,
                 emissive: m.emissive.extend(m.normal_scale),
-                params: Vec4::new(m.metallic, m.roughness, m.normal_texture.is_some() as u32 as f32, m.unlit as u32 as f32),
-                extra: Vec4::new(if let AlphaMode::Mask(c) = m.alpha_mode { c.max(1e-6) } else { 0.0 }, 0.0, 0.0, 0.0),
+                params: Vec4::new(
+                    m.metallic,
+                    m.roughness,
+                    m.normal_texture.is_some() as u32 as f32,
+                    m.unlit as u32 as f32,
+                ),
+                extra: Vec4::new(
+                    if let AlphaMode::Mask(c) = m.alpha_mode {
+                        c.max(1e-6)
+                    } else {
+                        0.0
+                    },
+                    0.0,
+                    0.0,
+                    0.0,
+                ),
             };
-            let mut buf = Buffer::new(ctx, &format!("material {i} '{}'", m.name), std::mem::size_of::<MaterialUniform>() as u64, vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu)?;
+            let mut buf = Buffer::new(
+                ctx,
+                &format!("material {i} '{}'", m.name),
+                std::mem::size_of::<MaterialUniform>() as u64,
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?;
             buf.write(0, bytemuck::bytes_of(&u))?;
             let base = get_tex(m.base_color_texture, true, 0, &mut textures)?;
             let normal = get_tex(m.normal_texture, false, 2, &mut textures)?;
             let mr = get_tex(m.metallic_roughness_texture, false, 1, &mut textures)?;
             let emissive = get_tex(m.emissive_texture, true, 0, &mut textures)?;
-            let buf_info = [vk::DescriptorBufferInfo { buffer: buf.raw, offset: 0, range: vk::WHOLE_SIZE }];
-            let img = |v| [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: v, image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL }];
+            let buf_info = [vk::DescriptorBufferInfo {
+                buffer: buf.raw,
+                offset: 0,
+                range: vk::WHOLE_SIZE,
+            }];
+            let img = |v| {
+                [vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: v,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }]
+            };
             let (i_base, i_normal, i_mr, i_em) = (img(base), img(normal), img(mr), img(emissive));
-            let samp = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
+            let samp = [vk::DescriptorImageInfo {
+                sampler,
+                image_view: vk::ImageView::null(),
+                image_layout: vk::ImageLayout::UNDEFINED,
+            }];
             let set = sets[i];
-            let w = |b: &crate::gpu::shaders::ReflectedBinding| vk::WriteDescriptorSet::default().dst_set(set).dst_binding(b.binding).descriptor_type(b.descriptor_type());
+            let w = |b: &crate::gpu::shaders::ReflectedBinding| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(b.binding)
+                    .descriptor_type(b.descriptor_type())
+            };
             let writes = [
                 w(&sh::MATERIAL).buffer_info(&buf_info),
                 w(&sh::BASE_COLOR_TEX).image_info(&i_base),

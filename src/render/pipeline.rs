@@ -31,15 +31,26 @@ pub struct PipelineDesc<'a> {
 /// Creates a graphics pipeline: triangle lists, reversed-z depth test (GREATER, writes on),
 /// counter-clockwise front faces, dynamic viewport, scissor and cull mode (and depth bias).
 pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, GpuError> {
-    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(d.vertex.0).name(d.vertex.1)];
+    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::VERTEX)
+        .module(d.vertex.0)
+        .name(d.vertex.1)];
     if let Some((m, e)) = d.fragment {
-        stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(m).name(e));
+        stages.push(
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(m)
+                .name(e),
+        );
     }
     let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
         .vertex_binding_descriptions(d.bindings)
         .vertex_attribute_descriptions(d.attributes);
-    let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-    let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+    let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+        .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport = vk::PipelineViewportStateCreateInfo::default()
+        .viewport_count(1)
+        .scissor_count(1);
     let raster = vk::PipelineRasterizationStateCreateInfo::default()
         .depth_clamp_enable(d.depth_clamp)
         .polygon_mode(vk::PolygonMode::FILL)
@@ -47,20 +58,33 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .depth_bias_enable(d.depth_bias)
         .line_width(1.0);
-    let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
     let depth = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(true)
         .depth_write_enable(true)
         .depth_compare_op(vk::CompareOp::GREATER);
-    let blend_attachments = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
-    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(if d.color_format.is_some() { &blend_attachments } else { &[] });
-    let mut dyn_states = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR, vk::DynamicState::CULL_MODE];
+    let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let blend =
+        vk::PipelineColorBlendStateCreateInfo::default().attachments(if d.color_format.is_some() {
+            &blend_attachments
+        } else {
+            &[]
+        });
+    let mut dyn_states = vec![
+        vk::DynamicState::VIEWPORT,
+        vk::DynamicState::SCISSOR,
+        vk::DynamicState::CULL_MODE,
+    ];
     if d.depth_bias {
         dyn_states.push(vk::DynamicState::DEPTH_BIAS);
     }
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dyn_states);
     let color_formats: Vec<vk::Format> = d.color_format.into_iter().collect();
-    let mut rendering = vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&color_formats).depth_attachment_format(d.depth_format);
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(&color_formats)
+        .depth_attachment_format(d.depth_format);
     let info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)
@@ -73,25 +97,53 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .dynamic_state(&dynamic)
         .layout(d.layout)
         .push_next(&mut rendering);
-    let p = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
-        .map_err(|(_, e)| GpuError::Vk { call: "vkCreateGraphicsPipelines", result: e })?[0];
+    let p = unsafe {
+        ctx.device
+            .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+    }
+    .map_err(|(_, e)| GpuError::Vk {
+        call: "vkCreateGraphicsPipelines",
+        result: e,
+    })?[0];
     ctx.set_name(p, d.name);
     Ok(p)
 }
 
 /// Creates a pipeline layout with set layouts and one immediate (push-constant) range.
-pub fn create_layout(ctx: &Context, sets: &[vk::DescriptorSetLayout], immediate_size: u32, name: &str) -> Result<vk::PipelineLayout, GpuError> {
-    let ranges = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, offset: 0, size: immediate_size }];
-    let info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if immediate_size > 0 { &ranges } else { &[] });
-    let l = unsafe { ctx.device.create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")?;
+pub fn create_layout(
+    ctx: &Context,
+    sets: &[vk::DescriptorSetLayout],
+    immediate_size: u32,
+    name: &str,
+) -> Result<vk::PipelineLayout, GpuError> {
+    let ranges = [vk::PushConstantRange {
+        stage_flags: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+        offset: 0,
+        size: immediate_size,
+    }];
+    let info = vk::PipelineLayoutCreateInfo::default()
+        .set_layouts(sets)
+        .push_constant_ranges(if immediate_size > 0 { &ranges } else { &[] });
+    let l =
+        unsafe { ctx.device.create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")?;
     ctx.set_name(l, name);
     Ok(l)
 }
 
 /// Full-extent viewport and scissor.
 pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D) {
-    let vp = [vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 }];
-    let sc = [vk::Rect2D { offset: vk::Offset2D::default(), extent }];
+    let vp = [vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: extent.width as f32,
+        height: extent.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    }];
+    let sc = [vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent,
+    }];
     unsafe {
         ctx.device.cmd_set_viewport(cmd, 0, &vp);
         ctx.device.cmd_set_scissor(cmd, 0, &sc);

@@ -56,7 +56,15 @@ impl ShadowPass {
     pub fn new(ctx: &Arc<Context>) -> Result<Self, GpuError> {
         let layout = create_layout(ctx, &[], sh::IMMEDIATE_SIZE, "shadow pipeline layout")?;
         let module = create_module(ctx, sh::SPIRV, "shadow.wgsl")?;
-        Ok(Self { ctx: ctx.clone(), layout, module, pipeline: vk::Pipeline::null(), pipeline_format: vk::Format::UNDEFINED, map: None, state: Access::Undefined })
+        Ok(Self {
+            ctx: ctx.clone(),
+            layout,
+            module,
+            pipeline: vk::Pipeline::null(),
+            pipeline_format: vk::Format::UNDEFINED,
+            map: None,
+            state: Access::Undefined,
+        })
     }
 
     /// Makes sure the map has this size and format; returns true if it was (re)created.
@@ -65,8 +73,17 @@ impl ShadowPass {
         if self.pipeline_format != fmt {
             unsafe { self.ctx.device.destroy_pipeline(self.pipeline, None) };
             self.pipeline = vk::Pipeline::null();
-            let bindings = [vk::VertexInputBindingDescription { binding: 0, stride: 12, input_rate: vk::VertexInputRate::VERTEX }];
-            let attributes = [vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 }];
+            let bindings = [vk::VertexInputBindingDescription {
+                binding: 0,
+                stride: 12,
+                input_rate: vk::VertexInputRate::VERTEX,
+            }];
+            let attributes = [vk::VertexInputAttributeDescription {
+                location: 0,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 0,
+            }];
             self.pipeline = create_pipeline(
                 &self.ctx,
                 &PipelineDesc {
@@ -85,7 +102,11 @@ impl ShadowPass {
             self.pipeline_format = fmt;
         }
         let size = size.clamp(1, 16384);
-        if self.map.as_ref().is_some_and(|m| m.extent.width == size && m.format == fmt) {
+        if self
+            .map
+            .as_ref()
+            .is_some_and(|m| m.extent.width == size && m.format == fmt)
+        {
             return Ok(false);
         }
         if self.map.is_some() {
@@ -97,9 +118,14 @@ impl ShadowPass {
             &self.ctx,
             "shadow map",
             fmt,
-            vk::Extent2D { width: size, height: size },
+            vk::Extent2D {
+                width: size,
+                height: size,
+            },
             1,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                | vk::ImageUsageFlags::SAMPLED
+                | vk::ImageUsageFlags::TRANSFER_SRC,
         )?);
         self.state = Access::Undefined;
         Ok(true)
@@ -107,23 +133,48 @@ impl ShadowPass {
 
     /// Whether the map's format supports hardware linear filtering of comparisons.
     pub fn hardware_filtering(&self) -> bool {
-        self.ctx.format_features(self.pipeline_format).contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
+        self.ctx
+            .format_features(self.pipeline_format)
+            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
     }
 
     /// Records the pass; leaves the map ready for fragment-shader sampling. Returns casters drawn.
-    pub fn record(&mut self, cmd: vk::CommandBuffer, scene: &GpuScene, light_clip_from_world: &Mat4, s: &ShadowSettings, draw: bool) -> usize {
+    pub fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        light_clip_from_world: &Mat4,
+        s: &ShadowSettings,
+        draw: bool,
+    ) -> usize {
         let Some(map) = &self.map else { return 0 };
         let d = &self.ctx.device;
         self.ctx.begin_label(cmd, "shadow depth pass");
-        image_barrier(d, cmd, map.raw, vk::ImageAspectFlags::DEPTH, 0..1, self.state, Access::DepthAttachment);
+        image_barrier(
+            d,
+            cmd,
+            map.raw,
+            vk::ImageAspectFlags::DEPTH,
+            0..1,
+            self.state,
+            Access::DepthAttachment,
+        );
         let depth_attachment = vk::RenderingAttachmentInfo::default()
             .image_view(map.view)
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 0.0, stencil: 0 } });
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 0.0,
+                    stencil: 0,
+                },
+            });
         let rendering = vk::RenderingInfo::default()
-            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: map.extent })
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: map.extent,
+            })
             .layer_count(1)
             .depth_attachment(&depth_attachment);
         let mut drawn = 0;
@@ -141,16 +192,40 @@ impl ShadowPass {
                     if !caster_visible(light_clip_from_world, &dr.world_bounds) {
                         continue;
                     }
-                    let pc = ShadowImmediates { light_clip_from_world: *light_clip_from_world, world_from_model: dr.world_from_model };
-                    d.cmd_set_cull_mode(cmd, if dr.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK });
-                    d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(&pc));
+                    let pc = ShadowImmediates {
+                        light_clip_from_world: *light_clip_from_world,
+                        world_from_model: dr.world_from_model,
+                    };
+                    d.cmd_set_cull_mode(
+                        cmd,
+                        if dr.double_sided {
+                            vk::CullModeFlags::NONE
+                        } else {
+                            vk::CullModeFlags::BACK
+                        },
+                    );
+                    d.cmd_push_constants(
+                        cmd,
+                        self.layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&pc),
+                    );
                     d.cmd_draw_indexed(cmd, dr.index_count, 1, dr.first_index, dr.vertex_offset, 0);
                     drawn += 1;
                 }
             }
             d.cmd_end_rendering(cmd);
         }
-        image_barrier(d, cmd, map.raw, vk::ImageAspectFlags::DEPTH, 0..1, Access::DepthAttachment, Access::DepthFragmentSampled);
+        image_barrier(
+            d,
+            cmd,
+            map.raw,
+            vk::ImageAspectFlags::DEPTH,
+            0..1,
+            Access::DepthAttachment,
+            Access::DepthFragmentSampled,
+        );
         self.state = Access::DepthFragmentSampled;
         self.ctx.end_label(cmd);
         drawn
@@ -182,12 +257,24 @@ mod tests {
     #[test]
     fn caster_culling() {
         let m = crate::math::projection::orthographic_reversed(-1.0, 1.0, -1.0, 1.0, 0.0, 10.0);
-        assert!(caster_visible(&m, &Aabb::new(Vec3::new(-0.5, -0.5, -5.0), Vec3::new(0.5, 0.5, -4.0))));
+        assert!(caster_visible(
+            &m,
+            &Aabb::new(Vec3::new(-0.5, -0.5, -5.0), Vec3::new(0.5, 0.5, -4.0))
+        ));
         // Outside in x.
-        assert!(!caster_visible(&m, &Aabb::new(Vec3::new(2.0, -0.5, -5.0), Vec3::new(3.0, 0.5, -4.0))));
+        assert!(!caster_visible(
+            &m,
+            &Aabb::new(Vec3::new(2.0, -0.5, -5.0), Vec3::new(3.0, 0.5, -4.0))
+        ));
         // Nearer than the near plane (depth > 1): kept, depth clamp flattens it.
-        assert!(caster_visible(&m, &Aabb::new(Vec3::new(-0.5, -0.5, 1.0), Vec3::new(0.5, 0.5, 2.0))));
+        assert!(caster_visible(
+            &m,
+            &Aabb::new(Vec3::new(-0.5, -0.5, 1.0), Vec3::new(0.5, 0.5, 2.0))
+        ));
         // Beyond the far plane: culled.
-        assert!(!caster_visible(&m, &Aabb::new(Vec3::new(-0.5, -0.5, -20.0), Vec3::new(0.5, 0.5, -15.0))));
+        assert!(!caster_visible(
+            &m,
+            &Aabb::new(Vec3::new(-0.5, -0.5, -20.0), Vec3::new(0.5, 0.5, -15.0))
+        ));
     }
 }

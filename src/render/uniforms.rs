@@ -85,16 +85,23 @@ pub struct ShadowImmediates {
 }
 
 const _: () = assert!(std::mem::size_of::<FrameUniform>() == shaders::scene::FRAME.size as usize);
-const _: () = assert!(std::mem::size_of::<MaterialUniform>() == shaders::scene::MATERIAL.size as usize);
-const _: () = assert!(std::mem::size_of::<SceneImmediates>() == shaders::scene::IMMEDIATE_SIZE as usize);
-const _: () = assert!(std::mem::size_of::<ShadowImmediates>() == shaders::shadow::IMMEDIATE_SIZE as usize);
+const _: () =
+    assert!(std::mem::size_of::<MaterialUniform>() == shaders::scene::MATERIAL.size as usize);
+const _: () =
+    assert!(std::mem::size_of::<SceneImmediates>() == shaders::scene::IMMEDIATE_SIZE as usize);
+const _: () =
+    assert!(std::mem::size_of::<ShadowImmediates>() == shaders::shadow::IMMEDIATE_SIZE as usize);
 
 impl SceneImmediates {
     /// Immediates for a model transform (normal matrix = inverse transpose of its 3×3).
     pub fn new(world_from_model: Mat4) -> Self {
         let m3 = glam::Mat3::from_mat4(world_from_model);
         let det = m3.determinant();
-        let nm = if det.abs() > 1e-30 { m3.inverse().transpose() } else { m3 };
+        let nm = if det.abs() > 1e-30 {
+            m3.inverse().transpose()
+        } else {
+            m3
+        };
         let sign = if det < 0.0 { -1.0 } else { 1.0 };
         Self {
             world_from_model,

@@ -19,11 +19,20 @@ pub fn checker_texture(size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> Texture
     let mut rgba = Vec::with_capacity((size * size * 4) as usize);
     for y in 0..size {
         for x in 0..size {
-            let c = if ((x * cells / size) + (y * cells / size)) % 2 == 0 { a } else { b };
+            let c = if ((x * cells / size) + (y * cells / size)) % 2 == 0 {
+                a
+            } else {
+                b
+            };
             rgba.extend([c[0], c[1], c[2], 255]);
         }
     }
-    Texture { name: "checker".into(), width: size, height: size, rgba }
+    Texture {
+        name: "checker".into(),
+        width: size,
+        height: size,
+        rgba,
+    }
 }
 
 /// A tangent-space normal map of a `bumps × bumps` grid of round domes (height h = cos² bumps).
@@ -39,21 +48,35 @@ pub fn bump_normal_map(size: u32, bumps: u32, strength: f32) -> Texture {
             let (sv, cv) = (k * v).sin_cos();
             let dh_du = 2.0 * su * cu * k * sv * sv;
             let dh_dv = 2.0 * sv * cv * k * su * su;
-            let n = normal_from_height_slope(dh_du, dh_dv, strength / k);
+            // glTF tangent space: +X along +u, +Y up the image (along −v).
+            let n = normal_from_height_slope(dh_du, -dh_dv, strength / k);
             let enc = |c: f32| ((c * 0.5 + 0.5) * 255.0).round().clamp(0.0, 255.0) as u8;
             rgba.extend([enc(n.x), enc(n.y), enc(n.z), 255]);
         }
     }
-    Texture { name: "bumps".into(), width: size, height: size, rgba }
+    Texture {
+        name: "bumps".into(),
+        width: size,
+        height: size,
+        rgba,
+    }
 }
 
 /// Builds the demo scene.
 pub fn demo_scene() -> Scene {
-    let mut s = Scene { name: "demo".into(), ..Default::default() };
-    let ground_tex = add_texture(&mut s, checker_texture(256, 16, [200, 200, 190], [150, 150, 145]));
+    let mut s = Scene {
+        name: "demo".into(),
+        ..Default::default()
+    };
+    let ground_tex = add_texture(
+        &mut s,
+        checker_texture(256, 16, [200, 200, 190], [150, 150, 145]),
+    );
     let ground = Material {
         name: "ground".into(),
-        base_color_texture: Some(TextureRef { texture: ground_tex }),
+        base_color_texture: Some(TextureRef {
+            texture: ground_tex,
+        }),
         roughness: 0.9,
         ..Default::default()
     };
@@ -79,8 +102,20 @@ pub fn demo_scene() -> Scene {
         colored(Vec3::new(0.6, 0.55, 0.3), 0.6),
         Mat4::from_translation(Vec3::new(0.5, 0.4, 4.0)),
     );
-    let gold = Material { name: "gold".into(), base_color: Vec3::new(0.9, 0.65, 0.2).extend(1.0), metallic: 0.8, roughness: 0.35, ..Default::default() };
-    add_object(&mut s, "sphere", uv_sphere(1.0, 48, 24), gold, Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)));
+    let gold = Material {
+        name: "gold".into(),
+        base_color: Vec3::new(0.9, 0.65, 0.2).extend(1.0),
+        metallic: 0.8,
+        roughness: 0.35,
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "sphere",
+        uv_sphere(1.0, 48, 24),
+        gold,
+        Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)),
+    );
     add_object(
         &mut s,
         "pillar",
@@ -88,12 +123,19 @@ pub fn demo_scene() -> Scene {
         colored(Vec3::new(0.75, 0.75, 0.72), 0.5),
         Mat4::from_translation(Vec3::new(3.5, 2.5, -2.0)),
     );
-    let panel_base = add_texture(&mut s, checker_texture(256, 4, [230, 180, 90], [90, 140, 200]));
+    let panel_base = add_texture(
+        &mut s,
+        checker_texture(256, 4, [230, 180, 90], [90, 140, 200]),
+    );
     let panel_normal = add_texture(&mut s, bump_normal_map(256, 6, 1.2));
     let panel = Material {
         name: "panel".into(),
-        base_color_texture: Some(TextureRef { texture: panel_base }),
-        normal_texture: Some(TextureRef { texture: panel_normal }),
+        base_color_texture: Some(TextureRef {
+            texture: panel_base,
+        }),
+        normal_texture: Some(TextureRef {
+            texture: panel_normal,
+        }),
         roughness: 0.45,
         double_sided: true,
         ..Default::default()
@@ -106,9 +148,17 @@ pub fn demo_scene() -> Scene {
         Mat4::from_rotation_translation(Quat::from_rotation_y(0.5), Vec3::new(-2.5, 1.6, -3.0)),
     );
     s.lights.push(Light::sun(
-        Light::sun_direction(DEMO_SUN_ELEVATION_DEG.to_radians(), DEMO_SUN_AZIMUTH_DEG.to_radians()),
+        Light::sun_direction(
+            DEMO_SUN_ELEVATION_DEG.to_radians(),
+            DEMO_SUN_AZIMUTH_DEG.to_radians(),
+        ),
         DEMO_SUN_INTENSITY,
     ));
-    s.cameras.push(Camera::look_at(Vec3::new(7.0, 5.5, 11.0), Vec3::new(0.0, 0.8, 0.0), 45f32.to_radians(), 0.1));
+    s.cameras.push(Camera::look_at(
+        Vec3::new(7.0, 5.5, 11.0),
+        Vec3::new(0.0, 0.8, 0.0),
+        45f32.to_radians(),
+        0.1,
+    ));
     s
 }

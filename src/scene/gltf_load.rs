@@ -4,8 +4,13 @@
 //! is read, indices are checked against the vertex count, external files must resolve inside the
 //! model's folder, and any remaining panic inside the parser is turned into an error.
 
-use super::tangents::{compute_smooth_normals, count_degenerate, fallback_tangent, generate_mikktspace};
-use super::{AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Primitive, Scene, Texture, TextureRef};
+use super::tangents::{
+    compute_smooth_normals, count_degenerate, fallback_tangent, generate_mikktspace,
+};
+use super::{
+    AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Primitive, Scene, Texture,
+    TextureRef,
+};
 use base64::Engine as _;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::path::{Component, Path, PathBuf};
@@ -19,12 +24,12 @@ pub const MAX_FILE_BYTES: u64 = 2 << 30;
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
     /// The file or one of its resources could not be read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}: {cause}")]
     Io {
         /// Path tried.
         path: PathBuf,
         /// Cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file is empty.
     #[error("{0}: file is empty")]
@@ -66,21 +71,34 @@ pub enum LoadError {
 }
 
 /// Extensions that may appear in `extensionsRequired`.
-const SUPPORTED_REQUIRED: &[&str] = &["KHR_materials_unlit", "KHR_lights_punctual", "KHR_texture_transform"];
+const SUPPORTED_REQUIRED: &[&str] = &[
+    "KHR_materials_unlit",
+    "KHR_lights_punctual",
+    "KHR_texture_transform",
+];
 
 /// Loads a `.gltf` or `.glb` file into a scene.
 pub fn load_gltf(path: &Path) -> Result<Scene, LoadError> {
-    let meta = std::fs::metadata(path).map_err(|e| LoadError::Io { path: path.into(), source: e })?;
+    let meta = std::fs::metadata(path).map_err(|e| LoadError::Io {
+        path: path.into(),
+        cause: e,
+    })?;
     if meta.is_dir() {
         return Err(LoadError::Io {
             path: path.into(),
-            source: std::io::Error::other("is a directory, not a glTF file"),
+            cause: std::io::Error::other("is a directory, not a glTF file"),
         });
     }
     if meta.len() > MAX_FILE_BYTES {
-        return Err(LoadError::Corrupt { path: path.into(), message: format!("file is {} bytes, over the limit", meta.len()) });
+        return Err(LoadError::Corrupt {
+            path: path.into(),
+            message: format!("file is {} bytes, over the limit", meta.len()),
+        });
     }
-    let bytes = std::fs::read(path).map_err(|e| LoadError::Io { path: path.into(), source: e })?;
+    let bytes = std::fs::read(path).map_err(|e| LoadError::Io {
+        path: path.into(),
+        cause: e,
+    })?;
     if bytes.is_empty() {
         return Err(LoadError::Empty(path.into()));
     }
@@ -88,29 +106,51 @@ pub fn load_gltf(path: &Path) -> Result<Scene, LoadError> {
     // The gltf crate is trusted not to panic, but a user's file must never crash us.
     match std::panic::catch_unwind(|| load_bytes(&p, &bytes)) {
         Ok(r) => r,
-        Err(_) => Err(LoadError::Corrupt { path: path.into(), message: "malformed data (parser failure)".into() }),
+        Err(_) => Err(LoadError::Corrupt {
+            path: path.into(),
+            message: "malformed data (parser failure)".into(),
+        }),
     }
 }
 
 fn invalid(path: &Path, e: impl std::fmt::Display) -> LoadError {
-    LoadError::Invalid { path: path.into(), message: e.to_string().replace('\n', " ") }
+    LoadError::Invalid {
+        path: path.into(),
+        message: e.to_string().replace('\n', " "),
+    }
 }
 
 fn corrupt(path: &Path, message: String) -> LoadError {
-    LoadError::Corrupt { path: path.into(), message }
+    LoadError::Corrupt {
+        path: path.into(),
+        message,
+    }
 }
 
 fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| invalid(path, e))?;
     for ext in gltf.extensions_required() {
         if !SUPPORTED_REQUIRED.contains(&ext) {
-            return Err(LoadError::UnsupportedExtension { path: path.into(), extension: ext.to_string() });
+            return Err(LoadError::UnsupportedExtension {
+                path: path.into(),
+                extension: ext.to_string(),
+            });
         }
     }
-    let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_else(|| PathBuf::from("."));
-    let base = if base.as_os_str().is_empty() { PathBuf::from(".") } else { base };
+    let base = path
+        .parent()
+        .map(|p| p.to_path_buf())
+        .unwrap_or_else(|| PathBuf::from("."));
+    let base = if base.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        base
+    };
     let mut scene = Scene {
-        name: path.file_name().map(|s| s.to_string_lossy().to_string()).unwrap_or_default(),
+        name: path
+            .file_name()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default(),
         ..Default::default()
     };
 
@@ -118,16 +158,28 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for b in gltf.buffers() {
         let data = match b.source() {
-            gltf::buffer::Source::Bin => gltf
-                .blob
-                .clone()
-                .ok_or_else(|| corrupt(path, format!("buffer {} refers to a GLB binary chunk that is missing", b.index())))?,
-            gltf::buffer::Source::Uri(uri) => read_uri(path, &base, uri, &format!("buffer {}", b.index()))?,
+            gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
+                corrupt(
+                    path,
+                    format!(
+                        "buffer {} refers to a GLB binary chunk that is missing",
+                        b.index()
+                    ),
+                )
+            })?,
+            gltf::buffer::Source::Uri(uri) => {
+                read_uri(path, &base, uri, &format!("buffer {}", b.index()))?
+            }
         };
         if data.len() < b.length() {
             return Err(corrupt(
                 path,
-                format!("buffer {} holds {} bytes but declares {}", b.index(), data.len(), b.length()),
+                format!(
+                    "buffer {} holds {} bytes but declares {}",
+                    b.index(),
+                    data.len(),
+                    b.length()
+                ),
             ));
         }
         buffers.push(data);
@@ -135,7 +187,14 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     for v in gltf.views() {
         let end = v.offset().checked_add(v.length());
         if end.is_none_or(|e| e > buffers[v.buffer().index()].len()) {
-            return Err(corrupt(path, format!("buffer view {} reads past the end of buffer {}", v.index(), v.buffer().index())));
+            return Err(corrupt(
+                path,
+                format!(
+                    "buffer view {} reads past the end of buffer {}",
+                    v.index(),
+                    v.buffer().index()
+                ),
+            ));
         }
     }
     for a in gltf.accessors() {
@@ -164,16 +223,29 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         };
         match decode_image(&data) {
             Ok((w, h, rgba)) => {
-                scene.textures.push(Texture { name: img.name().unwrap_or(&what).to_string(), width: w, height: h, rgba });
+                scene.textures.push(Texture {
+                    name: img.name().unwrap_or(&what).to_string(),
+                    width: w,
+                    height: h,
+                    rgba,
+                });
                 image_slots.push(Some(scene.textures.len() - 1));
             }
             Err(msg) => {
-                scene.warn(format!("{what} could not be decoded ({msg}); using a default"));
+                scene.warn(format!(
+                    "{what} could not be decoded ({msg}); using a default"
+                ));
                 image_slots.push(None);
             }
         }
     }
-    let tex_ref = |t: gltf::Texture| image_slots.get(t.source().index()).copied().flatten().map(|texture| TextureRef { texture });
+    let tex_ref = |t: gltf::Texture| {
+        image_slots
+            .get(t.source().index())
+            .copied()
+            .flatten()
+            .map(|texture| TextureRef { texture })
+    };
 
     // Materials (index = glTF index; the default material goes last).
     let mut uses_transform = false;
@@ -185,7 +257,9 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             base_color_texture: pbr.base_color_texture().and_then(|t| tex_ref(t.texture())),
             metallic: pbr.metallic_factor(),
             roughness: pbr.roughness_factor(),
-            metallic_roughness_texture: pbr.metallic_roughness_texture().and_then(|t| tex_ref(t.texture())),
+            metallic_roughness_texture: pbr
+                .metallic_roughness_texture()
+                .and_then(|t| tex_ref(t.texture())),
             normal_texture: m.normal_texture().and_then(|t| tex_ref(t.texture())),
             normal_scale: m.normal_texture().map(|t| t.scale()).unwrap_or(1.0),
             emissive: Vec3::from_array(m.emissive_factor()),
@@ -200,9 +274,15 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         };
         if mat.alpha_mode == AlphaMode::Blend {
             mat.alpha_mode = AlphaMode::Opaque;
-            scene.warn(format!("material '{}': alpha blending not supported yet, drawn opaque", mat.name));
+            scene.warn(format!(
+                "material '{}': alpha blending not supported yet, drawn opaque",
+                mat.name
+            ));
         }
-        if pbr.base_color_texture().is_some_and(|t| t.texture_transform().is_some()) {
+        if pbr
+            .base_color_texture()
+            .is_some_and(|t| t.texture_transform().is_some())
+        {
             uses_transform = true;
         }
         if !mat.base_color.is_finite() {
@@ -218,9 +298,14 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
 
     // Meshes.
     for mesh in gltf.meshes() {
-        let mut out = Mesh { name: mesh.name().unwrap_or("").to_string(), primitives: Vec::new() };
+        let mut out = Mesh {
+            name: mesh.name().unwrap_or("").to_string(),
+            primitives: Vec::new(),
+        };
         for prim in mesh.primitives() {
-            if let Some(p) = read_primitive(path, &mut scene, &buffers, &mesh, &prim, default_material)? {
+            if let Some(p) =
+                read_primitive(path, &mut scene, &buffers, &mesh, &prim, default_material)?
+            {
                 out.primitives.push(p);
             }
         }
@@ -240,7 +325,8 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             gltf.nodes().filter(|n| !is_child[n.index()]).collect()
         }
     };
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+        roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     let mut visited = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
         visited += 1;
@@ -250,11 +336,17 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;
         if !world.is_finite() {
-            scene.warn(format!("node {} has a non-finite transform; skipped", node.index()));
+            scene.warn(format!(
+                "node {} has a non-finite transform; skipped",
+                node.index()
+            ));
             continue;
         }
         if let Some(m) = node.mesh() {
-            scene.instances.push(Instance { mesh: m.index(), world_from_model: world });
+            scene.instances.push(Instance {
+                mesh: m.index(),
+                world_from_model: world,
+            });
         }
         if let Some(c) = node.camera() {
             match c.projection() {
@@ -269,7 +361,10 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                     });
                 }
                 gltf::camera::Projection::Orthographic(_) => {
-                    scene.warn(format!("camera {} is orthographic; not supported, skipped", c.index()));
+                    scene.warn(format!(
+                        "camera {} is orthographic; not supported, skipped",
+                        c.index()
+                    ));
                 }
             }
         }
@@ -279,9 +374,13 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             let kind = match l.kind() {
                 gltf::khr_lights_punctual::Kind::Directional => LightKind::Directional,
                 gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
-                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } => {
-                    LightKind::Spot { inner: inner_cone_angle, outer: outer_cone_angle.max(inner_cone_angle + 1e-4) }
-                }
+                gltf::khr_lights_punctual::Kind::Spot {
+                    inner_cone_angle,
+                    outer_cone_angle,
+                } => LightKind::Spot {
+                    inner: inner_cone_angle,
+                    outer: outer_cone_angle.max(inner_cone_angle + 1e-4),
+                },
             };
             scene.lights.push(Light {
                 kind,
@@ -307,10 +406,24 @@ fn check_accessor(path: &Path, a: &gltf::Accessor) -> Result<(), LoadError> {
     let count = a.count();
     if let Some(view) = a.view() {
         let stride = view.stride().unwrap_or(elem);
-        let need = if count == 0 { 0 } else { stride.checked_mul(count - 1).and_then(|x| x.checked_add(elem)) .unwrap_or(usize::MAX) };
+        let need = if count == 0 {
+            0
+        } else {
+            stride
+                .checked_mul(count - 1)
+                .and_then(|x| x.checked_add(elem))
+                .unwrap_or(usize::MAX)
+        };
         let end = a.offset().checked_add(need);
         if end.is_none_or(|e| e > view.length()) || stride < elem {
-            return Err(corrupt(path, format!("accessor {} reads past the end of buffer view {}", a.index(), view.index())));
+            return Err(corrupt(
+                path,
+                format!(
+                    "accessor {} reads past the end of buffer view {}",
+                    a.index(),
+                    view.index()
+                ),
+            ));
         }
     }
     if let Some(s) = a.sparse() {
@@ -321,8 +434,16 @@ fn check_accessor(path: &Path, a: &gltf::Accessor) -> Result<(), LoadError> {
             gltf::accessor::sparse::IndexType::U16 => 2,
             gltf::accessor::sparse::IndexType::U32 => 4,
         };
-        if s.indices().offset() + n * isize > iv.length() || s.values().offset() + n * elem > s.values().view().length() {
-            return Err(corrupt(path, format!("sparse accessor {} reads past the end of its buffer views", a.index())));
+        if s.indices().offset() + n * isize > iv.length()
+            || s.values().offset() + n * elem > s.values().view().length()
+        {
+            return Err(corrupt(
+                path,
+                format!(
+                    "sparse accessor {} reads past the end of its buffer views",
+                    a.index()
+                ),
+            ));
         }
     }
     Ok(())
@@ -353,7 +474,10 @@ fn read_primitive(
         None => (0..n as u32).collect(),
     };
     if let Some(bad) = raw_indices.iter().find(|&&i| i as usize >= n) {
-        return Err(corrupt(path, format!("{label}: index {bad} out of range (vertex count {n})")));
+        return Err(corrupt(
+            path,
+            format!("{label}: index {bad} out of range (vertex count {n})"),
+        ));
     }
     let indices: Vec<u32> = match prim.mode() {
         Mode::Triangles => raw_indices.chunks_exact(3).flatten().copied().collect(),
@@ -366,9 +490,13 @@ fn read_primitive(
                 }
             })
             .collect(),
-        Mode::TriangleFan => (2..raw_indices.len()).flat_map(|i| [raw_indices[0], raw_indices[i - 1], raw_indices[i]]).collect(),
+        Mode::TriangleFan => (2..raw_indices.len())
+            .flat_map(|i| [raw_indices[0], raw_indices[i - 1], raw_indices[i]])
+            .collect(),
         other => {
-            scene.warn(format!("{label}: mode {other:?} is not drawn (triangles only)"));
+            scene.warn(format!(
+                "{label}: mode {other:?} is not drawn (triangles only)"
+            ));
             return Ok(None);
         }
     };
@@ -381,25 +509,55 @@ fn read_primitive(
         .copied()
         .collect();
     if indices.len() / 3 != before {
-        scene.warn(format!("{label}: {} triangles with non-finite positions dropped", before - indices.len() / 3));
+        scene.warn(format!(
+            "{label}: {} triangles with non-finite positions dropped",
+            before - indices.len() / 3
+        ));
     }
     let degenerate = count_degenerate(&positions, &indices);
     if degenerate > 0 {
         scene.warn(format!("{label}: {degenerate} zero-area triangles"));
     }
     let normals: Vec<Vec3> = match reader.read_normals() {
-        Some(it) => it.map(|v| Vec3::from_array(v).try_normalize().unwrap_or(Vec3::Y)).collect(),
+        Some(it) => it
+            .map(|v| Vec3::from_array(v).try_normalize().unwrap_or(Vec3::Y))
+            .collect(),
         None => {
             scene.warn(format!("{label}: no normals; computed smooth normals"));
             compute_smooth_normals(&positions, &indices)
         }
     };
     let (uvs, has_uvs): (Vec<Vec2>, bool) = match reader.read_tex_coords(0) {
-        Some(it) => (it.into_f32().map(|v| { let v = Vec2::from_array(v); if v.is_finite() { v } else { Vec2::ZERO } }).collect(), true),
+        Some(it) => (
+            it.into_f32()
+                .map(|v| {
+                    let v = Vec2::from_array(v);
+                    if v.is_finite() {
+                        v
+                    } else {
+                        Vec2::ZERO
+                    }
+                })
+                .collect(),
+            true,
+        ),
         None => (vec![Vec2::ZERO; n], false),
     };
+    if reader.read_colors(0).is_some() {
+        scene.warn(format!(
+            "{label}: vertex colours (COLOR_0) are ignored (not supported yet)"
+        ));
+    }
     let material = prim.material().index().unwrap_or(default_material);
-    let mut p = Primitive { positions, normals, uvs, tangents: Vec::new(), indices, material, has_uvs };
+    let mut p = Primitive {
+        positions,
+        normals,
+        uvs,
+        tangents: Vec::new(),
+        indices,
+        material,
+        has_uvs,
+    };
     let wants_normal_map = scene.materials[material].normal_texture.is_some();
     match reader.read_tangents() {
         Some(it) => {
@@ -407,7 +565,9 @@ fn read_primitive(
                 .map(|t| {
                     let t = Vec4::from_array(t);
                     if t.is_finite() && t.truncate().length_squared() > 1e-12 {
-                        t.truncate().normalize().extend(if t.w < 0.0 { -1.0 } else { 1.0 })
+                        t.truncate()
+                            .normalize()
+                            .extend(if t.w < 0.0 { -1.0 } else { 1.0 })
                     } else {
                         Vec4::new(1.0, 0.0, 0.0, 1.0)
                     }
@@ -416,13 +576,17 @@ fn read_primitive(
         }
         None if wants_normal_map && has_uvs => {
             if !generate_mikktspace(&mut p) {
-                scene.warn(format!("{label}: MikkTSpace tangent generation failed; normal map may be wrong"));
+                scene.warn(format!(
+                    "{label}: MikkTSpace tangent generation failed; normal map may be wrong"
+                ));
             }
         }
         None => p.tangents = p.normals.iter().map(|n| fallback_tangent(*n)).collect(),
     }
     if wants_normal_map && !has_uvs {
-        scene.warn(format!("{label}: normal map ignored: the primitive has no TEXCOORD_0"));
+        scene.warn(format!(
+            "{label}: normal map ignored: the primitive has no TEXCOORD_0"
+        ));
         let mut m = scene.materials[material].clone();
         m.normal_texture = None;
         m.name = format!("{} (no UVs)", m.name);
@@ -443,7 +607,11 @@ fn read_uri(path: &Path, base: &Path, uri: &str, what: &str) -> Result<Vec<u8>, 
             .decode(payload.trim())
             .map_err(|e| corrupt(path, format!("{what}: bad base64 in data URI: {e}")));
     }
-    let refused = || LoadError::OutsideFolder { path: path.into(), what: what.into(), uri: uri.into() };
+    let refused = || LoadError::OutsideFolder {
+        path: path.into(),
+        what: what.into(),
+        uri: uri.into(),
+    };
     if uri.contains("://") || uri.starts_with('/') || uri.starts_with('\\') || uri.contains(':') {
         return Err(refused());
     }
@@ -470,7 +638,10 @@ fn read_uri(path: &Path, base: &Path, uri: &str, what: &str) -> Result<Vec<u8>, 
             return Err(refused());
         }
     }
-    std::fs::read(&full).map_err(|e| LoadError::Io { path: full, source: e })
+    std::fs::read(&full).map_err(|e| LoadError::Io {
+        path: full,
+        cause: e,
+    })
 }
 
 fn percent_decode(s: &str) -> String {
@@ -478,7 +649,7 @@ fn percent_decode(s: &str) -> String {
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;
     while i < b.len() {
-        if b[i] == b'%' && i + 2 < b.len() + 0 && i + 2 <= b.len() - 1 {
+        if b[i] == b'%' && i + 2 < b.len() {
             if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
                 out.push(v);
                 i += 3;
@@ -492,7 +663,9 @@ fn percent_decode(s: &str) -> String {
 }
 
 fn decode_image(data: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
-    let reader = image::ImageReader::new(std::io::Cursor::new(data)).with_guessed_format().map_err(|e| e.to_string())?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(data))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
     let (w, h) = reader.into_dimensions().map_err(|e| e.to_string())?;
     if w == 0 || h == 0 || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
         return Err(format!("size {w}x{h} outside 1..={MAX_TEXTURE_SIDE}"));
@@ -515,9 +688,20 @@ mod tests {
     #[test]
     fn uri_escape_refused() {
         let dir = std::env::temp_dir();
-        for uri in ["../secret.bin", "/etc/passwd", "a/../../x", "file:///etc/passwd", "http://x/y", "%2e%2e/x", "C:\\x"] {
+        for uri in [
+            "../secret.bin",
+            "/etc/passwd",
+            "a/../../x",
+            "file:///etc/passwd",
+            "http://x/y",
+            "%2e%2e/x",
+            "C:\\x",
+        ] {
             let r = read_uri(Path::new("m.gltf"), &dir, uri, "buffer 0");
-            assert!(matches!(r, Err(LoadError::OutsideFolder { .. })), "{uri}: {r:?}");
+            assert!(
+                matches!(r, Err(LoadError::OutsideFolder { .. })),
+                "{uri}: {r:?}"
+            );
         }
     }
 }

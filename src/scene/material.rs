@@ -35,7 +35,14 @@ pub fn blinn_phong_params(base: Vec3, metallic: f32, roughness: f32) -> BlinnPho
 
 /// Diffuse + specular from one light: `radiance` is I (already divided by r² for local lights),
 /// `vis` the shadow/facing term, n, l, v unit vectors.
-pub fn shade_blinn_phong(m: &BlinnPhong, n: Vec3, l: Vec3, v: Vec3, radiance: Vec3, vis: f32) -> Vec3 {
+pub fn shade_blinn_phong(
+    m: &BlinnPhong,
+    n: Vec3,
+    l: Vec3,
+    v: Vec3,
+    radiance: Vec3,
+    vis: f32,
+) -> Vec3 {
     let h = (l + v).normalize_or_zero();
     let ndl = n.dot(l).max(0.0);
     let ndh = n.dot(h).max(0.0);
@@ -68,6 +75,9 @@ mod tests {
         // h = +Y exactly, so the specular term is ks * 1.
         let expect = 2.0 * (l.y + 0.04);
         assert!((c.x - expect).abs() < 1e-5);
-        assert_eq!(shade_blinn_phong(&m, n, l, v, Vec3::splat(2.0), 0.0), Vec3::ZERO);
+        assert_eq!(
+            shade_blinn_phong(&m, n, l, v, Vec3::splat(2.0), 0.0),
+            Vec3::ZERO
+        );
     }
 }

@@ -2,9 +2,9 @@
 //! loaded from glTF 2.0 or built in code. Repairs (normals, tangents) happen here, with warnings.
 
 pub mod demo;
-pub mod shapes;
 pub mod gltf_load;
 pub mod material;
+pub mod shapes;
 pub mod tangents;
 mod types;
 

@@ -3,8 +3,22 @@
 use super::{Instance, Material, Mesh, Primitive, Scene, Texture};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-fn prim(positions: Vec<Vec3>, normals: Vec<Vec3>, uvs: Vec<Vec2>, tangents: Vec<Vec4>, indices: Vec<u32>) -> Primitive {
-    Primitive { positions, normals, uvs, tangents, indices, material: 0, has_uvs: true }
+fn prim(
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    tangents: Vec<Vec4>,
+    indices: Vec<u32>,
+) -> Primitive {
+    Primitive {
+        positions,
+        normals,
+        uvs,
+        tangents,
+        indices,
+        material: 0,
+        has_uvs: true,
+    }
 }
 
 /// A square in the XZ plane centred at the origin, facing +Y, `size` wide, UVs repeating `uv_scale`
@@ -12,9 +26,19 @@ fn prim(positions: Vec<Vec3>, normals: Vec<Vec3>, uvs: Vec<Vec2>, tangents: Vec<
 pub fn plane(size: f32, uv_scale: f32) -> Primitive {
     let h = size * 0.5;
     prim(
-        vec![Vec3::new(-h, 0.0, -h), Vec3::new(h, 0.0, -h), Vec3::new(h, 0.0, h), Vec3::new(-h, 0.0, h)],
+        vec![
+            Vec3::new(-h, 0.0, -h),
+            Vec3::new(h, 0.0, -h),
+            Vec3::new(h, 0.0, h),
+            Vec3::new(-h, 0.0, h),
+        ],
         vec![Vec3::Y; 4],
-        vec![Vec2::new(0.0, 0.0), Vec2::new(uv_scale, 0.0), Vec2::new(uv_scale, uv_scale), Vec2::new(0.0, uv_scale)],
+        vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(uv_scale, 0.0),
+            Vec2::new(uv_scale, uv_scale),
+            Vec2::new(0.0, uv_scale),
+        ],
         vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4],
         vec![0, 2, 1, 0, 3, 2],
     )
@@ -25,9 +49,19 @@ pub fn plane(size: f32, uv_scale: f32) -> Primitive {
 pub fn quad(width: f32, height: f32) -> Primitive {
     let (w, h) = (width * 0.5, height * 0.5);
     prim(
-        vec![Vec3::new(-w, -h, 0.0), Vec3::new(w, -h, 0.0), Vec3::new(w, h, 0.0), Vec3::new(-w, h, 0.0)],
+        vec![
+            Vec3::new(-w, -h, 0.0),
+            Vec3::new(w, -h, 0.0),
+            Vec3::new(w, h, 0.0),
+            Vec3::new(-w, h, 0.0),
+        ],
         vec![Vec3::Z; 4],
-        vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)],
+        vec![
+            Vec2::new(0.0, 1.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.0, 0.0),
+        ],
         // glTF: bitangent = w · (n × t) points up the image (towards decreasing v, the normal
         // map's +Y). Here n × t = Z × X = +Y is up, so w = +1.
         vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4],
@@ -37,7 +71,11 @@ pub fn quad(width: f32, height: f32) -> Primitive {
 
 /// An axis-aligned box centred at the origin with the given half extents, 24 vertices.
 pub fn cuboid(half: Vec3) -> Primitive {
-    let mut p = Primitive { material: 0, has_uvs: true, ..Default::default() };
+    let mut p = Primitive {
+        material: 0,
+        has_uvs: true,
+        ..Default::default()
+    };
     // (normal, tangent) for each face; bitangent = n × t.
     let faces = [
         (Vec3::X, -Vec3::Z),
@@ -58,21 +96,30 @@ pub fn cuboid(half: Vec3) -> Primitive {
             p.uvs.push(Vec2::new((su + 1.0) * 0.5, (1.0 - sv) * 0.5));
             p.tangents.push(t.extend(1.0));
         }
-        p.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        p.indices
+            .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
     }
     p
 }
 
 /// A UV sphere of `radius` centred at the origin.
 pub fn uv_sphere(radius: f32, segments: u32, rings: u32) -> Primitive {
-    let mut p = Primitive { material: 0, has_uvs: true, ..Default::default() };
+    let mut p = Primitive {
+        material: 0,
+        has_uvs: true,
+        ..Default::default()
+    };
     for r in 0..=rings {
         let v = r as f32 / rings as f32;
         let theta = v * std::f32::consts::PI;
         for s in 0..=segments {
             let u = s as f32 / segments as f32;
             let phi = u * std::f32::consts::TAU;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            );
             p.positions.push(n * radius);
             p.normals.push(n);
             p.uvs.push(Vec2::new(u, v));
@@ -97,11 +144,23 @@ pub fn uv_sphere(radius: f32, segments: u32, rings: u32) -> Primitive {
 }
 
 /// Appends a single-primitive mesh with its own material and one instance; returns the mesh index.
-pub fn add_object(scene: &mut Scene, name: &str, mut p: Primitive, material: Material, world_from_model: Mat4) -> usize {
+pub fn add_object(
+    scene: &mut Scene,
+    name: &str,
+    mut p: Primitive,
+    material: Material,
+    world_from_model: Mat4,
+) -> usize {
     scene.materials.push(material);
     p.material = scene.materials.len() - 1;
-    scene.meshes.push(Mesh { name: name.into(), primitives: vec![p] });
-    scene.instances.push(Instance { mesh: scene.meshes.len() - 1, world_from_model });
+    scene.meshes.push(Mesh {
+        name: name.into(),
+        primitives: vec![p],
+    });
+    scene.instances.push(Instance {
+        mesh: scene.meshes.len() - 1,
+        world_from_model,
+    });
     scene.meshes.len() - 1
 }
 
@@ -113,7 +172,32 @@ pub fn add_texture(scene: &mut Scene, t: Texture) -> usize {
 
 /// A plain material of linear colour `rgb`.
 pub fn colored(rgb: Vec3, roughness: f32) -> Material {
-    Material { name: format!("{rgb}"), base_color: rgb.extend(1.0), roughness, ..Default::default() }
+    Material {
+        name: format!("{rgb}"),
+        base_color: rgb.extend(1.0),
+        roughness,
+        ..Default::default()
+    }
+}
+
+/// Adds a grey ground plane just under the scene's bounds, wide enough to catch its shadows
+/// (5× the bounds' diagonal), for viewing models that have none.
+pub fn add_ground(scene: &mut Scene) {
+    let b = scene.bounds();
+    if b.is_empty() {
+        return;
+    }
+    let size = (b.diagonal() * 5.0).max(1e-3);
+    let y = b.min.y - b.diagonal() * 1e-3;
+    let c = b.center();
+    scene.framing.get_or_insert(b);
+    add_object(
+        scene,
+        "ground",
+        plane(size, 1.0),
+        colored(Vec3::splat(0.3), 0.9),
+        Mat4::from_translation(Vec3::new(c.x, y, c.z)),
+    );
 }
 
 #[cfg(test)]
@@ -122,10 +206,17 @@ mod tests {
 
     fn check_winding(p: &Primitive) {
         for t in p.indices.chunks_exact(3) {
-            let (a, b, c) = (p.positions[t[0] as usize], p.positions[t[1] as usize], p.positions[t[2] as usize]);
+            let (a, b, c) = (
+                p.positions[t[0] as usize],
+                p.positions[t[1] as usize],
+                p.positions[t[2] as usize],
+            );
             let face_n = (b - a).cross(c - a);
             let n = p.normals[t[0] as usize] + p.normals[t[1] as usize] + p.normals[t[2] as usize];
-            assert!(face_n.dot(n) > 0.0, "triangle {t:?} winds against its normal");
+            assert!(
+                face_n.dot(n) > 0.0,
+                "triangle {t:?} winds against its normal"
+            );
         }
     }
 
@@ -133,7 +224,10 @@ mod tests {
         // Tangent along +u, w·(n × t) along −v (up the image), measured on each triangle.
         for t in p.indices.chunks_exact(3) {
             let i = [t[0] as usize, t[1] as usize, t[2] as usize];
-            let (e1, e2) = (p.positions[i[1]] - p.positions[i[0]], p.positions[i[2]] - p.positions[i[0]]);
+            let (e1, e2) = (
+                p.positions[i[1]] - p.positions[i[0]],
+                p.positions[i[2]] - p.positions[i[0]],
+            );
             let (d1, d2) = (p.uvs[i[1]] - p.uvs[i[0]], p.uvs[i[2]] - p.uvs[i[0]]);
             let r = d1.x * d2.y - d2.x * d1.y;
             if r.abs() < 1e-8 {
@@ -150,7 +244,12 @@ mod tests {
 
     #[test]
     fn shapes_wind_ccw_with_consistent_tangents() {
-        for p in [plane(4.0, 2.0), quad(2.0, 1.0), cuboid(Vec3::new(1.0, 2.0, 3.0)), uv_sphere(1.0, 16, 8)] {
+        for p in [
+            plane(4.0, 2.0),
+            quad(2.0, 1.0),
+            cuboid(Vec3::new(1.0, 2.0, 3.0)),
+            uv_sphere(1.0, 16, 8),
+        ] {
             check_winding(&p);
             check_tangents(&p);
             assert_eq!(p.positions.len(), p.normals.len());

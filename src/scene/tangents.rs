@@ -17,7 +17,9 @@ pub fn compute_smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> 
             acc[c] += n;
         }
     }
-    acc.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect()
+    acc.into_iter()
+        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
+        .collect()
 }
 
 /// Counts triangles whose area is zero (or not finite).
@@ -25,9 +27,13 @@ pub fn count_degenerate(positions: &[Vec3], indices: &[u32]) -> usize {
     indices
         .chunks_exact(3)
         .filter(|t| {
-            let (a, b, c) = (positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]);
+            let (a, b, c) = (
+                positions[t[0] as usize],
+                positions[t[1] as usize],
+                positions[t[2] as usize],
+            );
             let n = (b - a).cross(c - a);
-            !(n.length_squared() > 0.0) || !n.is_finite()
+            n.length_squared().is_nan() || n.length_squared() <= 0.0 || !n.is_finite()
         })
         .count()
 }
@@ -88,7 +94,8 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
     }
     // Weld identical (position, normal, uv, tangent) vertices back together.
     let mut map: HashMap<[u32; 12], u32> = HashMap::new();
-    let (mut pos, mut nor, mut uv, mut tan, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut pos, mut nor, mut uv, mut tan, mut idx) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for k in 0..n {
         let mut t = g.tangents[k];
         if !t.is_finite() || t.truncate().length_squared() < 1e-12 {
@@ -139,9 +146,19 @@ mod tests {
     fn quad(mirror: bool) -> Primitive {
         let u = |x: f32| if mirror { 1.0 - x } else { x };
         Primitive {
-            positions: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            positions: vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
             normals: vec![Vec3::Z; 4],
-            uvs: vec![Vec2::new(u(0.0), 1.0), Vec2::new(u(1.0), 1.0), Vec2::new(u(1.0), 0.0), Vec2::new(u(0.0), 0.0)],
+            uvs: vec![
+                Vec2::new(u(0.0), 1.0),
+                Vec2::new(u(1.0), 1.0),
+                Vec2::new(u(1.0), 0.0),
+                Vec2::new(u(0.0), 0.0),
+            ],
             tangents: vec![],
             indices: vec![0, 1, 2, 0, 2, 3],
             material: 0,

@@ -197,7 +197,11 @@ impl Camera {
     /// A camera at `eye` looking at `target` (Y up; Z up if looking straight down or up).
     pub fn look_at(eye: Vec3, target: Vec3, fov_y: f32, near: f32) -> Self {
         let d = (target - eye).normalize_or_zero();
-        let up = if d.cross(Vec3::Y).length_squared() < 1e-8 { Vec3::Z } else { Vec3::Y };
+        let up = if d.cross(Vec3::Y).length_squared() < 1e-8 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
         Self {
             world_from_view: Mat4::look_at_rh(eye, target, up).inverse(),
             fov_y,
@@ -245,6 +249,9 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// Repairs and unsupported features met while loading.
     pub warnings: Vec<String>,
+    /// Bounds to frame with the default camera when they differ from `bounds()` (set when a
+    /// helper such as a ground plane is added).
+    pub framing: Option<Aabb>,
 }
 
 impl Scene {
@@ -263,7 +270,13 @@ impl Scene {
     pub fn triangle_count(&self) -> usize {
         self.instances
             .iter()
-            .map(|i| self.meshes[i.mesh].primitives.iter().map(|p| p.triangle_count()).sum::<usize>())
+            .map(|i| {
+                self.meshes[i.mesh]
+                    .primitives
+                    .iter()
+                    .map(|p| p.triangle_count())
+                    .sum::<usize>()
+            })
             .sum()
     }
 
@@ -276,12 +289,25 @@ impl Scene {
 
     /// A camera that frames the bounds from the front-right, above.
     pub fn default_camera(&self, aspect: f32) -> Camera {
-        let b = self.bounds();
-        let (center, radius) = if b.is_empty() { (Vec3::ZERO, 1.0) } else { (b.center(), (b.diagonal() * 0.5).max(1e-6)) };
+        let b = self.framing.unwrap_or_else(|| self.bounds());
+        let (center, radius) = if b.is_empty() {
+            (Vec3::ZERO, 1.0)
+        } else {
+            (b.center(), (b.diagonal() * 0.5).max(1e-6))
+        };
         let fov_y = 45f32.to_radians();
-        let fov_min = if aspect < 1.0 { 2.0 * ((fov_y * 0.5).tan() * aspect).atan() } else { fov_y };
+        let fov_min = if aspect < 1.0 {
+            2.0 * ((fov_y * 0.5).tan() * aspect).atan()
+        } else {
+            fov_y
+        };
         let dist = radius / (fov_min * 0.5).sin() * 1.05;
         let dir = Vec3::new(0.55, 0.45, 1.0).normalize();
-        Camera::look_at(center + dir * dist, center, fov_y, (dist - radius).max(dist * 1e-3) * 0.5)
+        Camera::look_at(
+            center + dir * dist,
+            center,
+            fov_y,
+            (dist - radius).max(dist * 1e-3) * 0.5,
+        )
     }
 }

@@ -10,15 +10,23 @@ use umbra::gpu::{Context, ContextDesc, Validation};
 /// A context with the Khronos validation layer (synchronization validation on). Fails if the
 /// layer is missing: GPU tests never run unvalidated.
 pub fn context() -> Arc<Context> {
-    Context::new(&ContextDesc { validation: Validation::Required, ..Default::default() })
-        .unwrap_or_else(|e| panic!("cannot create a validated Vulkan context: {e}"))
+    Context::new(&ContextDesc {
+        validation: Validation::Required,
+        ..Default::default()
+    })
+    .unwrap_or_else(|e| panic!("cannot create a validated Vulkan context: {e}"))
 }
 
 /// Fails the test if the validation layer reported any warning or error.
 pub fn assert_validation_clean(ctx: &Context) {
     assert!(ctx.validation_enabled, "validation layer not enabled");
     let n = ctx.validation_log.problem_count();
-    assert_eq!(n, 0, "validation messages: {:#?}", ctx.validation_log.messages());
+    assert_eq!(
+        n,
+        0,
+        "validation messages: {:#?}",
+        ctx.validation_log.messages()
+    );
 }
 
 /// Folder for test artifacts (images), under target/.
@@ -71,7 +79,12 @@ pub fn srgb_to_linear(b: u8) -> f32 {
 /// Linear → sRGB byte.
 pub fn linear_to_srgb(c: f32) -> f32 {
     let c = c.clamp(0.0, 1.0);
-    255.0 * if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+    255.0
+        * if c <= 0.0031308 {
+            c * 12.92
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        }
 }
 
 /// The corpus folder: UMBRA_GLTF_CORPUS, else ../shared/gltf beside the checkout.

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Makes sure a Vulkan loader, a driver (ICD) and, with --validation, the Khronos validation layer
+# are installed. Installs Mesa's lavapipe CPU driver with apt when root or with passwordless
+# sudo; otherwise prints exactly what to install and exits 1.
+# Usage: scripts/ensure-vulkan.sh [--validation] [--xvfb]
+set -euo pipefail
+
+need_validation=0
+need_xvfb=0
+for a in "$@"; do
+  case "$a" in
+    --validation) need_validation=1 ;;
+    --xvfb) need_xvfb=1 ;;
+  esac
+done
+
+missing=()
+if ! ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'; then
+  missing+=(libvulkan1)
+fi
+if ! ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 && [ -z "${VK_ICD_FILENAMES:-}${VK_DRIVER_FILES:-}" ]; then
+  missing+=(mesa-vulkan-drivers)
+fi
+if [ "$need_validation" = 1 ] && ! ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json /etc/vulkan/explicit_layer.d/VkLayer_khronos_validation.json >/dev/null 2>&1; then
+  missing+=(vulkan-validationlayers)
+fi
+if [ "$need_xvfb" = 1 ] && ! command -v Xvfb >/dev/null 2>&1; then
+  missing+=(xvfb)
+fi
+
+if [ "${#missing[@]}" -eq 0 ]; then
+  exit 0
+fi
+
+echo "umbra: installing missing Vulkan packages: ${missing[*]}" >&2
+if [ "$(id -u)" = 0 ]; then
+  SUDO=""
+elif command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
+  SUDO="sudo"
+else
+  echo "umbra: cannot install as this user. Run: sudo apt-get update && sudo apt-get install -y ${missing[*]}" >&2
+  exit 1
+fi
+if ! command -v apt-get >/dev/null 2>&1; then
+  echo "umbra: no apt-get here. Install a Vulkan loader and driver (Mesa lavapipe) and the Khronos validation layer with your package manager: ${missing[*]}" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
+echo "umbra: installed ${missing[*]}" >&2

@@ -1,0 +1,232 @@
+//! Bad input gets one clear error line and a non-zero exit, never a panic (the CLI binary is run).
+
+use base64::Engine as _;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli-errors")
+        .join(name);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A one-triangle glTF: positions (3 × vec3 f32) then u16 indices, in one buffer.
+fn triangle_bytes(indices: [u16; 3]) -> Vec<u8> {
+    let mut b = Vec::new();
+    for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        for c in v {
+            b.extend(c.to_le_bytes());
+        }
+    }
+    for i in indices {
+        b.extend(i.to_le_bytes());
+    }
+    b.extend([0, 0]); // pad to 4
+    b
+}
+
+fn triangle_json(buffer: Value, position_count: usize) -> Value {
+    json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "buffers": [buffer],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 6}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": position_count, "type": "VEC3",
+             "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0]},
+            {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}
+        ]
+    })
+}
+
+fn data_uri(bytes: &[u8]) -> String {
+    format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(bytes)
+    )
+}
+
+fn glb(json: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut j = serde_json::to_vec(json).unwrap();
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    let total = 12 + 8 + j.len() + 8 + bin.len();
+    let mut out = Vec::new();
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((j.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(&j);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+fn run(args: &[&str], dir: &Path) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+fn assert_one_line_error(file: &Path, expect: &str) {
+    let dir = file.parent().unwrap();
+    let out_png = dir.join("out.png");
+    let _ = std::fs::remove_file(&out_png);
+    let (ok, stderr) = run(
+        &[
+            "render",
+            file.to_str().unwrap(),
+            "-o",
+            out_png.to_str().unwrap(),
+        ],
+        dir,
+    );
+    assert!(!ok, "{}: should fail", file.display());
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(
+        lines.len(),
+        1,
+        "{}: expected one error line, got:\n{stderr}",
+        file.display()
+    );
+    assert!(lines[0].starts_with("error: "), "{stderr}");
+    assert!(
+        lines[0].to_lowercase().contains(expect),
+        "{}: '{}' should mention '{expect}'",
+        file.display(),
+        lines[0]
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!out_png.exists(), "no image may be written on error");
+}
+
+#[test]
+fn missing_file() {
+    let d = tmp("missing");
+    assert_one_line_error(&d.join("nope.gltf"), "cannot read");
+}
+
+#[test]
+fn empty_file() {
+    let d = tmp("empty");
+    let p = d.join("empty.gltf");
+    std::fs::write(&p, b"").unwrap();
+    assert_one_line_error(&p, "empty");
+}
+
+#[test]
+fn invalid_json() {
+    let d = tmp("json");
+    let p = d.join("bad.gltf");
+    std::fs::write(&p, b"{ \"asset\": { \"version\": \"2.0\" }, nope").unwrap();
+    assert_one_line_error(&p, "not a valid gltf");
+}
+
+#[test]
+fn truncated_glb() {
+    let d = tmp("truncated");
+    let bin = triangle_bytes([0, 1, 2]);
+    let full = glb(&triangle_json(json!({"byteLength": bin.len()}), 3), &bin);
+    let p = d.join("cut.glb");
+    std::fs::write(&p, &full[..full.len() - 20]).unwrap();
+    assert_one_line_error(&p, "not a valid gltf");
+    // The untruncated file renders (so the failure above is the truncation's).
+    let ok = d.join("whole.glb");
+    std::fs::write(&ok, &full).unwrap();
+    let (success, stderr) = run(
+        &[
+            "render",
+            ok.to_str().unwrap(),
+            "-o",
+            d.join("whole.png").to_str().unwrap(),
+            "--size",
+            "32x32",
+        ],
+        &d,
+    );
+    assert!(success, "{stderr}");
+}
+
+#[test]
+fn buffer_uri_outside_the_model_folder() {
+    let d = tmp("escape");
+    let model = d.join("model");
+    std::fs::create_dir_all(&model).unwrap();
+    std::fs::write(d.join("secret.bin"), triangle_bytes([0, 1, 2])).unwrap();
+    let p = model.join("escape.gltf");
+    std::fs::write(
+        &p,
+        triangle_json(json!({"uri": "../secret.bin", "byteLength": 44}), 3).to_string(),
+    )
+    .unwrap();
+    assert_one_line_error(&p, "outside the model's folder");
+    let p = model.join("absolute.gltf");
+    let abs = d.join("secret.bin").to_string_lossy().to_string();
+    std::fs::write(
+        &p,
+        triangle_json(json!({"uri": abs, "byteLength": 44}), 3).to_string(),
+    )
+    .unwrap();
+    assert_one_line_error(&p, "outside the model's folder");
+}
+
+#[test]
+fn accessor_reading_past_its_buffer() {
+    let d = tmp("accessor");
+    let p = d.join("long.gltf");
+    let bin = triangle_bytes([0, 1, 2]);
+    std::fs::write(
+        &p,
+        triangle_json(json!({"uri": data_uri(&bin), "byteLength": bin.len()}), 300).to_string(),
+    )
+    .unwrap();
+    assert_one_line_error(&p, "past the end");
+}
+
+#[test]
+fn index_out_of_range() {
+    let d = tmp("index");
+    let p = d.join("index.gltf");
+    let bin = triangle_bytes([0, 1, 99]);
+    std::fs::write(
+        &p,
+        triangle_json(json!({"uri": data_uri(&bin), "byteLength": bin.len()}), 3).to_string(),
+    )
+    .unwrap();
+    assert_one_line_error(&p, "out of range");
+}
+
+#[test]
+fn bad_arguments() {
+    let d = tmp("args");
+    for (args, expect) in [
+        (vec!["render", "--size", "0x0"], "size"),
+        (vec!["render", "--camera", "7"], "camera 7"),
+        (vec!["render", "--eye", "1,2,3"], "--target"),
+        (vec!["render", "--sun-dir", "0,0,0"], "zero"),
+        (vec!["render", "--shadow-map", "3"], "shadow-map"),
+    ] {
+        let (ok, stderr) = run(&args, &d);
+        assert!(!ok, "{args:?} should fail");
+        assert!(stderr.to_lowercase().contains(expect), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
