@@ -14,14 +14,25 @@ for a in "$@"; do
   esac
 done
 
+# True when any of the glob patterns matches a file.
+have_any() {
+  local pattern f
+  for pattern in "$@"; do
+    for f in $pattern; do
+      [ -e "$f" ] && return 0
+    done
+  done
+  return 1
+}
+
 missing=()
 if ! ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'; then
   missing+=(libvulkan1)
 fi
-if ! ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 && [ -z "${VK_ICD_FILENAMES:-}${VK_DRIVER_FILES:-}" ]; then
+if ! have_any '/usr/share/vulkan/icd.d/*.json' '/etc/vulkan/icd.d/*.json' && [ -z "${VK_ICD_FILENAMES:-}${VK_DRIVER_FILES:-}" ]; then
   missing+=(mesa-vulkan-drivers)
 fi
-if [ "$need_validation" = 1 ] && ! ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json /etc/vulkan/explicit_layer.d/VkLayer_khronos_validation.json >/dev/null 2>&1; then
+if [ "$need_validation" = 1 ] && ! have_any '/usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json' '/etc/vulkan/explicit_layer.d/VkLayer_khronos_validation.json'; then
   missing+=(vulkan-validationlayers)
 fi
 if [ "$need_xvfb" = 1 ] && ! command -v Xvfb >/dev/null 2>&1; then

@@ -18,5 +18,6 @@
 pub mod app;
 pub mod gpu;
 pub mod math;
+pub mod reference;
 pub mod render;
 pub mod scene;

@@ -2,7 +2,7 @@
 
 use anyhow::Context as _;
 use clap::Parser;
-use umbra::app::cli::{load_scene, make_view, Cli, Command, RenderArgs};
+use umbra::app::cli::{load_scene, make_view, Cli, Command, CompareArgs, RenderArgs};
 use umbra::gpu::{Context, ContextDesc, Validation};
 use umbra::render::Renderer;
 
@@ -13,6 +13,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(a) => render(a),
+        Command::Compare(a) => compare(a),
     };
     if let Err(e) = result {
         let msg = format!("{e:#}").replace('\n', " ");
@@ -79,5 +80,56 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
             ctx.validation_log.problem_count()
         );
     }
+    Ok(())
+}
+
+fn compare(a: CompareArgs) -> anyhow::Result<()> {
+    use umbra::reference::{compare as compare_frames, ReferenceScene};
+    use umbra::render::ViewMode;
+    let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
+    let mut view = make_view(&scene, &a.view)?;
+    let ctx = Context::new(&ContextDesc {
+        device: a.device.clone(),
+        ..Default::default()
+    })?;
+    let mut renderer = Renderer::new(&ctx, &scene)?;
+    renderer.set_read_depth(true);
+    let (w, h) = a.view.size;
+    view.mode = ViewMode::Lit;
+    let lit = renderer.render(&view, w, h)?;
+    view.mode = ViewMode::Shadow;
+    let shadow = renderer.render(&view, w, h)?;
+    let t0 = std::time::Instant::now();
+    let reference = ReferenceScene::new(&scene);
+    let build_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let frame = reference.render(&lit.plan, w, h, view.ambient);
+    let reference_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let depth = lit
+        .depth
+        .as_deref()
+        .ok_or_else(|| anyhow::anyhow!("no depth read back"))?;
+    let (metrics, diff) = compare_frames(&lit.image, &shadow.image, depth, &lit.plan, &frame);
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    for (name, img) in [
+        ("gpu.png", &lit.image),
+        ("reference.png", &frame.image),
+        ("diff.png", &diff),
+    ] {
+        let p = a.out.join(name);
+        img.save(&p)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    let mut j = metrics.to_json();
+    j["scene"] = serde_json::json!(scene.name);
+    j["size"] = serde_json::json!([w, h]);
+    j["shadow_map"] = serde_json::json!(view.shadow.map_size);
+    j["bvh_build_ms"] = serde_json::json!(build_ms);
+    j["reference_ms"] = serde_json::json!(reference_ms);
+    j["gpu_ms"] = serde_json::json!(lit
+        .stats
+        .gpu_shadow_ms
+        .zip(lit.stats.gpu_camera_ms)
+        .map(|(s, c)| s + c));
+    println!("{j}");
     Ok(())
 }

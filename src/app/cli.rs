@@ -21,6 +21,25 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene (the built-in demo without SCENE) to a PNG.
     Render(RenderArgs),
+    /// Render on the GPU and by CPU ray casting, print shadow and image error as one JSON line,
+    /// and write gpu.png, reference.png and diff.png (false shadow red, false light blue).
+    Compare(CompareArgs),
+}
+
+/// `umbra compare`.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// glTF 2.0 file; the built-in demo scene when omitted.
+    pub scene: Option<PathBuf>,
+    /// Folder for gpu.png, reference.png and diff.png.
+    #[arg(long, default_value = ".")]
+    pub out: PathBuf,
+    /// View and shadow options (as for render).
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
+    #[arg(long)]
+    pub device: Option<String>,
 }
 
 /// `umbra render`.

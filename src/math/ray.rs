@@ -53,10 +53,32 @@ pub fn ray_triangle(
 ) -> Option<TriangleHit> {
     let e1 = b - a;
     let e2 = c - a;
+    ray_triangle_edges(
+        ray,
+        a,
+        e1,
+        e2,
+        e1.cross(e2).length() * ray.dir.length(),
+        t_min,
+        t_max,
+    )
+}
+
+/// Möller–Trumbore with precomputed edges e1 = b − a, e2 = c − a and `scale` = |e1 × e2|·|dir|
+/// (the largest |det| can be); |det| ≤ 1e-7·scale counts as parallel (a miss), as does scale 0.
+#[inline]
+pub fn ray_triangle_edges(
+    ray: &Ray,
+    a: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    scale: f32,
+    t_min: f32,
+    t_max: f32,
+) -> Option<TriangleHit> {
     let p = ray.dir.cross(e2);
     let det = e1.dot(p);
-    let scale = e1.length() * e2.length() * ray.dir.length();
-    if det.abs() <= 1e-9 * scale || scale == 0.0 {
+    if det.abs() <= 1e-7 * scale || scale == 0.0 {
         return None;
     }
     let inv = 1.0 / det;

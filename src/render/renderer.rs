@@ -16,6 +16,8 @@ use std::time::Instant;
 
 /// Colour format of offscreen frames (sRGB-encoded on write).
 pub const OFFSCREEN_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
+/// Linear colour where nothing is drawn (the reference uses it too).
+pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
 /// Largest offscreen side.
 pub const MAX_SIDE: u32 = 16384;
 
@@ -46,12 +48,16 @@ pub struct RenderedFrame {
     pub stats: FrameStats,
     /// The CPU-side plan it was rendered with.
     pub plan: FramePlan,
+    /// The camera depth buffer (reversed-z, 0 = nothing drawn), row-major, when requested with
+    /// `Renderer::set_read_depth`.
+    pub depth: Option<Vec<f32>>,
 }
 
 struct Target {
     color: Image,
     depth: Image,
     readback: Buffer,
+    depth_readback: Buffer,
     color_state: Access,
     depth_state: Access,
 }
@@ -67,6 +73,7 @@ pub struct Renderer {
     shadow_readback: Option<Buffer>,
     query_pool: vk::QueryPool,
     cmd: vk::CommandBuffer,
+    read_depth: bool,
 }
 
 impl Renderer {
@@ -95,6 +102,7 @@ impl Renderer {
             shadow_readback: None,
             query_pool,
             cmd,
+            read_depth: false,
         })
     }
 
@@ -106,6 +114,11 @@ impl Renderer {
     /// The scene (CPU copy).
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// Also read back the camera depth buffer (into `RenderedFrame::depth`).
+    pub fn set_read_depth(&mut self, on: bool) {
+        self.read_depth = on;
     }
 
     /// Triangles per frame.
@@ -139,7 +152,7 @@ impl Renderer {
             DEPTH_FORMAT,
             extent,
             1,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
         )?;
         let readback = Buffer::new(
             &self.ctx,
@@ -148,10 +161,18 @@ impl Renderer {
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
+        let depth_readback = Buffer::new(
+            &self.ctx,
+            "depth readback",
+            w as u64 * h as u64 * 4,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
         self.target = Some(Target {
             color,
             depth,
             readback,
+            depth_readback,
             color_state: Access::Undefined,
             depth_state: Access::Undefined,
         });
@@ -278,7 +299,7 @@ impl Renderer {
                 t.color.view,
                 t.depth.view,
                 t.color.extent,
-                [0.02, 0.02, 0.025, 1.0],
+                CLEAR_COLOR,
             );
             if timestamps {
                 d.cmd_write_timestamp2(
@@ -319,6 +340,37 @@ impl Renderer {
                 t.readback.raw,
                 &region,
             );
+            if self.read_depth {
+                image_barrier(
+                    d,
+                    cmd,
+                    t.depth.raw,
+                    vk::ImageAspectFlags::DEPTH,
+                    0..1,
+                    Access::DepthAttachment,
+                    Access::TransferSrc,
+                );
+                t.depth_state = Access::TransferSrc;
+                let region = [vk::BufferImageCopy::default()
+                    .image_subresource(vk::ImageSubresourceLayers {
+                        aspect_mask: vk::ImageAspectFlags::DEPTH,
+                        mip_level: 0,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    })
+                    .image_extent(vk::Extent3D {
+                        width,
+                        height,
+                        depth: 1,
+                    })];
+                d.cmd_copy_image_to_buffer(
+                    cmd,
+                    t.depth.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    t.depth_readback.raw,
+                    &region,
+                );
+            }
             if want_map {
                 let map = self.shadow.map.as_ref().expect("map");
                 image_barrier(
@@ -416,8 +468,23 @@ impl Renderer {
             }
             image::RgbaImage::from_raw(width, height, rgba).expect("size")
         };
+        let depth = if self.read_depth {
+            let t = self.target.as_mut().expect("target");
+            let bytes = t
+                .depth_readback
+                .mapped()
+                .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
+            Some(bytemuck::cast_slice::<u8, f32>(&bytes[..(width * height * 4) as usize]).to_vec())
+        } else {
+            None
+        };
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        Ok(RenderedFrame { image, stats, plan })
+        Ok(RenderedFrame {
+            image,
+            stats,
+            plan,
+            depth,
+        })
     }
 }
 

@@ -1,0 +1,347 @@
+//! Exact shadow visibility and a Blinn-Phong reference image by ray casting, for the same view
+//! (same pixel centres, lights and material constants) as a GPU frame.
+
+use super::bvh::{Bvh, Hit};
+use crate::math::ray::Ray;
+use crate::render::frame::FramePlan;
+use crate::scene::{blinn_phong_params, shade_blinn_phong, LightKind, Scene, Texture};
+use glam::{Mat3, Vec2, Vec3, Vec4};
+use rayon::prelude::*;
+
+/// Where a world triangle came from.
+#[derive(Clone, Copy, Debug)]
+struct TriRef {
+    instance: u32,
+    mesh: u32,
+    primitive: u32,
+    /// Index of the triangle's first index in the primitive.
+    first: u32,
+}
+
+/// A scene prepared for ray casting: world-space triangles in a BVH, plus what shading needs.
+pub struct ReferenceScene<'a> {
+    scene: &'a Scene,
+    /// The hierarchy.
+    pub bvh: Bvh,
+    refs: Vec<TriRef>,
+    normal_mats: Vec<Mat3>,
+    linear: Vec<Vec<Vec4>>,
+    srgb_lut: [f32; 256],
+    eps: f32,
+}
+
+/// The reference result for one view.
+pub struct ReferenceFrame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Per pixel: None when no surface is hit; else exact visibility of the shadowed light
+    /// (facing and unoccluded → true).
+    pub visibility: Vec<Option<bool>>,
+    /// Per pixel: distance along the primary ray (∞ for none).
+    pub distance: Vec<f32>,
+    /// The reference image (sRGB), exact hard shadows.
+    pub image: image::RgbaImage,
+}
+
+fn srgb_decode(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn srgb_encode(c: f32) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let s = if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}
+
+impl<'a> ReferenceScene<'a> {
+    /// Collects world-space triangles of every instance and builds the BVH.
+    pub fn new(scene: &'a Scene) -> Self {
+        let mut tris = Vec::new();
+        let mut refs = Vec::new();
+        let mut normal_mats = Vec::new();
+        for (ii, inst) in scene.instances.iter().enumerate() {
+            let m3 = Mat3::from_mat4(inst.world_from_model);
+            normal_mats.push(if m3.determinant().abs() > 1e-30 {
+                m3.inverse().transpose()
+            } else {
+                m3
+            });
+            for (pi, p) in scene.meshes[inst.mesh].primitives.iter().enumerate() {
+                let world: Vec<Vec3> = p
+                    .positions
+                    .iter()
+                    .map(|v| inst.world_from_model.transform_point3(*v))
+                    .collect();
+                for (k, t) in p.indices.chunks_exact(3).enumerate() {
+                    tris.push([
+                        world[t[0] as usize],
+                        world[t[1] as usize],
+                        world[t[2] as usize],
+                    ]);
+                    refs.push(TriRef {
+                        instance: ii as u32,
+                        mesh: inst.mesh as u32,
+                        primitive: pi as u32,
+                        first: (k * 3) as u32,
+                    });
+                }
+            }
+        }
+        let bvh = Bvh::build(&tris);
+        let mut srgb_lut = [0.0; 256];
+        for (i, v) in srgb_lut.iter_mut().enumerate() {
+            *v = srgb_decode(i as f32 / 255.0);
+        }
+        let linear = Vec::new();
+        let eps = (scene.bounds().diagonal() * 2e-5).max(1e-6);
+        Self {
+            scene,
+            bvh,
+            refs,
+            normal_mats,
+            linear,
+            srgb_lut,
+            eps,
+        }
+    }
+
+    fn texel(&self, t: &Texture, x: i64, y: i64, srgb: bool) -> Vec4 {
+        let (w, h) = (t.width as i64, t.height as i64);
+        let (x, y) = (x.rem_euclid(w), y.rem_euclid(h));
+        let i = ((y * w + x) * 4) as usize;
+        let px = &t.rgba[i..i + 4];
+        if srgb {
+            Vec4::new(
+                self.srgb_lut[px[0] as usize],
+                self.srgb_lut[px[1] as usize],
+                self.srgb_lut[px[2] as usize],
+                px[3] as f32 / 255.0,
+            )
+        } else {
+            Vec4::new(px[0] as f32, px[1] as f32, px[2] as f32, px[3] as f32) / 255.0
+        }
+    }
+
+    /// Bilinear sample of mip 0 with repeat wrapping (decoded from sRGB when `srgb`).
+    fn sample(&self, tex: Option<usize>, uv: Vec2, srgb: bool, default: Vec4) -> Vec4 {
+        let Some(t) = tex.and_then(|i| self.scene.textures.get(i)) else {
+            return default;
+        };
+        let _ = &self.linear;
+        let x = uv.x * t.width as f32 - 0.5;
+        let y = uv.y * t.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let a = self
+            .texel(t, x0, y0, srgb)
+            .lerp(self.texel(t, x0 + 1, y0, srgb), fx);
+        let b = self
+            .texel(t, x0, y0 + 1, srgb)
+            .lerp(self.texel(t, x0 + 1, y0 + 1, srgb), fx);
+        a.lerp(b, fy)
+    }
+
+    /// Exact visibility of world point `p` (geometric normal `ng`, facing normal `n`) from light `i`.
+    fn visible(
+        &self,
+        plan: &FramePlan,
+        i: usize,
+        p: Vec3,
+        ng: Vec3,
+        n_facing: Vec3,
+    ) -> (bool, Vec3, Vec3) {
+        let l = &plan.lights[i];
+        let (dir, dist, radiance) = match l.kind {
+            LightKind::Directional => (
+                -l.direction.normalize_or(Vec3::NEG_Y),
+                f32::INFINITY,
+                l.color * l.intensity,
+            ),
+            _ => {
+                let d = l.position - p;
+                let r2 = d.length_squared().max(1e-8);
+                let dir = d / r2.sqrt();
+                let mut rad = l.color * l.intensity / r2;
+                if let LightKind::Spot { inner, outer } = l.kind {
+                    let cd = (-dir).dot(l.direction.normalize_or(Vec3::NEG_Y));
+                    let (lo, hi) = (outer.cos(), inner.cos());
+                    let t = ((cd - lo) / (hi - lo)).clamp(0.0, 1.0);
+                    rad *= t * t * (3.0 - 2.0 * t);
+                }
+                (dir, r2.sqrt(), rad)
+            }
+        };
+        let facing = n_facing.dot(dir) > 0.0;
+        if !facing {
+            return (false, dir, radiance);
+        }
+        if plan.shadow_light != Some(i) || plan.uniform.shadow.w < 0.5 {
+            return (true, dir, radiance);
+        }
+        // Start the shadow ray off the surface, on the light's side of the true face.
+        let side = if ng.dot(dir) >= 0.0 { ng } else { -ng };
+        let origin = p + side * self.eps;
+        let occluded = self
+            .bvh
+            .occluded(&Ray::new(origin, dir), self.eps, dist - self.eps);
+        (!occluded, dir, radiance)
+    }
+
+    /// Casts one primary ray per pixel centre of `plan`'s camera and shades the hits.
+    pub fn render(
+        &self,
+        plan: &FramePlan,
+        width: u32,
+        height: u32,
+        ambient: Vec3,
+    ) -> ReferenceFrame {
+        let inv = plan.clip_from_world.inverse();
+        let eye = plan.uniform.camera_position.truncate();
+        let n = (width * height) as usize;
+        let c = crate::render::renderer::CLEAR_COLOR;
+        let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];
+        let results: Vec<(Option<bool>, f32, [u8; 4])> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let (x, y) = (
+                    (i as u32 % width) as f32 + 0.5,
+                    (i as u32 / width) as f32 + 0.5,
+                );
+                let nx = x / width as f32 * 2.0 - 1.0;
+                let ny = 1.0 - y / height as f32 * 2.0;
+                let far = inv * Vec4::new(nx, ny, 1e-3, 1.0);
+                let dir = (far.truncate() / far.w - eye).normalize_or(Vec3::NEG_Z);
+                let ray = Ray::new(eye, dir);
+                match self.bvh.intersect(&ray, 0.0, f32::INFINITY) {
+                    None => (None, f32::INFINITY, background),
+                    Some(h) => {
+                        let (vis, rgb) = self.shade(plan, &ray, &h, ambient);
+                        (
+                            Some(vis),
+                            h.t,
+                            [
+                                srgb_encode(rgb.x),
+                                srgb_encode(rgb.y),
+                                srgb_encode(rgb.z),
+                                255,
+                            ],
+                        )
+                    }
+                }
+            })
+            .collect();
+        let mut image = image::RgbaImage::new(width, height);
+        for (i, r) in results.iter().enumerate() {
+            image.put_pixel(i as u32 % width, i as u32 / width, image::Rgba(r.2));
+        }
+        ReferenceFrame {
+            width,
+            height,
+            visibility: results.iter().map(|r| r.0).collect(),
+            distance: results.iter().map(|r| r.1).collect(),
+            image,
+        }
+    }
+
+    fn shade(&self, plan: &FramePlan, ray: &Ray, h: &Hit, ambient: Vec3) -> (bool, Vec3) {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let inst = &self.scene.instances[r.instance as usize];
+        let idx = [
+            prim.indices[r.first as usize] as usize,
+            prim.indices[r.first as usize + 1] as usize,
+            prim.indices[r.first as usize + 2] as usize,
+        ];
+        let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
+        let lerp3 = |a: &[Vec3]| a[idx[0]] * w.x + a[idx[1]] * w.y + a[idx[2]] * w.z;
+        let p = ray.at(h.t);
+        let nm = self.normal_mats[r.instance as usize];
+        let m3 = Mat3::from_mat4(inst.world_from_model);
+        let pw: Vec<Vec3> = idx
+            .iter()
+            .map(|&i| inst.world_from_model.transform_point3(prim.positions[i]))
+            .collect();
+        let mut ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
+        let mut n_geo = (nm * lerp3(&prim.normals)).normalize_or(ng);
+        let uv = prim.uvs[idx[0]] * w.x + prim.uvs[idx[1]] * w.y + prim.uvs[idx[2]] * w.z;
+        let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];
+        let base = mat.base_color
+            * self.sample(
+                mat.base_color_texture.map(|t| t.texture),
+                uv,
+                true,
+                Vec4::ONE,
+            );
+        let mut n = n_geo;
+        if mat.normal_texture.is_some() && !prim.tangents.is_empty() {
+            let t4 = prim.tangents[idx[0]] * w.x
+                + prim.tangents[idx[1]] * w.y
+                + prim.tangents[idx[2]] * w.z;
+            let det_sign = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
+            let t = m3 * t4.truncate();
+            let t = t - n_geo * n_geo.dot(t);
+            if t.length_squared() > 1e-12 {
+                let t = t.normalize();
+                let sign = if prim.tangents[idx[0]].w * det_sign >= 0.0 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                let b = n_geo.cross(t) * sign;
+                let s = self.sample(
+                    mat.normal_texture.map(|t| t.texture),
+                    uv,
+                    false,
+                    Vec4::new(0.5, 0.5, 1.0, 1.0),
+                );
+                let tn = s.truncate() * 2.0 - Vec3::ONE;
+                let tn = Vec3::new(tn.x * mat.normal_scale, tn.y * mat.normal_scale, tn.z);
+                n = (t * tn.x + b * tn.y + n_geo * tn.z).normalize_or(n_geo);
+            }
+        }
+        // Back faces (seen only on double-sided materials on the GPU) flip like the shader does.
+        if ng.dot(ray.dir) > 0.0 && n_geo.dot(ray.dir) > 0.0 {
+            n_geo = -n_geo;
+            n = -n;
+            ng = -ng;
+        } else if ng.dot(ray.dir) > 0.0 {
+            ng = -ng;
+        }
+        let mr = self.sample(
+            mat.metallic_roughness_texture.map(|t| t.texture),
+            uv,
+            false,
+            Vec4::ONE,
+        );
+        let bp = blinn_phong_params(base.truncate(), mat.metallic * mr.z, mat.roughness * mr.y);
+        let emissive = mat.emissive
+            * self
+                .sample(mat.emissive_texture.map(|t| t.texture), uv, true, Vec4::ONE)
+                .truncate();
+        let v = -ray.dir;
+        let mut color = bp.ka * ambient + emissive;
+        let mut shadow_vis = true;
+        for i in 0..plan.lights.len() {
+            let (vis, l, radiance) = self.visible(plan, i, p, ng, n_geo);
+            if plan.shadow_light == Some(i) {
+                shadow_vis = vis;
+            }
+            color += shade_blinn_phong(&bp, n, l, v, radiance, if vis { 1.0 } else { 0.0 });
+        }
+        if mat.unlit {
+            color = base.truncate();
+        }
+        (shadow_vis, color)
+    }
+}
