@@ -282,3 +282,28 @@ fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0)
         }
     }
 }
+
+// Full-screen triangle for the shadow-map debug view.
+struct FullscreenOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+}
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) index: u32) -> FullscreenOut {
+    var out: FullscreenOut;
+    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
+    // uv (0,0) is the top-left of the image (clip y = +1 is the top).
+    out.clip = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 0.0, 1.0);
+    out.uv = uv;
+    return out;
+}
+
+// The shadow map itself: grey = stored depth (reversed-z: white is nearest the light), row 0 on top.
+@fragment
+fn fs_shadow_map(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let size = i32(frame.shadow.x);
+    let c = clamp(vec2<i32>(in.uv * f32(size)), vec2<i32>(0), vec2<i32>(size - 1));
+    let d = textureLoad(shadow_map, c, 0);
+    return vec4<f32>(srgb_to_linear(vec3<f32>(d)), 1.0);
+}

@@ -209,7 +209,7 @@ impl<'a> ReferenceScene<'a> {
         let inv = plan.clip_from_world.inverse();
         let eye = plan.uniform.camera_position.truncate();
         let n = (width * height) as usize;
-        let c = crate::render::renderer::CLEAR_COLOR;
+        let c = crate::render::core::CLEAR_COLOR;
         let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];
         let results: Vec<(Option<bool>, f32, [u8; 4])> = (0..n)
             .into_par_iter()

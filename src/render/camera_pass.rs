@@ -1,4 +1,5 @@
-//! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl).
+//! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
+//! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
 use super::gpu_scene::{GpuScene, VertexAttributes};
 use super::pipeline::{create_layout, create_pipeline, set_viewport, PipelineDesc};
@@ -13,6 +14,12 @@ use std::sync::Arc;
 /// Depth format of the camera pass.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
+struct Slot {
+    buffer: Buffer,
+    set: vk::DescriptorSet,
+    bound_map: vk::ImageView,
+}
+
 /// The camera pass for one colour format.
 pub struct CameraPass {
     ctx: Arc<Context>,
@@ -20,30 +27,26 @@ pub struct CameraPass {
     frame_layout: vk::DescriptorSetLayout,
     module: vk::ShaderModule,
     pipeline: vk::Pipeline,
+    map_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
-    frame_set: vk::DescriptorSet,
-    frame_buffer: Buffer,
+    slots: Vec<Slot>,
     linear_sampler: vk::Sampler,
     nearest_sampler: vk::Sampler,
-    bound_map: vk::ImageView,
 }
 
-impl CameraPass {
-    /// Creates the pass for `color_format` with the scene's material set layout.
-    pub fn new(
-        ctx: &Arc<Context>,
-        scene: &GpuScene,
-        color_format: vk::Format,
-    ) -> Result<Self, GpuError> {
-        let frame_layout = set_layout(ctx, sh::BINDINGS, 0, "frame set layout")?;
-        let layout = create_layout(
-            ctx,
-            &[frame_layout, scene.material_layout],
-            sh::IMMEDIATE_SIZE,
-            "camera pipeline layout",
-        )?;
-        let module = create_module(ctx, sh::SPIRV, "scene.wgsl")?;
-        let bindings = [
+/// Vertex streams of the camera pass: positions (binding 0), attributes (binding 1).
+fn vertex_layout() -> (
+    [vk::VertexInputBindingDescription; 2],
+    [vk::VertexInputAttributeDescription; 4],
+) {
+    let f = |location, binding, format, offset| vk::VertexInputAttributeDescription {
+        location,
+        binding,
+        format,
+        offset,
+    };
+    (
+        [
             vk::VertexInputBindingDescription {
                 binding: 0,
                 stride: 12,
@@ -54,87 +57,102 @@ impl CameraPass {
                 stride: std::mem::size_of::<VertexAttributes>() as u32,
                 input_rate: vk::VertexInputRate::VERTEX,
             },
-        ];
-        let attributes = [
-            vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 1,
-                binding: 1,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 2,
-                binding: 1,
-                format: vk::Format::R32G32_SFLOAT,
-                offset: 12,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 3,
-                binding: 1,
-                format: vk::Format::R32G32B32A32_SFLOAT,
-                offset: 20,
-            },
-        ];
-        let pipeline = create_pipeline(
+        ],
+        [
+            f(0, 0, vk::Format::R32G32B32_SFLOAT, 0),
+            f(1, 1, vk::Format::R32G32B32_SFLOAT, 0),
+            f(2, 1, vk::Format::R32G32_SFLOAT, 12),
+            f(3, 1, vk::Format::R32G32B32A32_SFLOAT, 20),
+        ],
+    )
+}
+
+impl CameraPass {
+    /// Creates the pass for `color_format`, with `slots` frame-uniform slots (frames in flight).
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &GpuScene,
+        color_format: vk::Format,
+        slots: usize,
+    ) -> Result<Self, GpuError> {
+        let frame_layout = set_layout(ctx, sh::BINDINGS, 0, "frame set layout")?;
+        let layout = create_layout(
             ctx,
-            &PipelineDesc {
-                name: "camera pipeline",
-                layout,
-                vertex: (module, sh::ENTRY_VS_MAIN),
-                fragment: Some((module, sh::ENTRY_FS_MAIN)),
-                bindings: &bindings,
-                attributes: &attributes,
-                color_format: Some(color_format),
-                depth_format: DEPTH_FORMAT,
-                depth_clamp: false,
-                depth_bias: false,
-            },
+            &[frame_layout, scene.material_layout],
+            sh::IMMEDIATE_SIZE,
+            "camera pipeline layout",
         )?;
+        let module = create_module(ctx, sh::SPIRV, "scene.wgsl")?;
+        let (bindings, attributes) = vertex_layout();
+        let mut desc = PipelineDesc {
+            name: "camera pipeline",
+            layout,
+            vertex: (module, sh::ENTRY_VS_MAIN),
+            fragment: Some((module, sh::ENTRY_FS_MAIN)),
+            bindings: &bindings,
+            attributes: &attributes,
+            color_format: Some(color_format),
+            depth_format: DEPTH_FORMAT,
+            depth_clamp: false,
+            depth_bias: false,
+            depth_test: true,
+        };
+        let pipeline = create_pipeline(ctx, &desc)?;
+        desc.name = "shadow-map view pipeline";
+        desc.vertex = (module, sh::ENTRY_VS_FULLSCREEN);
+        desc.fragment = Some((module, sh::ENTRY_FS_SHADOW_MAP));
+        desc.bindings = &[];
+        desc.attributes = &[];
+        desc.depth_test = false;
+        let map_pipeline = create_pipeline(ctx, &desc)?;
+        let n = slots.max(1) as u32;
         let sizes = [
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::UNIFORM_BUFFER,
-                descriptor_count: 1,
+                descriptor_count: n,
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::SAMPLED_IMAGE,
-                descriptor_count: 1,
+                descriptor_count: n,
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::SAMPLER,
-                descriptor_count: 1,
+                descriptor_count: n,
             },
         ];
         let pool = unsafe {
             ctx.device.create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(1)
+                    .max_sets(n)
                     .pool_sizes(&sizes),
                 None,
             )
         }
         .vk("vkCreateDescriptorPool")?;
-        let layouts = [frame_layout];
-        let frame_set = unsafe {
+        let layouts = vec![frame_layout; n as usize];
+        let sets = unsafe {
             ctx.device.allocate_descriptor_sets(
                 &vk::DescriptorSetAllocateInfo::default()
                     .descriptor_pool(pool)
                     .set_layouts(&layouts),
             )
         }
-        .vk("vkAllocateDescriptorSets")?[0];
-        let frame_buffer = Buffer::new(
-            ctx,
-            "frame uniforms",
-            std::mem::size_of::<FrameUniform>() as u64,
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-            MemoryLocation::CpuToGpu,
-        )?;
+        .vk("vkAllocateDescriptorSets")?;
+        let mut slot_list = Vec::new();
+        for (i, set) in sets.into_iter().enumerate() {
+            let buffer = Buffer::new(
+                ctx,
+                &format!("frame uniforms {i}"),
+                std::mem::size_of::<FrameUniform>() as u64,
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?;
+            slot_list.push(Slot {
+                buffer,
+                set,
+                bound_map: vk::ImageView::null(),
+            });
+        }
         // Comparison samplers: reversed-z, so "lit" is reference >= stored.
         let mk = |filter| {
             let info = vk::SamplerCreateInfo::default()
@@ -159,26 +177,23 @@ impl CameraPass {
             frame_layout,
             module,
             pipeline,
+            map_pipeline,
             pool,
-            frame_set,
-            frame_buffer,
+            slots: slot_list,
             linear_sampler,
             nearest_sampler,
-            bound_map: vk::ImageView::null(),
         })
     }
 
-    /// Points the frame set at the shadow map (call when the map is recreated). Every binding is
-    /// written (lavapipe crashes on unwritten descriptors, used or not).
-    pub fn bind_shadow_map(&mut self, view: vk::ImageView, hardware_filtering: bool) {
-        if view == self.bound_map {
+    /// Points slot `slot`'s set at the shadow map. Every binding is written (lavapipe crashes on
+    /// unwritten descriptors, used or not). The slot's previous frame must have completed.
+    pub fn bind_shadow_map(&mut self, slot: usize, view: vk::ImageView, hardware_filtering: bool) {
+        let s = &mut self.slots[slot];
+        if view == s.bound_map {
             return;
         }
-        unsafe {
-            let _ = self.ctx.device.device_wait_idle();
-        }
         let buf = [vk::DescriptorBufferInfo {
-            buffer: self.frame_buffer.raw,
+            buffer: s.buffer.raw,
             offset: 0,
             range: vk::WHOLE_SIZE,
         }];
@@ -197,7 +212,7 @@ impl CameraPass {
             image_view: vk::ImageView::null(),
             image_layout: vk::ImageLayout::UNDEFINED,
         }];
-        let set = self.frame_set;
+        let set = s.set;
         let w = |b: &ReflectedBinding| {
             vk::WriteDescriptorSet::default()
                 .dst_set(set)
@@ -210,23 +225,27 @@ impl CameraPass {
             w(&sh::SHADOW_SAMPLER).image_info(&samp),
         ];
         unsafe { self.ctx.device.update_descriptor_sets(&writes, &[]) };
-        self.bound_map = view;
+        s.bound_map = view;
     }
 
-    /// Writes the frame uniforms (the previous frame using them must have completed).
-    pub fn write_frame(&mut self, u: &FrameUniform) -> Result<(), GpuError> {
-        self.frame_buffer.write(0, bytemuck::bytes_of(u))
+    /// Writes slot `slot`'s frame uniforms (its previous frame must have completed).
+    pub fn write_frame(&mut self, slot: usize, u: &FrameUniform) -> Result<(), GpuError> {
+        self.slots[slot].buffer.write(0, bytemuck::bytes_of(u))
     }
 
-    /// Records the pass into colour and depth attachments already in attachment layouts.
+    /// Records the pass into colour and depth attachments already in attachment layouts; with
+    /// `shadow_map_view` it draws the shadow map full-screen instead of the scene.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         cmd: vk::CommandBuffer,
+        slot: usize,
         scene: &GpuScene,
         color: vk::ImageView,
         depth: vk::ImageView,
         extent: vk::Extent2D,
         clear: [f32; 4],
+        shadow_map_view: bool,
     ) {
         let d = &self.ctx.device;
         self.ctx.begin_label(cmd, "camera pass");
@@ -257,11 +276,24 @@ impl CameraPass {
             .layer_count(1)
             .color_attachments(&color_att)
             .depth_attachment(&depth_att);
+        let frame_set = self.slots[slot].set;
         unsafe {
             d.cmd_begin_rendering(cmd, &rendering);
-            if !scene.draws.is_empty() {
+            set_viewport(&self.ctx, cmd, extent);
+            if shadow_map_view {
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.map_pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.layout,
+                    0,
+                    &[frame_set],
+                    &[],
+                );
+                d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
+                d.cmd_draw(cmd, 3, 1, 0, 0);
+            } else if !scene.draws.is_empty() {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-                set_viewport(&self.ctx, cmd, extent);
                 d.cmd_bind_vertex_buffers(
                     cmd,
                     0,
@@ -274,7 +306,7 @@ impl CameraPass {
                     vk::PipelineBindPoint::GRAPHICS,
                     self.layout,
                     0,
-                    &[self.frame_set],
+                    &[frame_set],
                     &[],
                 );
                 let mut bound_material = usize::MAX;
@@ -321,6 +353,7 @@ impl Drop for CameraPass {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
             d.destroy_pipeline(self.pipeline, None);
+            d.destroy_pipeline(self.map_pipeline, None);
             d.destroy_shader_module(self.module, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_pool(self.pool, None);

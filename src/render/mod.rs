@@ -1,6 +1,7 @@
 //! Rendering: one module per pass, the per-frame plan, and the offscreen renderer.
 
 pub mod camera_pass;
+pub mod core;
 pub mod frame;
 pub mod gpu_scene;
 pub mod pipeline;

@@ -26,6 +26,8 @@ pub struct PipelineDesc<'a> {
     pub depth_clamp: bool,
     /// Enable (dynamic) depth bias.
     pub depth_bias: bool,
+    /// Depth test and write (off for full-screen passes).
+    pub depth_test: bool,
 }
 
 /// Creates a graphics pipeline: triangle lists, reversed-z depth test (GREATER, writes on),
@@ -61,8 +63,8 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
     let multisample = vk::PipelineMultisampleStateCreateInfo::default()
         .rasterization_samples(vk::SampleCountFlags::TYPE_1);
     let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(true)
-        .depth_write_enable(true)
+        .depth_test_enable(d.depth_test)
+        .depth_write_enable(d.depth_test)
         .depth_compare_op(vk::CompareOp::GREATER);
     let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
         .color_write_mask(vk::ColorComponentFlags::RGBA)];

@@ -1,10 +1,9 @@
-//! The offscreen renderer: shadow pass + camera pass into an image, read back to RGBA8.
+//! The offscreen renderer: the shared frame core into an image, read back to RGBA8.
 
-use super::camera_pass::{CameraPass, DEPTH_FORMAT};
-use super::frame::{plan_frame, FramePlan};
-use super::gpu_scene::GpuScene;
-use super::settings::{ShadowFormat, View, ViewMode};
-use super::shadow_pass::ShadowPass;
+use super::camera_pass::DEPTH_FORMAT;
+use super::core::{Attachment, FrameCore};
+use super::frame::FramePlan;
+use super::settings::View;
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
@@ -14,10 +13,10 @@ use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 use std::time::Instant;
 
+pub use super::core::CLEAR_COLOR;
+
 /// Colour format of offscreen frames (sRGB-encoded on write).
 pub const OFFSCREEN_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
-/// Linear colour where nothing is drawn (the reference uses it too).
-pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
 /// Largest offscreen side.
 pub const MAX_SIDE: u32 = 16384;
 
@@ -42,7 +41,7 @@ pub struct FrameStats {
 
 /// A rendered frame.
 pub struct RenderedFrame {
-    /// The pixels (the shadow map as grey for `ViewMode::ShadowMap`).
+    /// The pixels.
     pub image: image::RgbaImage,
     /// Timings and counts.
     pub stats: FrameStats,
@@ -56,51 +55,83 @@ pub struct RenderedFrame {
 struct Target {
     color: Image,
     depth: Image,
-    readback: Buffer,
-    depth_readback: Buffer,
     color_state: Access,
     depth_state: Access,
+    readback: Buffer,
+    depth_readback: Buffer,
 }
 
 /// Renders views of one scene offscreen.
 pub struct Renderer {
-    ctx: Arc<Context>,
-    scene: Scene,
-    gpu: GpuScene,
-    shadow: ShadowPass,
-    camera: CameraPass,
+    core: FrameCore,
     target: Option<Target>,
-    shadow_readback: Option<Buffer>,
-    query_pool: vk::QueryPool,
     cmd: vk::CommandBuffer,
     read_depth: bool,
+}
+
+/// Copies a whole single-level image aspect into a tightly packed buffer.
+pub fn copy_to_buffer(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    aspect: vk::ImageAspectFlags,
+    extent: vk::Extent2D,
+    buffer: vk::Buffer,
+) {
+    let region = [vk::BufferImageCopy::default()
+        .buffer_row_length(0)
+        .image_subresource(vk::ImageSubresourceLayers {
+            aspect_mask: aspect,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        })
+        .image_extent(vk::Extent3D {
+            width: extent.width,
+            height: extent.height,
+            depth: 1,
+        })];
+    unsafe {
+        d.cmd_copy_image_to_buffer(
+            cmd,
+            image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            buffer,
+            &region,
+        )
+    };
+}
+
+/// Makes transfer writes visible to the host.
+pub fn transfer_to_host_barrier(d: &ash::Device, cmd: vk::CommandBuffer) {
+    let mb = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    unsafe { d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&mb)) };
+}
+
+/// Tightly packed RGBA8 rows (row pitch = width · 4) from a mapped readback; `bgra` swaps R and B.
+pub fn rgba_from_readback(bytes: &[u8], width: u32, height: u32, bgra: bool) -> image::RgbaImage {
+    let pitch = width as usize * 4;
+    let mut rgba = bytes[..pitch * height as usize].to_vec();
+    if bgra {
+        for p in rgba.chunks_exact_mut(4) {
+            p.swap(0, 2);
+        }
+    }
+    image::RgbaImage::from_raw(width, height, rgba).expect("size matches")
 }
 
 impl Renderer {
     /// Uploads `scene` and creates the passes.
     pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self, GpuError> {
-        let gpu = GpuScene::new(ctx, scene)?;
-        let shadow = ShadowPass::new(ctx)?;
-        let camera = CameraPass::new(ctx, &gpu, OFFSCREEN_FORMAT)?;
-        let query_pool = unsafe {
-            ctx.device.create_query_pool(
-                &vk::QueryPoolCreateInfo::default()
-                    .query_type(vk::QueryType::TIMESTAMP)
-                    .query_count(3),
-                None,
-            )
-        }
-        .vk("vkCreateQueryPool")?;
+        let core = FrameCore::new(ctx, scene, OFFSCREEN_FORMAT, 1)?;
         let cmd = ctx.allocate_command_buffer()?;
         Ok(Self {
-            ctx: ctx.clone(),
-            scene: scene.clone(),
-            gpu,
-            shadow,
-            camera,
+            core,
             target: None,
-            shadow_readback: None,
-            query_pool,
             cmd,
             read_depth: false,
         })
@@ -108,12 +139,12 @@ impl Renderer {
 
     /// The context.
     pub fn context(&self) -> &Arc<Context> {
-        &self.ctx
+        &self.core.ctx
     }
 
     /// The scene (CPU copy).
     pub fn scene(&self) -> &Scene {
-        &self.scene
+        &self.core.scene
     }
 
     /// Also read back the camera depth buffer (into `RenderedFrame::depth`).
@@ -123,7 +154,7 @@ impl Renderer {
 
     /// Triangles per frame.
     pub fn triangles(&self) -> usize {
-        self.gpu.triangles
+        self.core.gpu.triangles
     }
 
     fn ensure_target(&mut self, w: u32, h: u32) -> Result<(), GpuError> {
@@ -134,47 +165,50 @@ impl Renderer {
         {
             return Ok(());
         }
+        let ctx = &self.core.ctx;
         let extent = vk::Extent2D {
             width: w,
             height: h,
         };
+        let usage = vk::ImageUsageFlags::TRANSFER_SRC;
         let color = Image::new(
-            &self.ctx,
+            ctx,
             "offscreen colour",
             OFFSCREEN_FORMAT,
             extent,
             1,
-            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT | usage,
         )?;
         let depth = Image::new(
-            &self.ctx,
+            ctx,
             "offscreen depth",
             DEPTH_FORMAT,
             extent,
             1,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | usage,
         )?;
+        let bytes = w as u64 * h as u64 * 4;
         let readback = Buffer::new(
-            &self.ctx,
+            ctx,
             "offscreen readback",
-            w as u64 * h as u64 * 4,
+            bytes,
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
         let depth_readback = Buffer::new(
-            &self.ctx,
+            ctx,
             "depth readback",
-            w as u64 * h as u64 * 4,
+            bytes,
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
         self.target = Some(Target {
             color,
             depth,
-            readback,
-            depth_readback,
             color_state: Access::Undefined,
             depth_state: Access::Undefined,
+            readback,
+            depth_readback,
         });
         Ok(())
     }
@@ -192,53 +226,23 @@ impl Renderer {
             )));
         }
         let start = Instant::now();
-        let map_size = if view.shadow.enabled {
-            view.shadow.map_size.clamp(16, 16384)
-        } else {
-            1
-        };
-        if self.shadow.ensure_map(map_size, view.shadow.format)? {
-            let hw = self.shadow.hardware_filtering();
-            self.camera.bind_shadow_map(
-                self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default(),
-                hw,
-            );
-        }
-        let hw = self.shadow.hardware_filtering();
+        let plan = self.core.prepare(0, view, width, height)?;
         self.ensure_target(width, height)?;
-        let mut v = view.clone();
-        v.shadow.map_size = map_size;
-        let plan = plan_frame(
-            &self.scene,
-            &self.gpu.bounds,
-            &v,
-            width as f32 / height as f32,
-            hw,
-        );
-        self.camera.write_frame(&plan.uniform)?;
-
-        let ctx = self.ctx.clone();
+        let ctx = self.core.ctx.clone();
         let d = &ctx.device;
         let cmd = self.cmd;
-        let timestamps = ctx.timestamp_valid_bits > 0;
-        let want_map = view.mode == ViewMode::ShadowMap;
-        if want_map {
-            let bytes_per = if view.shadow.format == ShadowFormat::D16 {
-                2
-            } else {
-                4
-            };
-            let need = map_size as u64 * map_size as u64 * bytes_per;
-            if self.shadow_readback.as_ref().is_none_or(|b| b.size < need) {
-                self.shadow_readback = Some(Buffer::new(
-                    &ctx,
-                    "shadow map readback",
-                    need,
-                    vk::BufferUsageFlags::TRANSFER_DST,
-                    MemoryLocation::GpuToCpu,
-                )?);
-            }
-        }
+        let extent = vk::Extent2D { width, height };
+        let t = self.target.as_mut().expect("target");
+        let mut color = Attachment {
+            image: t.color.raw,
+            view: t.color.view,
+            state: t.color_state,
+        };
+        let mut depth = Attachment {
+            image: t.depth.raw,
+            view: t.depth.view,
+            state: t.depth_state,
+        };
         let casters;
         unsafe {
             d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
@@ -249,227 +253,69 @@ impl Renderer {
                     .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
             )
             .vk("vkBeginCommandBuffer")?;
-            if timestamps {
-                d.cmd_reset_query_pool(cmd, self.query_pool, 0, 3);
-                d.cmd_write_timestamp2(
-                    cmd,
-                    vk::PipelineStageFlags2::TOP_OF_PIPE,
-                    self.query_pool,
-                    0,
-                );
-            }
-            let shadows_on = plan.uniform.shadow.w > 0.5;
-            casters = self.shadow.record(
-                cmd,
-                &self.gpu,
-                &plan.light_clip_from_world,
-                &view.shadow,
-                shadows_on,
-            );
-            if timestamps {
-                d.cmd_write_timestamp2(
-                    cmd,
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    self.query_pool,
-                    1,
-                );
-            }
-            let t = self.target.as_mut().expect("target");
+        }
+        casters = self
+            .core
+            .record(cmd, 0, view, &plan, &mut color, &mut depth, extent);
+        image_barrier(
+            d,
+            cmd,
+            color.image,
+            vk::ImageAspectFlags::COLOR,
+            0..1,
+            color.state,
+            Access::TransferSrc,
+        );
+        t.color_state = Access::TransferSrc;
+        t.depth_state = depth.state;
+        copy_to_buffer(
+            d,
+            cmd,
+            t.color.raw,
+            vk::ImageAspectFlags::COLOR,
+            extent,
+            t.readback.raw,
+        );
+        if self.read_depth {
             image_barrier(
                 d,
                 cmd,
-                t.color.raw,
-                vk::ImageAspectFlags::COLOR,
+                depth.image,
+                vk::ImageAspectFlags::DEPTH,
                 0..1,
-                t.color_state,
-                Access::ColorAttachment,
+                depth.state,
+                Access::TransferSrc,
             );
-            image_barrier(
+            t.depth_state = Access::TransferSrc;
+            copy_to_buffer(
                 d,
                 cmd,
                 t.depth.raw,
                 vk::ImageAspectFlags::DEPTH,
-                0..1,
-                t.depth_state,
-                Access::DepthAttachment,
+                extent,
+                t.depth_readback.raw,
             );
-            self.camera.record(
-                cmd,
-                &self.gpu,
-                t.color.view,
-                t.depth.view,
-                t.color.extent,
-                CLEAR_COLOR,
-            );
-            if timestamps {
-                d.cmd_write_timestamp2(
-                    cmd,
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    self.query_pool,
-                    2,
-                );
-            }
-            image_barrier(
-                d,
-                cmd,
-                t.color.raw,
-                vk::ImageAspectFlags::COLOR,
-                0..1,
-                Access::ColorAttachment,
-                Access::TransferSrc,
-            );
-            t.color_state = Access::TransferSrc;
-            t.depth_state = Access::DepthAttachment;
-            let region = [vk::BufferImageCopy::default()
-                .buffer_row_length(0)
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                })
-                .image_extent(vk::Extent3D {
-                    width,
-                    height,
-                    depth: 1,
-                })];
-            d.cmd_copy_image_to_buffer(
-                cmd,
-                t.color.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                t.readback.raw,
-                &region,
-            );
-            if self.read_depth {
-                image_barrier(
-                    d,
-                    cmd,
-                    t.depth.raw,
-                    vk::ImageAspectFlags::DEPTH,
-                    0..1,
-                    Access::DepthAttachment,
-                    Access::TransferSrc,
-                );
-                t.depth_state = Access::TransferSrc;
-                let region = [vk::BufferImageCopy::default()
-                    .image_subresource(vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::DEPTH,
-                        mip_level: 0,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    })
-                    .image_extent(vk::Extent3D {
-                        width,
-                        height,
-                        depth: 1,
-                    })];
-                d.cmd_copy_image_to_buffer(
-                    cmd,
-                    t.depth.raw,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    t.depth_readback.raw,
-                    &region,
-                );
-            }
-            if want_map {
-                let map = self.shadow.map.as_ref().expect("map");
-                image_barrier(
-                    d,
-                    cmd,
-                    map.raw,
-                    vk::ImageAspectFlags::DEPTH,
-                    0..1,
-                    Access::DepthFragmentSampled,
-                    Access::TransferSrc,
-                );
-                let region = [vk::BufferImageCopy::default()
-                    .image_subresource(vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::DEPTH,
-                        mip_level: 0,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    })
-                    .image_extent(vk::Extent3D {
-                        width: map_size,
-                        height: map_size,
-                        depth: 1,
-                    })];
-                d.cmd_copy_image_to_buffer(
-                    cmd,
-                    map.raw,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    self.shadow_readback.as_ref().expect("buffer").raw,
-                    &region,
-                );
-                self.shadow.set_state(Access::TransferSrc);
-            }
-            // Make the copies visible to the host.
-            let mb = [vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-            d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&mb));
-            d.end_command_buffer(cmd).vk("vkEndCommandBuffer")?;
         }
+        transfer_to_host_barrier(d, cmd);
+        unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
         ctx.submit_and_wait(cmd)?;
-        let mut stats = FrameStats {
+        let times = self.core.gpu_times(0);
+        let stats = FrameStats {
+            gpu_shadow_ms: times.map(|t| t.0),
+            gpu_camera_ms: times.map(|t| t.1),
+            wall_ms: 0.0,
             casters_drawn: casters,
-            draws: self.gpu.draws.len(),
-            triangles: self.gpu.triangles,
-            hardware_compare: hw,
-            ..Default::default()
+            draws: self.core.gpu.draws.len(),
+            triangles: self.core.gpu.triangles,
+            hardware_compare: self.core.shadow.hardware_filtering(),
         };
-        if timestamps {
-            let mut q = [0u64; 3];
-            unsafe {
-                d.get_query_pool_results(
-                    self.query_pool,
-                    0,
-                    &mut q,
-                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-                )
-            }
-            .vk("vkGetQueryPoolResults")?;
-            let period = ctx.properties.limits.timestamp_period as f64 * 1e-6;
-            stats.gpu_shadow_ms = Some(q[1].wrapping_sub(q[0]) as f64 * period);
-            stats.gpu_camera_ms = Some(q[2].wrapping_sub(q[1]) as f64 * period);
-        }
-        let image = if want_map {
-            let buf = self.shadow_readback.as_mut().expect("buffer");
-            let bytes = buf
-                .mapped()
-                .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
-            let n = (map_size * map_size) as usize;
-            let grey: Vec<u8> = if view.shadow.format == ShadowFormat::D16 {
-                bytemuck::cast_slice::<u8, u16>(&bytes[..n * 2])
-                    .iter()
-                    .map(|&v| (v >> 8) as u8)
-                    .collect()
-            } else {
-                bytemuck::cast_slice::<u8, f32>(&bytes[..n * 4])
-                    .iter()
-                    .map(|&v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
-                    .collect()
-            };
-            let rgba: Vec<u8> = grey.iter().flat_map(|&g| [g, g, g, 255]).collect();
-            image::RgbaImage::from_raw(map_size, map_size, rgba).expect("size")
-        } else {
-            let t = self.target.as_mut().expect("target");
-            let bytes = t
-                .readback
-                .mapped()
-                .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
-            // Tightly packed rows (bufferRowLength 0): row pitch = width * 4.
-            let pitch = width as usize * 4;
-            let mut rgba = Vec::with_capacity(pitch * height as usize);
-            for row in 0..height as usize {
-                rgba.extend_from_slice(&bytes[row * pitch..row * pitch + pitch]);
-            }
-            image::RgbaImage::from_raw(width, height, rgba).expect("size")
-        };
+        let t = self.target.as_mut().expect("target");
+        let bytes = t
+            .readback
+            .mapped()
+            .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
+        let image = rgba_from_readback(bytes, width, height, false);
         let depth = if self.read_depth {
-            let t = self.target.as_mut().expect("target");
             let bytes = t
                 .depth_readback
                 .mapped()
@@ -478,6 +324,7 @@ impl Renderer {
         } else {
             None
         };
+        let mut stats = stats;
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(RenderedFrame {
             image,
@@ -491,9 +338,8 @@ impl Renderer {
 impl Drop for Renderer {
     fn drop(&mut self) {
         unsafe {
-            let _ = self.ctx.device.device_wait_idle();
-            self.ctx.device.destroy_query_pool(self.query_pool, None);
+            let _ = self.core.ctx.device.device_wait_idle();
         }
-        self.ctx.free_command_buffer(self.cmd);
+        self.core.ctx.free_command_buffer(self.cmd);
     }
 }

@@ -97,6 +97,7 @@ impl ShadowPass {
                     depth_format: fmt,
                     depth_clamp: true,
                     depth_bias: true,
+                    depth_test: true,
                 },
             )?;
             self.pipeline_format = fmt;

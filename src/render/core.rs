@@ -1,0 +1,230 @@
+//! What the offscreen renderer and the window share: the uploaded scene, the shadow and camera
+//! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
+//! record exactly the same commands, so the window and the capture give the same pixels.
+
+use super::camera_pass::CameraPass;
+use super::frame::{plan_frame, FramePlan};
+use super::gpu_scene::GpuScene;
+use super::settings::{View, ViewMode};
+use super::shadow_pass::ShadowPass;
+use crate::gpu::barrier::{image_barrier, Access};
+use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::scene::Scene;
+use ash::vk;
+use std::sync::Arc;
+
+/// Linear colour where nothing is drawn (the CPU reference uses it too).
+pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
+
+/// An attachment the core renders into, with the access it was last used with.
+pub struct Attachment {
+    /// Image.
+    pub image: vk::Image,
+    /// View.
+    pub view: vk::ImageView,
+    /// Last access (updated by `record`).
+    pub state: Access,
+}
+
+/// Scene + passes + per-slot uniforms and timestamps.
+pub struct FrameCore {
+    /// The context.
+    pub ctx: Arc<Context>,
+    /// CPU scene.
+    pub scene: Scene,
+    /// GPU scene.
+    pub gpu: GpuScene,
+    /// Shadow depth pass.
+    pub shadow: ShadowPass,
+    /// Camera pass.
+    pub camera: CameraPass,
+    query_pool: vk::QueryPool,
+    timestamps_written: Vec<bool>,
+}
+
+impl FrameCore {
+    /// Uploads `scene` and creates the passes for `color_format` with `slots` frames in flight.
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        color_format: vk::Format,
+        slots: usize,
+    ) -> Result<Self, GpuError> {
+        let gpu = GpuScene::new(ctx, scene)?;
+        let shadow = ShadowPass::new(ctx)?;
+        let camera = CameraPass::new(ctx, &gpu, color_format, slots)?;
+        let query_pool = unsafe {
+            ctx.device.create_query_pool(
+                &vk::QueryPoolCreateInfo::default()
+                    .query_type(vk::QueryType::TIMESTAMP)
+                    .query_count(3 * slots as u32),
+                None,
+            )
+        }
+        .vk("vkCreateQueryPool")?;
+        Ok(Self {
+            ctx: ctx.clone(),
+            scene: scene.clone(),
+            gpu,
+            shadow,
+            camera,
+            query_pool,
+            timestamps_written: vec![false; slots],
+        })
+    }
+
+    /// Sizes the shadow map for `view`, plans the frame and writes slot `slot`'s uniforms (the
+    /// slot's previous frame must have completed).
+    pub fn prepare(
+        &mut self,
+        slot: usize,
+        view: &View,
+        width: u32,
+        height: u32,
+    ) -> Result<FramePlan, GpuError> {
+        let map_size = if view.shadow.enabled {
+            view.shadow.map_size.clamp(16, 16384)
+        } else {
+            1
+        };
+        self.shadow.ensure_map(map_size, view.shadow.format)?;
+        let hw = self.shadow.hardware_filtering();
+        let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
+        self.camera.bind_shadow_map(slot, map_view, hw);
+        let mut v = view.clone();
+        v.shadow.map_size = map_size;
+        let plan = plan_frame(
+            &self.scene,
+            &self.gpu.bounds,
+            &v,
+            width as f32 / height.max(1) as f32,
+            hw,
+        );
+        self.camera.write_frame(slot, &plan.uniform)?;
+        Ok(plan)
+    }
+
+    /// Records the shadow pass and the camera pass with timestamps; leaves `color` as a colour
+    /// attachment and `depth` as a depth attachment. Returns the casters drawn.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        view: &View,
+        plan: &FramePlan,
+        color: &mut Attachment,
+        depth: &mut Attachment,
+        extent: vk::Extent2D,
+    ) -> usize {
+        let ctx = self.ctx.clone();
+        let d = &ctx.device;
+        let q = 3 * slot as u32;
+        let timestamps = ctx.timestamp_valid_bits > 0;
+        unsafe {
+            if timestamps {
+                d.cmd_reset_query_pool(cmd, self.query_pool, q, 3);
+                d.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::TOP_OF_PIPE,
+                    self.query_pool,
+                    q,
+                );
+            }
+        }
+        let shadows_on = plan.uniform.shadow.w > 0.5;
+        let casters = self.shadow.record(
+            cmd,
+            &self.gpu,
+            &plan.light_clip_from_world,
+            &view.shadow,
+            shadows_on,
+        );
+        unsafe {
+            if timestamps {
+                d.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    self.query_pool,
+                    q + 1,
+                );
+            }
+        }
+        image_barrier(
+            d,
+            cmd,
+            color.image,
+            vk::ImageAspectFlags::COLOR,
+            0..1,
+            color.state,
+            Access::ColorAttachment,
+        );
+        image_barrier(
+            d,
+            cmd,
+            depth.image,
+            vk::ImageAspectFlags::DEPTH,
+            0..1,
+            depth.state,
+            Access::DepthAttachment,
+        );
+        color.state = Access::ColorAttachment;
+        depth.state = Access::DepthAttachment;
+        self.camera.record(
+            cmd,
+            slot,
+            &self.gpu,
+            color.view,
+            depth.view,
+            extent,
+            CLEAR_COLOR,
+            view.mode == ViewMode::ShadowMap,
+        );
+        unsafe {
+            if timestamps {
+                d.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    self.query_pool,
+                    q + 2,
+                );
+            }
+        }
+        self.timestamps_written[slot] = timestamps;
+        casters
+    }
+
+    /// GPU milliseconds (shadow pass, camera pass) of slot `slot`'s last frame, which must have
+    /// completed.
+    pub fn gpu_times(&self, slot: usize) -> Option<(f64, f64)> {
+        if !self.timestamps_written[slot] {
+            return None;
+        }
+        let mut t = [0u64; 3];
+        unsafe {
+            self.ctx
+                .device
+                .get_query_pool_results(
+                    self.query_pool,
+                    3 * slot as u32,
+                    &mut t,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                )
+                .ok()?;
+        }
+        let period = self.ctx.properties.limits.timestamp_period as f64 * 1e-6;
+        Some((
+            t[1].wrapping_sub(t[0]) as f64 * period,
+            t[2].wrapping_sub(t[1]) as f64 * period,
+        ))
+    }
+}
+
+impl Drop for FrameCore {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.ctx.device.device_wait_idle();
+            self.ctx.device.destroy_query_pool(self.query_pool, None);
+        }
+    }
+}
