@@ -2,7 +2,7 @@
 
 use anyhow::Context as _;
 use clap::Parser;
-use umbra::app::cli::{load_scene, make_view, Cli, Command, CompareArgs, RenderArgs};
+use umbra::app::cli::{load_scene, make_view, Cli, Command, CompareArgs, RenderArgs, ViewArgsCmd};
 use umbra::gpu::{Context, ContextDesc, Validation};
 use umbra::render::Renderer;
 
@@ -14,6 +14,7 @@ fn main() {
     let result = match cli.command {
         Command::Render(a) => render(a),
         Command::Compare(a) => compare(a),
+        Command::View(a) => view(a),
     };
     if let Err(e) = result {
         let msg = format!("{e:#}").replace('\n', " ");
@@ -132,4 +133,23 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
         .map(|(s, c)| s + c));
     println!("{j}");
     Ok(())
+}
+
+fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
+    let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", scene.name);
+    }
+    let view = make_view(&scene, &a.view)?;
+    umbra::app::viewer::run(umbra::app::viewer::ViewerOptions {
+        scene,
+        view,
+        size: a.view.size,
+        vsync: !a.no_vsync,
+        frames: a.frames,
+        screenshot: a.screenshot,
+        device: a.device,
+        validation: a.validation,
+        resize_script: a.resize_script,
+    })
 }

@@ -24,6 +24,43 @@ pub enum Command {
     /// Render on the GPU and by CPU ray casting, print shadow and image error as one JSON line,
     /// and write gpu.png, reference.png and diff.png (false shadow red, false light blue).
     Compare(CompareArgs),
+    /// Open a window and render continuously (the demo scene without SCENE).
+    View(ViewArgsCmd),
+}
+
+/// `umbra view`.
+#[derive(Args, Debug)]
+pub struct ViewArgsCmd {
+    /// glTF 2.0 file; the built-in demo scene when omitted.
+    pub scene: Option<PathBuf>,
+    /// View and shadow options (as for render; --size is the window's inner size).
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Present without vsync (for measuring).
+    #[arg(long)]
+    pub no_vsync: bool,
+    /// Render this many frames, then exit.
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// With --frames: save the last frame here.
+    #[arg(long, requires = "frames")]
+    pub screenshot: Option<PathBuf>,
+    /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Enable the Khronos validation layer; exit 1 on any warning or error.
+    #[arg(long)]
+    pub validation: bool,
+    /// Testing: window sizes to go through, e.g. 400x300,0x0,640x480 (0x0 simulates minimising).
+    #[arg(long, value_delimiter = ',', value_parser = parse_size_or_zero, hide = true)]
+    pub resize_script: Vec<(u32, u32)>,
+}
+
+fn parse_size_or_zero(s: &str) -> Result<(u32, u32), String> {
+    if s.trim() == "0x0" {
+        return Ok((0, 0));
+    }
+    parse_size(s)
 }
 
 /// `umbra compare`.

@@ -8,7 +8,9 @@ pub mod pipeline;
 pub mod renderer;
 pub mod settings;
 pub mod shadow_pass;
+pub mod swapchain;
 pub mod uniforms;
+pub mod window;
 
 pub use renderer::{FrameStats, RenderedFrame, Renderer};
 pub use settings::{Pcf, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};

@@ -243,7 +243,6 @@ impl Renderer {
             view: t.depth.view,
             state: t.depth_state,
         };
-        let casters;
         unsafe {
             d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
                 .vk("vkResetCommandBuffer")?;
@@ -254,7 +253,7 @@ impl Renderer {
             )
             .vk("vkBeginCommandBuffer")?;
         }
-        casters = self
+        let casters = self
             .core
             .record(cmd, 0, view, &plan, &mut color, &mut depth, extent);
         image_barrier(

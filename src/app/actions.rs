@@ -1,0 +1,193 @@
+//! Viewer key actions on the view settings, as pure logic; each returns the line to print.
+
+use crate::render::{Pcf, View, ViewMode};
+use crate::scene::Light;
+use glam::Vec3;
+
+/// What a key does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    /// Sun azimuth −5° (left arrow).
+    SunLeft,
+    /// Sun azimuth +5° (right arrow).
+    SunRight,
+    /// Sun elevation +5° (up arrow).
+    SunUp,
+    /// Sun elevation −5° (down arrow).
+    SunDown,
+    /// Halve the shadow map (`[`).
+    MapSmaller,
+    /// Double the shadow map (`]`).
+    MapLarger,
+    /// Next PCF kernel (`K`).
+    CyclePcf,
+    /// All biases ×1.25 (`=`/`+`).
+    BiasUp,
+    /// All biases ÷1.25 (`-`).
+    BiasDown,
+    /// Next debug view: lit, shadow, normals, shadow map (`V`).
+    CycleView,
+    /// Toggle shadows (`H`).
+    ToggleShadows,
+}
+
+/// The sun as elevation/azimuth in degrees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SunAngles {
+    /// Degrees above the horizon.
+    pub elevation: f32,
+    /// Degrees around +Y from +Z.
+    pub azimuth: f32,
+}
+
+impl SunAngles {
+    /// The angles of a light travelling along `direction`.
+    pub fn from_direction(direction: Vec3) -> Self {
+        let to_sun = -direction.normalize_or(Vec3::NEG_Y);
+        Self {
+            elevation: to_sun.y.clamp(-1.0, 1.0).asin().to_degrees(),
+            azimuth: to_sun.x.atan2(to_sun.z).to_degrees(),
+        }
+    }
+
+    /// The direction the light travels.
+    pub fn direction(&self) -> Vec3 {
+        Light::sun_direction(self.elevation.to_radians(), self.azimuth.to_radians())
+    }
+}
+
+/// Applies `a` to the view (and the sun angles); returns a one-line description of the change.
+pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
+    let s = &mut view.shadow;
+    match a {
+        Action::SunLeft | Action::SunRight | Action::SunUp | Action::SunDown => {
+            match a {
+                Action::SunLeft => sun.azimuth -= 5.0,
+                Action::SunRight => sun.azimuth += 5.0,
+                Action::SunUp => sun.elevation = (sun.elevation + 5.0).min(90.0),
+                _ => sun.elevation = (sun.elevation - 5.0).max(1.0),
+            }
+            sun.azimuth = (sun.azimuth + 540.0) % 360.0 - 180.0;
+            view.sun_direction = Some(sun.direction());
+            format!(
+                "sun: elevation {:.0}°, azimuth {:.0}°",
+                sun.elevation, sun.azimuth
+            )
+        }
+        Action::MapSmaller => {
+            s.map_size = (s.map_size / 2).max(64);
+            format!("shadow map: {0}x{0}", s.map_size)
+        }
+        Action::MapLarger => {
+            s.map_size = (s.map_size * 2).min(8192);
+            format!("shadow map: {0}x{0}", s.map_size)
+        }
+        Action::CyclePcf => {
+            s.pcf = match s.pcf {
+                Pcf::None => Pcf::P2x2,
+                Pcf::P2x2 => Pcf::P3x3,
+                Pcf::P3x3 => Pcf::P5x5,
+                Pcf::P5x5 => Pcf::None,
+            };
+            format!("PCF: {:?}", s.pcf)
+        }
+        Action::BiasUp | Action::BiasDown => {
+            let k = if a == Action::BiasUp { 1.25 } else { 0.8 };
+            s.constant_bias *= k;
+            s.slope_bias *= k;
+            s.normal_offset *= k;
+            format!(
+                "bias: constant {:.2} texels, slope {:.2}, normal offset {:.2} texels",
+                s.constant_bias, s.slope_bias, s.normal_offset
+            )
+        }
+        Action::CycleView => {
+            view.mode = match view.mode {
+                ViewMode::Lit => ViewMode::Shadow,
+                ViewMode::Shadow => ViewMode::Normals,
+                ViewMode::Normals => ViewMode::ShadowMap,
+                ViewMode::ShadowMap => ViewMode::Lit,
+            };
+            format!("view: {:?}", view.mode)
+        }
+        Action::ToggleShadows => {
+            s.enabled = !s.enabled;
+            format!("shadows: {}", if s.enabled { "on" } else { "off" })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Camera;
+
+    fn view() -> View {
+        View::new(Camera::look_at(
+            Vec3::new(0.0, 1.0, 5.0),
+            Vec3::ZERO,
+            0.8,
+            0.1,
+        ))
+    }
+
+    #[test]
+    fn sun_keys_rotate_and_clamp() {
+        let mut v = view();
+        let mut sun = SunAngles {
+            elevation: 30.0,
+            azimuth: 0.0,
+        };
+        let msg = apply(Action::SunUp, &mut v, &mut sun);
+        assert_eq!(sun.elevation, 35.0);
+        assert!(msg.contains("elevation 35"));
+        let d = v.sun_direction.unwrap();
+        assert!((SunAngles::from_direction(d).elevation - 35.0).abs() < 1e-3);
+        for _ in 0..40 {
+            apply(Action::SunDown, &mut v, &mut sun);
+        }
+        assert_eq!(sun.elevation, 1.0);
+        for _ in 0..72 {
+            apply(Action::SunRight, &mut v, &mut sun);
+        }
+        assert!(sun.azimuth.abs() < 1e-3, "full turn: {}", sun.azimuth);
+    }
+
+    #[test]
+    fn map_size_pcf_bias_and_view_cycle() {
+        let mut v = view();
+        let mut sun = SunAngles {
+            elevation: 30.0,
+            azimuth: 0.0,
+        };
+        apply(Action::MapLarger, &mut v, &mut sun);
+        assert_eq!(v.shadow.map_size, 4096);
+        for _ in 0..10 {
+            apply(Action::MapSmaller, &mut v, &mut sun);
+        }
+        assert_eq!(v.shadow.map_size, 64);
+        let pcf = v.shadow.pcf;
+        for _ in 0..4 {
+            apply(Action::CyclePcf, &mut v, &mut sun);
+        }
+        assert_eq!(v.shadow.pcf, pcf, "four kernels cycle");
+        let b = v.shadow.normal_offset;
+        apply(Action::BiasUp, &mut v, &mut sun);
+        assert!((v.shadow.normal_offset - b * 1.25).abs() < 1e-6);
+        let mut seen = vec![v.mode];
+        for _ in 0..3 {
+            apply(Action::CycleView, &mut v, &mut sun);
+            seen.push(v.mode);
+        }
+        assert_eq!(
+            seen,
+            vec![
+                ViewMode::Lit,
+                ViewMode::Shadow,
+                ViewMode::Normals,
+                ViewMode::ShadowMap
+            ]
+        );
+        assert!(apply(Action::ToggleShadows, &mut v, &mut sun).contains("off"));
+    }
+}

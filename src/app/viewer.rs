@@ -1,0 +1,488 @@
+//! `umbra view`: the real-time viewer (winit). Same passes as the offscreen path; orbit/fly
+//! cameras; keys change the light and shadow settings and print what changed; frame statistics
+//! in the title a few times a second; `P` saves a screenshot of what is on screen.
+//!
+//! Keys: mouse left-drag rotate, right/middle-drag pan, wheel zoom, `F` frame the scene, `Tab`
+//! orbit/fly (WASD, Q/E down/up, Shift faster), `C` next glTF camera, arrows rotate the sun,
+//! `[`/`]` shadow-map size, `K` PCF kernel, `+`/`-` bias, `V` debug view, `H` shadows on/off,
+//! `P` screenshot, `Esc` quit.
+
+use super::actions::{apply, Action, SunAngles};
+use super::controller::{Button, Controller, Input, MoveKey};
+use crate::gpu::{Context, ContextDesc, Validation};
+use crate::render::frame::effective_lights;
+use crate::render::window::{DrawResult, WindowRenderer};
+use crate::render::View;
+use crate::scene::{LightKind, Scene};
+use anyhow::{anyhow, Context as _};
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use std::ffi::CStr;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
+
+/// How to run the viewer.
+pub struct ViewerOptions {
+    /// The scene.
+    pub scene: Scene,
+    /// Initial view (camera, sun, shadow settings, mode).
+    pub view: View,
+    /// Window inner size.
+    pub size: (u32, u32),
+    /// FIFO presentation (vsync).
+    pub vsync: bool,
+    /// Render this many frames, then exit (with `screenshot`, save the last one).
+    pub frames: Option<u64>,
+    /// Where `--frames` saves the last frame.
+    pub screenshot: Option<PathBuf>,
+    /// Device name substring.
+    pub device: Option<String>,
+    /// Khronos validation on (exit 1 on any message).
+    pub validation: bool,
+    /// Window sizes to go through, one every few frames (testing); 0×0 simulates minimising.
+    pub resize_script: Vec<(u32, u32)>,
+}
+
+/// Frames between two resize-script steps.
+const SCRIPT_STEP_FRAMES: u64 = 4;
+
+/// What a key does in the viewer.
+enum KeyAction {
+    Setting(Action),
+    Move(MoveKey),
+    Frame,
+    ToggleFly,
+    NextCamera,
+    Screenshot,
+    Quit,
+}
+
+fn key_action(code: KeyCode) -> Option<KeyAction> {
+    use KeyAction::*;
+    Some(match code {
+        KeyCode::ArrowLeft => Setting(Action::SunLeft),
+        KeyCode::ArrowRight => Setting(Action::SunRight),
+        KeyCode::ArrowUp => Setting(Action::SunUp),
+        KeyCode::ArrowDown => Setting(Action::SunDown),
+        KeyCode::BracketLeft => Setting(Action::MapSmaller),
+        KeyCode::BracketRight => Setting(Action::MapLarger),
+        KeyCode::KeyK => Setting(Action::CyclePcf),
+        KeyCode::Equal | KeyCode::NumpadAdd => Setting(Action::BiasUp),
+        KeyCode::Minus | KeyCode::NumpadSubtract => Setting(Action::BiasDown),
+        KeyCode::KeyV => Setting(Action::CycleView),
+        KeyCode::KeyH => Setting(Action::ToggleShadows),
+        KeyCode::KeyW => Move(MoveKey::W),
+        KeyCode::KeyA => Move(MoveKey::A),
+        KeyCode::KeyS => Move(MoveKey::S),
+        KeyCode::KeyD => Move(MoveKey::D),
+        KeyCode::KeyQ => Move(MoveKey::Q),
+        KeyCode::KeyE => Move(MoveKey::E),
+        KeyCode::ShiftLeft | KeyCode::ShiftRight => Move(MoveKey::Shift),
+        KeyCode::KeyF => Frame,
+        KeyCode::Tab => ToggleFly,
+        KeyCode::KeyC => NextCamera,
+        KeyCode::KeyP => Screenshot,
+        KeyCode::Escape => Quit,
+        _ => return None,
+    })
+}
+
+struct State {
+    // Field order is drop order: the renderer (swapchain, surface) before the window.
+    renderer: WindowRenderer,
+    ctx: Arc<Context>,
+    window: Arc<Window>,
+    controller: Controller,
+    view: View,
+    sun: SunAngles,
+    camera_index: Option<usize>,
+    drawn: u64,
+    ticks: u64,
+    first_draw: Option<Instant>,
+    last_frame: Instant,
+    last_title: Instant,
+    frame_ms: Vec<f64>,
+    cpu_ms: Vec<f64>,
+    want_screenshot: bool,
+    screenshot_count: u32,
+    script_pos: usize,
+    minimized: bool,
+}
+
+struct App {
+    opts: ViewerOptions,
+    state: Option<State>,
+    error: Option<anyhow::Error>,
+}
+
+impl App {
+    fn fail(&mut self, el: &ActiveEventLoop, e: anyhow::Error) {
+        if self.error.is_none() {
+            self.error = Some(e);
+        }
+        el.exit();
+    }
+
+    fn init(&mut self, el: &ActiveEventLoop) -> anyhow::Result<State> {
+        let (w, h) = self.opts.size;
+        let attrs = Window::default_attributes()
+            .with_title(format!("umbra — {}", self.opts.scene.name))
+            .with_inner_size(PhysicalSize::new(w, h));
+        let window = Arc::new(el.create_window(attrs).context("cannot create a window")?);
+        let display = window
+            .display_handle()
+            .map_err(|e| anyhow!("no display handle: {e}"))?
+            .as_raw();
+        let exts = ash_window::enumerate_required_extensions(display)
+            .map_err(|e| anyhow!("no Vulkan surface support for this display: {e:?}"))?;
+        let instance_extensions = exts
+            .iter()
+            .map(|&p| unsafe { CStr::from_ptr(p) }.to_owned())
+            .collect();
+        let ctx = Context::new(&ContextDesc {
+            validation: if self.opts.validation {
+                Validation::Required
+            } else {
+                Validation::Off
+            },
+            device: self.opts.device.clone(),
+            instance_extensions,
+            swapchain: true,
+        })?;
+        let handle = window
+            .window_handle()
+            .map_err(|e| anyhow!("no window handle: {e}"))?
+            .as_raw();
+        let surface =
+            unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, handle, None) }
+                .map_err(|e| anyhow!("cannot create a Vulkan surface: {e:?}"))?;
+        let size = window.inner_size();
+        let renderer = WindowRenderer::new(
+            &ctx,
+            &self.opts.scene,
+            surface,
+            size.width,
+            size.height,
+            self.opts.vsync,
+        )?;
+        let view = self.opts.view.clone();
+        let bounds = self
+            .opts
+            .scene
+            .framing
+            .unwrap_or_else(|| self.opts.scene.bounds());
+        let controller = Controller::from_camera(&view.camera, &bounds);
+        let lights = effective_lights(&self.opts.scene, &view);
+        let sun_dir = lights
+            .iter()
+            .find(|l| l.kind == LightKind::Directional)
+            .map(|l| l.direction)
+            .unwrap_or(glam::Vec3::NEG_Y);
+        println!(
+            "viewer: {} on {} ({} triangles); press Esc to quit",
+            self.opts.scene.name,
+            ctx.device_name,
+            renderer.triangles()
+        );
+        Ok(State {
+            renderer,
+            ctx,
+            window,
+            controller,
+            view,
+            sun: SunAngles::from_direction(sun_dir),
+            camera_index: None,
+            drawn: 0,
+            ticks: 0,
+            first_draw: None,
+            last_frame: Instant::now(),
+            last_title: Instant::now(),
+            frame_ms: Vec::new(),
+            cpu_ms: Vec::new(),
+            want_screenshot: false,
+            screenshot_count: 0,
+            script_pos: 0,
+            minimized: size.width == 0 || size.height == 0,
+        })
+    }
+
+    fn redraw(&mut self, el: &ActiveEventLoop) -> anyhow::Result<()> {
+        let opts = &self.opts;
+        let Some(s) = self.state.as_mut() else {
+            return Ok(());
+        };
+        s.ticks += 1;
+        // Resize script (automation): one step every few frames.
+        if s.ticks % SCRIPT_STEP_FRAMES == 0 && s.script_pos < opts.resize_script.len() {
+            let (w, h) = opts.resize_script[s.script_pos];
+            s.script_pos += 1;
+            if w == 0 || h == 0 {
+                // What a minimised window reports on platforms that do: a 0×0 resize.
+                s.minimized = true;
+                s.renderer.resize(0, 0)?;
+            } else {
+                s.minimized = false;
+                let now = s
+                    .window
+                    .request_inner_size(PhysicalSize::new(w, h))
+                    .unwrap_or_else(|| s.window.inner_size());
+                s.renderer.resize(now.width, now.height)?;
+            }
+        }
+        let now = Instant::now();
+        let dt = (now - s.last_frame).as_secs_f32().min(0.25);
+        s.last_frame = now;
+        s.controller.update(dt);
+        if s.camera_index.is_none() {
+            s.view.camera = s.controller.camera();
+        }
+        let last_scripted = s.script_pos >= opts.resize_script.len();
+        let final_frame = opts.frames.is_some_and(|n| s.drawn + 1 >= n) && last_scripted;
+        let shot = s.want_screenshot || (final_frame && opts.screenshot.is_some());
+        let t0 = Instant::now();
+        let result = if s.minimized {
+            DrawResult::Skipped
+        } else {
+            s.renderer.draw(&s.view, shot)?
+        };
+        let cpu = t0.elapsed().as_secs_f64() * 1e3;
+        if let DrawResult::Drawn { screenshot, .. } = result {
+            s.drawn += 1;
+            s.first_draw.get_or_insert(t0);
+            s.cpu_ms.push(cpu);
+            s.frame_ms.push(dt as f64 * 1e3);
+            if let Some(img) = screenshot {
+                let path = if final_frame {
+                    opts.screenshot
+                        .clone()
+                        .unwrap_or_else(|| PathBuf::from("screenshot.png"))
+                } else {
+                    s.screenshot_count += 1;
+                    PathBuf::from(format!("umbra-screenshot-{}.png", s.screenshot_count))
+                };
+                img.save(&path)
+                    .with_context(|| format!("writing {}", path.display()))?;
+                println!(
+                    "screenshot: {} ({}x{})",
+                    path.display(),
+                    img.width(),
+                    img.height()
+                );
+                s.want_screenshot = false;
+            }
+        }
+        if s.last_title.elapsed().as_secs_f64() >= 0.25 && !s.cpu_ms.is_empty() {
+            let n = s.cpu_ms.len() as f64;
+            let cpu = s.cpu_ms.iter().sum::<f64>() / n;
+            let frame = s.frame_ms.iter().sum::<f64>() / n;
+            let gpu = match s.renderer.gpu_times() {
+                Some((a, b)) => format!("GPU {:.1} ms (shadow {a:.1} + camera {b:.1})", a + b),
+                None => "GPU n/a".into(),
+            };
+            let title = format!(
+                "umbra — {} — {:.1} fps | {gpu} | CPU {cpu:.1} ms | {} tris | map {}²",
+                opts.scene.name,
+                1000.0 / frame.max(1e-3),
+                s.renderer.triangles(),
+                s.view.shadow.map_size
+            );
+            s.window.set_title(&title);
+            log::info!("{title}");
+            s.cpu_ms.clear();
+            s.frame_ms.clear();
+            s.last_title = Instant::now();
+        }
+        if final_frame && s.drawn >= opts.frames.unwrap_or(0) {
+            el.exit();
+        }
+        Ok(())
+    }
+
+    fn key(&mut self, el: &ActiveEventLoop, code: KeyCode, pressed: bool) {
+        let opts = &self.opts;
+        let Some(s) = self.state.as_mut() else { return };
+        let Some(action) = key_action(code) else {
+            return;
+        };
+        match action {
+            KeyAction::Move(k) => s.controller.handle(Input::Key(k, pressed)),
+            _ if !pressed => {}
+            KeyAction::Setting(a) => println!("{}", apply(a, &mut s.view, &mut s.sun)),
+            KeyAction::Frame => {
+                s.camera_index = None;
+                s.controller
+                    .frame(&opts.scene.framing.unwrap_or_else(|| opts.scene.bounds()));
+                println!("camera: framing the scene");
+            }
+            KeyAction::ToggleFly => {
+                s.camera_index = None;
+                s.controller.toggle_mode();
+                println!("camera: {:?}", s.controller.mode);
+            }
+            KeyAction::NextCamera => {
+                if opts.scene.cameras.is_empty() {
+                    println!("camera: the scene has no cameras");
+                } else {
+                    let i = s
+                        .camera_index
+                        .map(|i| (i + 1) % opts.scene.cameras.len())
+                        .unwrap_or(0);
+                    s.camera_index = Some(i);
+                    s.view.camera = opts.scene.cameras[i];
+                    s.controller = Controller::from_camera(&s.view.camera, &opts.scene.bounds());
+                    println!("camera: glTF camera {i}");
+                }
+            }
+            KeyAction::Screenshot => s.want_screenshot = true,
+            KeyAction::Quit => el.exit(),
+        }
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, el: &ActiveEventLoop) {
+        if self.state.is_some() {
+            return;
+        }
+        match self.init(el) {
+            Ok(s) => self.state = Some(s),
+            Err(e) => self.fail(el, e),
+        }
+    }
+
+    fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        if self.state.is_none() {
+            return;
+        }
+        let r: anyhow::Result<()> = match event {
+            WindowEvent::CloseRequested => {
+                el.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(size) => {
+                let s = self.state.as_mut().expect("state");
+                s.minimized = size.width == 0 || size.height == 0;
+                s.renderer
+                    .resize(size.width, size.height)
+                    .map_err(Into::into)
+            }
+            WindowEvent::RedrawRequested => self.redraw(el),
+            WindowEvent::KeyboardInput { event, .. } => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    if !event.repeat
+                        || matches!(
+                            code,
+                            KeyCode::ArrowLeft
+                                | KeyCode::ArrowRight
+                                | KeyCode::ArrowUp
+                                | KeyCode::ArrowDown
+                        )
+                    {
+                        self.key(el, code, event.state == ElementState::Pressed);
+                    }
+                }
+                Ok(())
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                let b = match button {
+                    MouseButton::Left => Some(Button::Left),
+                    MouseButton::Right => Some(Button::Right),
+                    MouseButton::Middle => Some(Button::Middle),
+                    _ => None,
+                };
+                if let (Some(b), Some(s)) = (b, self.state.as_mut()) {
+                    if s.camera_index.take().is_some() {
+                        s.controller =
+                            Controller::from_camera(&s.view.camera, &self.opts.scene.bounds());
+                    }
+                    s.controller.handle(if state == ElementState::Pressed {
+                        Input::Press(b)
+                    } else {
+                        Input::Release(b)
+                    });
+                }
+                Ok(())
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                if let Some(s) = self.state.as_mut() {
+                    s.controller
+                        .handle(Input::Cursor(position.x as f32, position.y as f32));
+                }
+                Ok(())
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                if let Some(s) = self.state.as_mut() {
+                    s.camera_index = None;
+                    s.controller.handle(Input::Scroll(lines));
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = r {
+            self.fail(el, e);
+        }
+    }
+
+    fn about_to_wait(&mut self, el: &ActiveEventLoop) {
+        if let Some(s) = &self.state {
+            let scripted = s.script_pos < self.opts.resize_script.len();
+            if s.minimized && !scripted {
+                el.set_control_flow(ControlFlow::Wait);
+            } else {
+                el.set_control_flow(ControlFlow::Poll);
+                s.window.request_redraw();
+            }
+        }
+    }
+}
+
+/// Opens the window and runs until closed (or `frames` are drawn).
+pub fn run(opts: ViewerOptions) -> anyhow::Result<()> {
+    let event_loop = EventLoop::new().map_err(|e| {
+        anyhow!(
+            "cannot open a window ({e}); is DISPLAY or WAYLAND_DISPLAY set? Under CI use xvfb-run"
+        )
+    })?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        opts,
+        state: None,
+        error: None,
+    };
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| anyhow!("window event loop failed: {e}"))?;
+    if let Some(e) = app.error.take() {
+        return Err(e);
+    }
+    if let Some(s) = app.state.take() {
+        if let (Some(t), true) = (s.first_draw, s.drawn > 1) {
+            let secs = t.elapsed().as_secs_f64();
+            println!(
+                "viewer: {} frames in {secs:.2} s ({:.1} fps, vsync {})",
+                s.drawn,
+                (s.drawn - 1) as f64 / secs,
+                if app.opts.vsync { "on" } else { "off" }
+            );
+        }
+        // Keep the log past the teardown, so messages from destroying objects count too.
+        let log = s.ctx.validation_log.clone();
+        drop(s);
+        let problems = log.problem_count();
+        if problems > 0 {
+            anyhow::bail!("{problems} validation message(s) of warning or error severity");
+        }
+    }
+    Ok(())
+}

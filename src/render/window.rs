@@ -1,0 +1,297 @@
+//! Rendering to a window: the shared frame core into swapchain images, two frames in flight
+//! (per frame: command buffer, fence, acquire semaphore, uniform slot; per image: render-finished
+//! semaphore).
+
+use super::camera_pass::DEPTH_FORMAT;
+use super::core::{Attachment, FrameCore};
+use super::renderer::{copy_to_buffer, rgba_from_readback, transfer_to_host_barrier};
+use super::settings::View;
+use super::swapchain::Swapchain;
+use crate::gpu::barrier::{image_barrier, Access};
+use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::{Buffer, Image};
+use crate::scene::Scene;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+/// Frames recorded ahead of the GPU.
+pub const FRAMES_IN_FLIGHT: usize = 2;
+
+struct FrameSync {
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    acquired: vk::Semaphore,
+}
+
+/// What `draw` did.
+pub enum DrawResult {
+    /// Nothing drawn: the window is 0×0 or the swapchain was out of date (recreated).
+    Skipped,
+    /// A frame was submitted and presented.
+    Drawn {
+        /// Casters drawn into the shadow map.
+        casters: usize,
+        /// The presented pixels, when a screenshot was asked for.
+        screenshot: Option<image::RgbaImage>,
+    },
+}
+
+/// Draws views of a scene into a window's swapchain.
+pub struct WindowRenderer {
+    core: FrameCore,
+    /// The swapchain.
+    pub swapchain: Swapchain,
+    frames: Vec<FrameSync>,
+    depth: Option<Image>,
+    depth_state: Access,
+    frame: usize,
+    wanted: (u32, u32),
+    screenshot: Option<Buffer>,
+    last_gpu: Option<(f64, f64)>,
+}
+
+impl WindowRenderer {
+    /// Creates the swapchain on `surface` (taking ownership) and the passes for its format.
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        surface: vk::SurfaceKHR,
+        width: u32,
+        height: u32,
+        vsync: bool,
+    ) -> Result<Self, GpuError> {
+        let swapchain = Swapchain::new(ctx, surface, width, height, vsync)?;
+        let core = FrameCore::new(ctx, scene, swapchain.format, FRAMES_IN_FLIGHT)?;
+        let mut frames = Vec::new();
+        for i in 0..FRAMES_IN_FLIGHT {
+            let cmd = ctx.allocate_command_buffer()?;
+            let fence = unsafe {
+                ctx.device.create_fence(
+                    &vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED),
+                    None,
+                )
+            }
+            .vk("vkCreateFence")?;
+            let acquired = unsafe {
+                ctx.device
+                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+            }
+            .vk("vkCreateSemaphore")?;
+            ctx.set_name(acquired, &format!("image acquired {i}"));
+            frames.push(FrameSync {
+                cmd,
+                fence,
+                acquired,
+            });
+        }
+        let mut r = Self {
+            core,
+            swapchain,
+            frames,
+            depth: None,
+            depth_state: Access::Undefined,
+            frame: 0,
+            wanted: (width, height),
+            screenshot: None,
+            last_gpu: None,
+        };
+        r.ensure_depth()?;
+        Ok(r)
+    }
+
+    /// The triangles drawn per frame.
+    pub fn triangles(&self) -> usize {
+        self.core.gpu.triangles
+    }
+
+    /// GPU milliseconds (shadow, camera) of the most recently completed frame.
+    pub fn gpu_times(&self) -> Option<(f64, f64)> {
+        self.last_gpu
+    }
+
+    fn ensure_depth(&mut self) -> Result<(), GpuError> {
+        let e = self.swapchain.extent;
+        if e.width == 0 || e.height == 0 {
+            self.depth = None;
+            return Ok(());
+        }
+        if self.depth.as_ref().is_some_and(|d| d.extent == e) {
+            return Ok(());
+        }
+        self.depth = Some(Image::new(
+            &self.core.ctx,
+            "window depth",
+            DEPTH_FORMAT,
+            e,
+            1,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        )?);
+        self.depth_state = Access::Undefined;
+        Ok(())
+    }
+
+    /// The window's inner size changed (0×0 when minimised: drawing pauses).
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), GpuError> {
+        self.wanted = (width, height);
+        self.swapchain.recreate(width, height)?;
+        self.ensure_depth()
+    }
+
+    /// Draws one frame of `view`; with `screenshot`, also returns the presented pixels.
+    pub fn draw(&mut self, view: &View, screenshot: bool) -> Result<DrawResult, GpuError> {
+        let ctx = self.core.ctx.clone();
+        let d = &ctx.device;
+        let f = self.frame;
+        let sync = &self.frames[f];
+        unsafe { d.wait_for_fences(&[sync.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        if let Some(t) = self.core.gpu_times(f) {
+            self.last_gpu = Some(t);
+        }
+        let extent = self.swapchain.extent;
+        if extent.width == 0 || extent.height == 0 || self.swapchain.raw == vk::SwapchainKHR::null()
+        {
+            return Ok(DrawResult::Skipped);
+        }
+        let Some((index, _suboptimal)) = self.swapchain.acquire(sync.acquired)? else {
+            let (w, h) = self.wanted;
+            self.resize(w, h)?;
+            return Ok(DrawResult::Skipped);
+        };
+        unsafe { d.reset_fences(&[sync.fence]) }.vk("vkResetFences")?;
+        let plan = self.core.prepare(f, view, extent.width, extent.height)?;
+        let want_copy = screenshot && self.swapchain.can_copy;
+        if want_copy {
+            let need = extent.width as u64 * extent.height as u64 * 4;
+            if self.screenshot.as_ref().is_none_or(|b| b.size < need) {
+                self.screenshot = Some(Buffer::new(
+                    &ctx,
+                    "screenshot readback",
+                    need,
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuToCpu,
+                )?);
+            }
+        }
+        let cmd = sync.cmd;
+        let depth_img = self.depth.as_ref().expect("depth exists with a swapchain");
+        let mut color = Attachment {
+            image: self.swapchain.images[index as usize],
+            view: self.swapchain.views[index as usize],
+            state: Access::Present,
+        };
+        let mut depth = Attachment {
+            image: depth_img.raw,
+            view: depth_img.view,
+            state: self.depth_state,
+        };
+        unsafe {
+            d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
+                .vk("vkResetCommandBuffer")?;
+            d.begin_command_buffer(
+                cmd,
+                &vk::CommandBufferBeginInfo::default()
+                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            )
+            .vk("vkBeginCommandBuffer")?;
+        }
+        let casters = self
+            .core
+            .record(cmd, f, view, &plan, &mut color, &mut depth, extent);
+        self.depth_state = depth.state;
+        if want_copy {
+            image_barrier(
+                d,
+                cmd,
+                color.image,
+                vk::ImageAspectFlags::COLOR,
+                0..1,
+                Access::ColorAttachment,
+                Access::TransferSrc,
+            );
+            copy_to_buffer(
+                d,
+                cmd,
+                color.image,
+                vk::ImageAspectFlags::COLOR,
+                extent,
+                self.screenshot.as_ref().expect("buffer").raw,
+            );
+            transfer_to_host_barrier(d, cmd);
+            image_barrier(
+                d,
+                cmd,
+                color.image,
+                vk::ImageAspectFlags::COLOR,
+                0..1,
+                Access::TransferSrc,
+                Access::Present,
+            );
+        } else {
+            image_barrier(
+                d,
+                cmd,
+                color.image,
+                vk::ImageAspectFlags::COLOR,
+                0..1,
+                Access::ColorAttachment,
+                Access::Present,
+            );
+        }
+        unsafe {
+            d.end_command_buffer(cmd).vk("vkEndCommandBuffer")?;
+            let waits = [vk::SemaphoreSubmitInfo::default()
+                .semaphore(sync.acquired)
+                .stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)];
+            let signals = [vk::SemaphoreSubmitInfo::default()
+                .semaphore(self.swapchain.render_finished[index as usize])
+                .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = [vk::SubmitInfo2::default()
+                .wait_semaphore_infos(&waits)
+                .command_buffer_infos(&cmds)
+                .signal_semaphore_infos(&signals)];
+            d.queue_submit2(ctx.queue, &submit, sync.fence)
+                .vk("vkQueueSubmit2")?;
+        }
+        let stale = self.swapchain.present(index)?;
+        self.frame = (f + 1) % FRAMES_IN_FLIGHT;
+        let mut shot = None;
+        if want_copy {
+            unsafe { d.wait_for_fences(&[self.frames[f].fence], true, u64::MAX) }
+                .vk("vkWaitForFences")?;
+            let bgra = self.swapchain.format == vk::Format::B8G8R8A8_SRGB;
+            let buf = self.screenshot.as_mut().expect("buffer");
+            let bytes = buf
+                .mapped()
+                .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
+            shot = Some(rgba_from_readback(bytes, extent.width, extent.height, bgra));
+        } else if screenshot {
+            log::warn!(
+                "this swapchain cannot be copied from (no TRANSFER_SRC usage); no screenshot"
+            );
+        }
+        if stale {
+            let (w, h) = self.wanted;
+            self.resize(w, h)?;
+        }
+        Ok(DrawResult::Drawn {
+            casters,
+            screenshot: shot,
+        })
+    }
+}
+
+impl Drop for WindowRenderer {
+    fn drop(&mut self) {
+        let ctx = self.core.ctx.clone();
+        unsafe {
+            let _ = ctx.device.device_wait_idle();
+            for f in self.frames.drain(..) {
+                ctx.device.destroy_fence(f.fence, None);
+                ctx.device.destroy_semaphore(f.acquired, None);
+                ctx.free_command_buffer(f.cmd);
+            }
+        }
+    }
+}

@@ -1,0 +1,167 @@
+//! The viewer under Xvfb on lavapipe, validation on: its screenshot matches the offscreen render
+//! of the same scene, camera and size, and resizing (through 0×0 and back) is clean.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command};
+use umbra::reference::metrics::{flip, psnr};
+
+/// A private X server for one test; killed on drop.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Xvfb {
+        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let base = 100 + (std::process::id() % 200) * 4;
+        for _ in 0..200 {
+            let n = base + NEXT.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            let lock = format!("/tmp/.X{n}-lock");
+            if Path::new(&lock).exists() {
+                continue;
+            }
+            let child = Command::new("Xvfb")
+                .args([
+                    format!(":{n}").as_str(),
+                    "-screen",
+                    "0",
+                    "1280x1024x24",
+                    "-nolisten",
+                    "tcp",
+                ])
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::null())
+                .spawn()
+                .expect("Xvfb is needed for the viewer tests (apt-get install xvfb)");
+            let socket = format!("/tmp/.X11-unix/X{n}");
+            let mut child = child;
+            for _ in 0..100 {
+                if child.try_wait().ok().flatten().is_some() {
+                    break; // this display was taken: try the next
+                }
+                if Path::new(&socket).exists() {
+                    std::thread::sleep(std::time::Duration::from_millis(100));
+                    if child.try_wait().ok().flatten().is_none() {
+                        return Xvfb {
+                            child,
+                            display: format!(":{n}"),
+                        };
+                    }
+                    break;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(50));
+            }
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+        panic!("could not start Xvfb");
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn out(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("umbra-test-output");
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn umbra(args: &[&str], display: Option<&str>) -> (bool, String) {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_umbra"));
+    c.args(args).env_remove("WAYLAND_DISPLAY");
+    if let Some(d) = display {
+        c.env("DISPLAY", d);
+    }
+    let o = c.output().unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o.status.success(), text)
+}
+
+#[test]
+fn viewer_screenshot_matches_offscreen_render() {
+    let x = Xvfb::start();
+    let shot = out("viewer_shot.png");
+    let offscreen = out("viewer_offscreen.png");
+    let common = ["--size", "320x240", "--sun-dir=-0.6,-0.5,-0.4"];
+    let mut args = vec![
+        "view",
+        "--frames",
+        "30",
+        "--screenshot",
+        shot.to_str().unwrap(),
+        "--validation",
+    ];
+    args.extend(common);
+    let (ok, log) = umbra(&args, Some(&x.display));
+    assert!(ok, "viewer failed:\n{log}");
+    let mut args = vec!["render", "-o", offscreen.to_str().unwrap(), "--validation"];
+    args.extend(common);
+    let (ok, log) = umbra(&args, None);
+    assert!(ok, "render failed:\n{log}");
+    let a = image::open(&shot).unwrap().to_rgba8();
+    let b = image::open(&offscreen).unwrap().to_rgba8();
+    assert_eq!(a.dimensions(), (320, 240));
+    assert_eq!(a.dimensions(), b.dimensions());
+    let (p, f) = (psnr(&b, &a), flip(&b, &a));
+    eprintln!("viewer vs offscreen: PSNR {p:.1} dB, FLIP {f:.5}");
+    // Same passes, same plan: identical up to the camera reconstructed by the controller.
+    assert!(
+        p > 40.0 && f < 0.01,
+        "viewer and offscreen differ: PSNR {p:.1} dB, FLIP {f:.4}"
+    );
+}
+
+#[test]
+fn resizing_through_zero_and_back_is_clean() {
+    let x = Xvfb::start();
+    let shot = out("viewer_resized.png");
+    let (ok, log) = umbra(
+        &[
+            "view",
+            "--frames",
+            "12",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--validation",
+            "--no-vsync",
+            "--size",
+            "320x240",
+            "--resize-script",
+            "400x300,0x0,0x0,200x150,0x0,640x360,300x200",
+        ],
+        Some(&x.display),
+    );
+    assert!(ok, "viewer failed while resizing:\n{log}");
+    assert!(!log.contains("panicked"), "{log}");
+    let img = image::open(&shot).unwrap().to_rgba8();
+    assert_eq!(
+        img.dimensions(),
+        (300, 200),
+        "the last size must be the one on screen"
+    );
+}
+
+#[test]
+fn viewer_without_a_display_fails_with_one_line() {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_umbra"));
+    c.args(["view", "--frames", "1"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY");
+    let o = c.output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        err.starts_with("error: ") && err.trim().lines().count() == 1,
+        "{err}"
+    );
+}
