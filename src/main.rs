@@ -2,7 +2,9 @@
 
 use anyhow::Context as _;
 use clap::Parser;
-use umbra::app::cli::{load_scene, make_view, Cli, Command, CompareArgs, RenderArgs, ViewArgsCmd};
+use umbra::app::cli::{
+    load_scene, make_view, pcf_of, BenchArgs, Cli, Command, CompareArgs, RenderArgs, ViewArgsCmd,
+};
 use umbra::gpu::{Context, ContextDesc, Validation};
 use umbra::render::Renderer;
 
@@ -15,6 +17,7 @@ fn main() {
         Command::Render(a) => render(a),
         Command::Compare(a) => compare(a),
         Command::View(a) => view(a),
+        Command::Bench(a) => bench(a),
     };
     if let Err(e) = result {
         let msg = format!("{e:#}").replace('\n', " ");
@@ -152,4 +155,77 @@ fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
         validation: a.validation,
         resize_script: a.resize_script,
     })
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v[v.len() / 2]
+    }
+}
+
+fn bench(a: BenchArgs) -> anyhow::Result<()> {
+    let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
+    let base = make_view(&scene, &a.view)?;
+    let ctx = Context::new(&ContextDesc {
+        device: a.device.clone(),
+        ..Default::default()
+    })?;
+    let mut renderer = Renderer::new(&ctx, &scene)?;
+    let (w, h) = a.view.size;
+    println!(
+        "{} ({} triangles) at {w}x{h} on {}; medians of {} frames after 1 warm-up",
+        scene.name,
+        renderer.triangles(),
+        ctx.device_name,
+        a.repeat
+    );
+    println!();
+    println!(
+        "| shadow map | PCF | GPU shadow ms | GPU camera ms | GPU total ms | wall ms | casters |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for &map in &a.maps {
+        let kernels = if map == 0 {
+            &a.kernels[..a.kernels.len().min(1)]
+        } else {
+            &a.kernels[..]
+        };
+        for &k in kernels {
+            let mut v = base.clone();
+            v.shadow.enabled = map > 0;
+            v.shadow.map_size = map.max(16);
+            v.shadow.pcf = pcf_of(k);
+            renderer.render(&v, w, h)?;
+            let mut frames = Vec::new();
+            for _ in 0..a.repeat.max(1) {
+                frames.push(renderer.render(&v, w, h)?.stats);
+            }
+            let m = |f: &dyn Fn(&umbra::render::FrameStats) -> f64| {
+                median(frames.iter().map(f).collect())
+            };
+            let sh = m(&|s| s.gpu_shadow_ms.unwrap_or(f64::NAN));
+            let cam = m(&|s| s.gpu_camera_ms.unwrap_or(f64::NAN));
+            let tot =
+                m(&|s| s.gpu_shadow_ms.unwrap_or(f64::NAN) + s.gpu_camera_ms.unwrap_or(f64::NAN));
+            let wall = m(&|s| s.wall_ms);
+            let map_label = if map == 0 {
+                "off".to_string()
+            } else {
+                format!("{map}²")
+            };
+            let pcf = if map == 0 {
+                "-".to_string()
+            } else {
+                format!("{:?}", v.shadow.pcf)
+            };
+            println!(
+                "| {map_label} | {pcf} | {sh:.1} | {cam:.1} | {tot:.1} | {wall:.1} | {} |",
+                frames[0].casters_drawn
+            );
+        }
+    }
+    Ok(())
 }

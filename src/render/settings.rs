@@ -104,7 +104,7 @@ impl Default for ShadowSettings {
             enabled: true,
             map_size: 2048,
             format: ShadowFormat::D32,
-            pcf: Pcf::P3x3,
+            pcf: Pcf::P2x2,
             constant_bias: 1.0,
             slope_bias: 1.5,
             normal_offset: 1.5,

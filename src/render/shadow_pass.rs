@@ -231,11 +231,6 @@ impl ShadowPass {
         self.ctx.end_label(cmd);
         drawn
     }
-
-    /// Records a transition of the map for a copy out, and back (for `ViewMode::ShadowMap`).
-    pub fn set_state(&mut self, a: Access) {
-        self.state = a;
-    }
 }
 
 impl Drop for ShadowPass {
