@@ -453,6 +453,20 @@ impl Context {
         unsafe { self.device.free_command_buffers(*pool, &[cmd]) };
     }
 
+    /// Resets `cmd` and begins recording it for one submission.
+    pub fn begin_one_time(&self, cmd: vk::CommandBuffer) -> Result<(), GpuError> {
+        unsafe {
+            self.device
+                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
+                .vk("vkResetCommandBuffer")?;
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            self.device
+                .begin_command_buffer(cmd, &begin)
+                .vk("vkBeginCommandBuffer")
+        }
+    }
+
     /// Records `f` into a one-time command buffer, submits it and waits for it to finish.
     pub fn immediate<R>(&self, f: impl FnOnce(vk::CommandBuffer) -> R) -> Result<R, GpuError> {
         let cmd = self.allocate_command_buffer()?;

@@ -7,6 +7,28 @@ use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
+/// A named allocation from the context's allocator.
+fn allocate(
+    ctx: &Context,
+    name: &str,
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> Result<Allocation, GpuError> {
+    ctx.allocator()
+        .allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        })
+        .map_err(|e| GpuError::Alloc {
+            name: name.into(),
+            message: e.to_string(),
+        })
+}
+
 /// A buffer with its memory.
 pub struct Buffer {
     ctx: Arc<Context>,
@@ -33,22 +55,13 @@ impl Buffer {
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         let raw = unsafe { ctx.device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
-        let allocation = ctx
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|e| {
+        let allocation = match allocate(ctx, name, requirements, location, true) {
+            Ok(a) => a,
+            Err(e) => {
                 unsafe { ctx.device.destroy_buffer(raw, None) };
-                GpuError::Alloc {
-                    name: name.into(),
-                    message: e.to_string(),
-                }
-            })?;
+                return Err(e);
+            }
+        };
         unsafe {
             ctx.device
                 .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
@@ -174,22 +187,13 @@ impl Image {
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let raw = unsafe { ctx.device.create_image(&info, None) }.vk("vkCreateImage")?;
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
-        let allocation = ctx
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|e| {
+        let allocation = match allocate(ctx, name, requirements, MemoryLocation::GpuOnly, false) {
+            Ok(a) => a,
+            Err(e) => {
                 unsafe { ctx.device.destroy_image(raw, None) };
-                GpuError::Alloc {
-                    name: name.into(),
-                    message: e.to_string(),
-                }
-            })?;
+                return Err(e);
+            }
+        };
         unsafe {
             ctx.device
                 .bind_image_memory(raw, allocation.memory(), allocation.offset())

@@ -100,6 +100,56 @@ pub fn set_layout(
 // lavapipe (and the Vulkan minimum) allow 128 bytes of push constants.
 const _: () = assert!(scene::IMMEDIATE_SIZE <= 128 && shadow::IMMEDIATE_SIZE <= 128);
 
+/// Creates a descriptor pool sized for `count` sets of `group` (descriptor counts taken from the
+/// reflected bindings) and allocates the sets with `layout`.
+pub fn allocate_sets(
+    ctx: &Context,
+    bindings: &[ReflectedBinding],
+    group: u32,
+    layout: vk::DescriptorSetLayout,
+    count: usize,
+) -> Result<(vk::DescriptorPool, Vec<vk::DescriptorSet>), GpuError> {
+    let n = count.max(1) as u32;
+    let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
+    for b in bindings.iter().filter(|b| b.group == group) {
+        let ty = b.descriptor_type();
+        match sizes.iter_mut().find(|s| s.ty == ty) {
+            Some(s) => s.descriptor_count += n,
+            None => sizes.push(vk::DescriptorPoolSize {
+                ty,
+                descriptor_count: n,
+            }),
+        }
+    }
+    let pool = unsafe {
+        ctx.device.create_descriptor_pool(
+            &vk::DescriptorPoolCreateInfo::default()
+                .max_sets(n)
+                .pool_sizes(&sizes),
+            None,
+        )
+    }
+    .vk("vkCreateDescriptorPool")?;
+    let layouts = vec![layout; n as usize];
+    let sets = unsafe {
+        ctx.device.allocate_descriptor_sets(
+            &vk::DescriptorSetAllocateInfo::default()
+                .descriptor_pool(pool)
+                .set_layouts(&layouts),
+        )
+    };
+    match sets {
+        Ok(sets) => Ok((pool, sets)),
+        Err(e) => {
+            unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
+            Err(GpuError::Vk {
+                call: "vkAllocateDescriptorSets",
+                result: e,
+            })
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

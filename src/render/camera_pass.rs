@@ -2,10 +2,14 @@
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
 use super::gpu_scene::{GpuScene, VertexAttributes};
-use super::pipeline::{create_layout, create_pipeline, set_viewport, PipelineDesc};
+use super::pipeline::{
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
+};
 use super::uniforms::{FrameUniform, SceneImmediates};
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::gpu::shaders::{create_module, scene as sh, set_layout, ReflectedBinding};
+use crate::gpu::shaders::{
+    allocate_sets, create_module, scene as sh, set_layout, ReflectedBinding,
+};
 use crate::gpu::Buffer;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -105,39 +109,7 @@ impl CameraPass {
         desc.attributes = &[];
         desc.depth_test = false;
         let map_pipeline = create_pipeline(ctx, &desc)?;
-        let n = slots.max(1) as u32;
-        let sizes = [
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::UNIFORM_BUFFER,
-                descriptor_count: n,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::SAMPLED_IMAGE,
-                descriptor_count: n,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::SAMPLER,
-                descriptor_count: n,
-            },
-        ];
-        let pool = unsafe {
-            ctx.device.create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(n)
-                    .pool_sizes(&sizes),
-                None,
-            )
-        }
-        .vk("vkCreateDescriptorPool")?;
-        let layouts = vec![frame_layout; n as usize];
-        let sets = unsafe {
-            ctx.device.allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(pool)
-                    .set_layouts(&layouts),
-            )
-        }
-        .vk("vkAllocateDescriptorSets")?;
+        let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, frame_layout, slots)?;
         let mut slot_list = Vec::new();
         for (i, set) in sets.into_iter().enumerate() {
             let buffer = Buffer::new(
@@ -257,17 +229,7 @@ impl CameraPass {
             .clear_value(vk::ClearValue {
                 color: vk::ClearColorValue { float32: clear },
             })];
-        let depth_att = vk::RenderingAttachmentInfo::default()
-            .image_view(depth)
-            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                depth_stencil: vk::ClearDepthStencilValue {
-                    depth: 0.0,
-                    stencil: 0,
-                },
-            });
+        let depth_att = depth_clear_attachment(depth);
         let rendering = vk::RenderingInfo::default()
             .render_area(vk::Rect2D {
                 offset: vk::Offset2D::default(),

@@ -3,7 +3,7 @@
 
 use super::uniforms::MaterialUniform;
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::gpu::shaders::{scene as sh, set_layout};
+use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
 use crate::gpu::{Buffer, Image};
 use crate::math::Aabb;
 use crate::scene::{AlphaMode, Scene};
@@ -182,30 +182,8 @@ impl GpuScene {
         };
 
         let material_layout = set_layout(ctx, sh::BINDINGS, 1, "material set layout")?;
-        let n = scene.materials.len().max(1) as u32;
-        let pool_sizes = [
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::UNIFORM_BUFFER,
-                descriptor_count: n,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::SAMPLED_IMAGE,
-                descriptor_count: 4 * n,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::SAMPLER,
-                descriptor_count: n,
-            },
-        ];
-        let pool = unsafe {
-            ctx.device.create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(n)
-                    .pool_sizes(&pool_sizes),
-                None,
-            )
-        }
-        .vk("vkCreateDescriptorPool")?;
+        let (pool, sets) =
+            allocate_sets(ctx, sh::BINDINGS, 1, material_layout, scene.materials.len())?;
         let sampler_info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::LINEAR)
             .min_filter(vk::Filter::LINEAR)
@@ -224,15 +202,6 @@ impl GpuScene {
             unsafe { ctx.device.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
         ctx.set_name(sampler, "material sampler");
 
-        let layouts = vec![material_layout; n as usize];
-        let sets = unsafe {
-            ctx.device.allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(pool)
-                    .set_layouts(&layouts),
-            )
-        }
-        .vk("vkAllocateDescriptorSets")?;
         let mut material_buffers = Vec::new();
         for (i, m) in scene.materials.iter().enumerate() {
             let u = MaterialUniform {

@@ -151,3 +151,18 @@ pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D)
         ctx.device.cmd_set_scissor(cmd, 0, &sc);
     }
 }
+
+/// A depth attachment cleared to 0 (reversed-z: 0 is the far plane) and stored.
+pub fn depth_clear_attachment(view: vk::ImageView) -> vk::RenderingAttachmentInfo<'static> {
+    vk::RenderingAttachmentInfo::default()
+        .image_view(view)
+        .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(vk::ClearValue {
+            depth_stencil: vk::ClearDepthStencilValue {
+                depth: 0.0,
+                stencil: 0,
+            },
+        })
+}

@@ -243,16 +243,7 @@ impl Renderer {
             view: t.depth.view,
             state: t.depth_state,
         };
-        unsafe {
-            d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
-                .vk("vkResetCommandBuffer")?;
-            d.begin_command_buffer(
-                cmd,
-                &vk::CommandBufferBeginInfo::default()
-                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-            )
-            .vk("vkBeginCommandBuffer")?;
-        }
+        ctx.begin_one_time(cmd)?;
         let casters = self
             .core
             .record(cmd, 0, view, &plan, &mut color, &mut depth, extent);

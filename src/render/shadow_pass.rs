@@ -2,7 +2,9 @@
 //! depth bias pushing casters away from the light (negative factors under reversed-z).
 
 use super::gpu_scene::GpuScene;
-use super::pipeline::{create_layout, create_pipeline, set_viewport, PipelineDesc};
+use super::pipeline::{
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
+};
 use super::settings::{ShadowFormat, ShadowSettings};
 use super::uniforms::ShadowImmediates;
 use crate::gpu::barrier::{image_barrier, Access};
@@ -160,17 +162,7 @@ impl ShadowPass {
             self.state,
             Access::DepthAttachment,
         );
-        let depth_attachment = vk::RenderingAttachmentInfo::default()
-            .image_view(map.view)
-            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                depth_stencil: vk::ClearDepthStencilValue {
-                    depth: 0.0,
-                    stencil: 0,
-                },
-            });
+        let depth_attachment = depth_clear_attachment(map.view);
         let rendering = vk::RenderingInfo::default()
             .render_area(vk::Rect2D {
                 offset: vk::Offset2D::default(),

@@ -185,16 +185,7 @@ impl WindowRenderer {
             view: depth_img.view,
             state: self.depth_state,
         };
-        unsafe {
-            d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
-                .vk("vkResetCommandBuffer")?;
-            d.begin_command_buffer(
-                cmd,
-                &vk::CommandBufferBeginInfo::default()
-                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-            )
-            .vk("vkBeginCommandBuffer")?;
-        }
+        ctx.begin_one_time(cmd)?;
         let casters = self
             .core
             .record(cmd, f, view, &plan, &mut color, &mut depth, extent);
