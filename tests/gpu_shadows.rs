@@ -11,7 +11,7 @@ use common::*;
 use glam::{Mat4, Vec3};
 use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
-use umbra::render::{Renderer, ShadowSettings, View, ViewMode};
+use umbra::render::{Renderer, ShadowFormat, ShadowSettings, View, ViewMode};
 use umbra::scene::shapes::{add_object, colored, cuboid, plane};
 use umbra::scene::{Camera, Light, LightKind, Scene};
 
@@ -204,6 +204,29 @@ fn box_shadow_matches_geometry_at_80_45_15_degrees() {
 }
 
 #[test]
+fn d16_shadow_map_matches_geometry_too() {
+    let ctx = context();
+    for elevation in [60.0f32, 25.0] {
+        let light = Light::sun(Light::sun_direction(elevation.to_radians(), 0.6), 2.0);
+        let scene = box_scene(light);
+        let mut r = Renderer::new(&ctx, &scene).unwrap();
+        let mut view = shadow_view(camera_on_shadow_side(light.direction));
+        view.shadow.format = ShadowFormat::D16;
+        let f = r.render(&view, W, H).unwrap();
+        let (j, diff) = judge(&f, &light, EDGE_TEXELS * f.plan.texel_world);
+        save(&diff, &format!("box_shadow_d16_{elevation}_diff.png"));
+        assert!(j.exact_shadowed > 60);
+        assert_eq!(
+            (j.false_shadow, j.false_light),
+            (0, 0),
+            "D16 at {elevation}° (of {} judged)",
+            j.judged
+        );
+    }
+    assert_validation_clean(&ctx);
+}
+
+#[test]
 fn no_acne_on_a_plane_from_10_to_90_degrees() {
     let ctx = context();
     let mut s = Scene {
@@ -218,7 +241,10 @@ fn no_acne_on_a_plane_from_10_to_90_degrees() {
         Mat4::IDENTITY,
     );
     let mut r = Renderer::new(&ctx, &s).unwrap();
-    for elevation in (10..=90).step_by(10) {
+    let cases = (10..=90)
+        .step_by(10)
+        .flat_map(|e| [(e, ShadowFormat::D32), (e, ShadowFormat::D16)]);
+    for (elevation, depth_format) in cases {
         for azimuth in [0.0f32, 0.9] {
             let dir = Light::sun_direction((elevation as f32).to_radians(), azimuth);
             let mut view = shadow_view(Camera::look_at(
@@ -228,6 +254,7 @@ fn no_acne_on_a_plane_from_10_to_90_degrees() {
                 0.1,
             ));
             view.sun_direction = Some(dir);
+            view.shadow.format = depth_format;
             let f = r.render(&view, W, H).unwrap();
             let m = f.plan.clip_from_world;
             let mut ground = 0;
@@ -246,7 +273,7 @@ fn no_acne_on_a_plane_from_10_to_90_degrees() {
                 save(&f.image, &format!("acne_{elevation}.png"));
             }
             assert!(ground > 10000);
-            assert_eq!(shadowed, 0, "acne: {shadowed} of {ground} ground pixels not fully lit at elevation {elevation}°");
+            assert_eq!(shadowed, 0, "acne ({depth_format:?}): {shadowed} of {ground} ground pixels not fully lit at elevation {elevation}°");
         }
     }
     assert_validation_clean(&ctx);

@@ -183,6 +183,9 @@ pub struct ViewArgs {
     /// Direction the sun's light travels X,Y,Z (e.g. -1,-1,0).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub sun_dir: Option<Vec3>,
+    /// Intensity of the sun (the first directional light, or the default sun).
+    #[arg(long)]
+    pub sun_intensity: Option<f32>,
     /// Output: lit, shadow (visibility), normals, shadow-map.
     #[arg(long = "view", value_enum, default_value = "lit")]
     pub mode: ViewArg,
@@ -306,6 +309,12 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     v.sun_direction = match a.sun_dir {
         Some(d) if d.length_squared() == 0.0 => bail!("--sun-dir must not be zero"),
         d => d,
+    };
+    v.sun_intensity = match a.sun_intensity {
+        Some(i) if !(i.is_finite() && i >= 0.0) => {
+            bail!("--sun-intensity must be a finite number >= 0")
+        }
+        i => i,
     };
     v.mode = match a.mode {
         ViewArg::Lit => ViewMode::Lit,

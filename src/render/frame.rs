@@ -36,6 +36,11 @@ pub fn effective_lights(scene: &Scene, view: &View) -> Vec<Light> {
             lights.insert(0, Light::sun(d, DEFAULT_SUN_INTENSITY));
         }
     }
+    if let Some(i) = view.sun_intensity.filter(|i| i.is_finite() && *i >= 0.0) {
+        if let Some(l) = lights.iter_mut().find(|l| l.kind == LightKind::Directional) {
+            l.intensity = i;
+        }
+    }
     lights.truncate(MAX_LIGHTS);
     lights
 }

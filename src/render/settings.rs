@@ -121,6 +121,8 @@ pub struct View {
     pub camera: Camera,
     /// Override for the direction of the scene's first directional light (or the default sun).
     pub sun_direction: Option<Vec3>,
+    /// Override for that light's intensity.
+    pub sun_intensity: Option<f32>,
     /// Output.
     pub mode: ViewMode,
     /// Shadow settings.
@@ -137,6 +139,7 @@ impl View {
         Self {
             camera,
             sun_direction: None,
+            sun_intensity: None,
             mode: ViewMode::Lit,
             shadow: ShadowSettings::default(),
             ambient: Vec3::splat(0.12),
