@@ -159,6 +159,7 @@ fn truncated_glb() {
             d.join("whole.png").to_str().unwrap(),
             "--size",
             "32x32",
+            "--validation",
         ],
         &d,
     );
