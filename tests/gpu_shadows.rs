@@ -23,6 +23,13 @@ const H: u32 = 192;
 // Half extents of the caster standing on the ground at the origin, per test thread.
 thread_local! {
     static CASTER_HALF: std::cell::Cell<Vec3> = const { std::cell::Cell::new(Vec3::ONE) };
+    // World placement of the whole test scene (uniform scale, then translation), per test thread.
+    static PLACEMENT: std::cell::Cell<(f32, Vec3)> = const { std::cell::Cell::new((1.0, Vec3::ZERO)) };
+}
+
+fn world_from_local() -> Mat4 {
+    let (s, t) = PLACEMENT.with(|p| p.get());
+    Mat4::from_translation(t) * Mat4::from_scale(Vec3::splat(s))
 }
 
 fn box_aabb() -> Aabb {
@@ -58,6 +65,17 @@ fn box_scene(light: Light) -> Scene {
     caster_scene(light, Vec3::ONE)
 }
 
+/// The box scene placed at `scale` and `offset` in the world (for huge, tiny and far scenes).
+fn placed_box_scene(light: Light, scale: f32, offset: Vec3) -> Scene {
+    let mut s = caster_scene(light, Vec3::ONE);
+    PLACEMENT.with(|p| p.set((scale, offset)));
+    let m = world_from_local();
+    for inst in &mut s.instances {
+        inst.world_from_model = m * inst.world_from_model;
+    }
+    s
+}
+
 /// Exact visibility of ground point `g` from the light: 1 lit, 0 blocked by the caster.
 fn exact_visible(light: &Light, g: Vec3) -> bool {
     let (dir, t_max) = match light.kind {
@@ -70,9 +88,15 @@ fn exact_visible(light: &Light, g: Vec3) -> bool {
     ray_aabb(&Ray::new(g, dir), &box_aabb(), 1e-5, t_max).is_none()
 }
 
-/// The ground point seen through pixel (x, y), or None when the box or the sky is seen.
+/// The ground point (in the scene's local frame) seen through pixel (x, y), or None when the box
+/// or the sky is seen.
 fn ground_point(clip_from_world: &Mat4, x: u32, y: u32) -> Option<Vec3> {
     let (o, d) = pixel_ray(clip_from_world, x, y, W, H);
+    let local = world_from_local().inverse();
+    let (o, d) = (
+        local.transform_point3(o),
+        local.transform_vector3(d).normalize(),
+    );
     if d.y >= -1e-6 {
         return None;
     }
@@ -200,6 +224,46 @@ fn box_shadow_matches_geometry_at_80_45_15_degrees() {
             j.judged
         );
     }
+    assert_validation_clean(&ctx);
+}
+
+#[test]
+fn huge_tiny_and_far_scenes_match_geometry() {
+    // The same box on a plane at 1 mm, 1 km and 10 km from the origin: shadows stay exact outside
+    // the band (measured in the scene's own units).
+    let ctx = context();
+    let light = Light::sun(Light::sun_direction(35f32.to_radians(), 0.6), 2.0);
+    for (scale, offset) in [
+        (1e-3, Vec3::ZERO),
+        (1e3, Vec3::ZERO),
+        (1.0, Vec3::new(1e4, 0.0, -1e4)),
+        (1e-2, Vec3::new(50.0, 3.0, 0.0)),
+    ] {
+        let scene = placed_box_scene(light, scale, offset);
+        let mut r = Renderer::new(&ctx, &scene).unwrap();
+        let local_cam = camera_on_shadow_side(light.direction);
+        let m = world_from_local();
+        let eye = m.transform_point3(local_cam.position());
+        let target = m.transform_point3(
+            local_cam.position() + local_cam.world_from_view.transform_vector3(-Vec3::Z),
+        );
+        let cam = Camera::look_at(eye, target, local_cam.fov_y, 0.1 * scale);
+        let f = r.render(&shadow_view(cam), W, H).unwrap();
+        let (j, diff) = judge(&f, &light, EDGE_TEXELS * f.plan.texel_world / scale);
+        save(&diff, &format!("placed_{scale}_{}_diff.png", offset.x));
+        assert!(
+            j.judged > (W * H / 3) as usize && j.exact_shadowed > 200,
+            "scale {scale} offset {offset}: {} judged",
+            j.judged
+        );
+        assert_eq!(
+            (j.false_shadow, j.false_light),
+            (0, 0),
+            "scale {scale} offset {offset} (of {} judged)",
+            j.judged
+        );
+    }
+    PLACEMENT.with(|p| p.set((1.0, Vec3::ZERO)));
     assert_validation_clean(&ctx);
 }
 

@@ -280,10 +280,10 @@ impl Scene {
             .sum()
     }
 
-    /// Records a warning (also logged).
+    /// Records a warning in `warnings` (logged at debug level; front ends print the list).
     pub fn warn(&mut self, msg: impl Into<String>) {
         let m = msg.into();
-        log::warn!("{}: {m}", self.name);
+        log::debug!("{}: {m}", self.name);
         self.warnings.push(m);
     }
 
