@@ -38,6 +38,10 @@ fi
 if [ "$need_xvfb" = 1 ] && ! command -v Xvfb >/dev/null 2>&1; then
   missing+=(xvfb)
 fi
+# Libraries the viewer's X11 backend (winit) loads at run time.
+if [ "$need_xvfb" = 1 ] && ! ldconfig -p 2>/dev/null | grep -q 'libxkbcommon-x11\.so\.0'; then
+  missing+=(libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6)
+fi
 
 if [ "${#missing[@]}" -eq 0 ]; then
   exit 0
