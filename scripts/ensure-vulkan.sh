@@ -26,7 +26,7 @@ have_any() {
 }
 
 missing=()
-if ! ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'; then
+if ! ldconfig -p 2>/dev/null | grep 'libvulkan\.so\.1' >/dev/null; then
   missing+=(libvulkan1)
 fi
 if ! have_any '/usr/share/vulkan/icd.d/*.json' '/etc/vulkan/icd.d/*.json' && [ -z "${VK_ICD_FILENAMES:-}${VK_DRIVER_FILES:-}" ]; then
@@ -39,7 +39,7 @@ if [ "$need_xvfb" = 1 ] && ! command -v Xvfb >/dev/null 2>&1; then
   missing+=(xvfb)
 fi
 # Libraries the viewer's X11 backend (winit) loads at run time.
-if [ "$need_xvfb" = 1 ] && ! ldconfig -p 2>/dev/null | grep -q 'libxkbcommon-x11\.so\.0'; then
+if [ "$need_xvfb" = 1 ] && ! ldconfig -p 2>/dev/null | grep 'libxkbcommon-x11\.so\.0' >/dev/null; then
   missing+=(libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6)
 fi
 
