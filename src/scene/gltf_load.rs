@@ -127,7 +127,108 @@ fn corrupt(path: &Path, message: String) -> LoadError {
     }
 }
 
+/// The JSON of a `.glb` (after checking its container: magic, version 2, declared length and
+/// chunk lengths within the file), or the whole input for `.gltf`.
+fn json_part<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a [u8], LoadError> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(bytes);
+    }
+    let word = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]) as usize)
+    };
+    let bad = |what: &str| invalid(path, format!("GLB container: {what}"));
+    let version = word(4).ok_or_else(|| bad("truncated header"))?;
+    let length = word(8).ok_or_else(|| bad("truncated header"))?;
+    if version != 2 {
+        return Err(bad(&format!("version {version}, expected 2")));
+    }
+    if length < 20 || length > bytes.len() {
+        return Err(bad(&format!(
+            "declared length {length} but the file has {} bytes",
+            bytes.len()
+        )));
+    }
+    let mut at = 12;
+    let mut json = None;
+    while at < length {
+        let (Some(n), Some(kind)) = (word(at), bytes.get(at + 4..at + 8)) else {
+            return Err(bad("truncated chunk header"));
+        };
+        let end = at
+            .checked_add(8)
+            .and_then(|x| x.checked_add(n))
+            .filter(|&e| e <= length)
+            .ok_or_else(|| bad("chunk runs past the end"))?;
+        if json.is_none() {
+            if kind != b"JSON" {
+                return Err(bad("first chunk is not JSON"));
+            }
+            json = Some(&bytes[at + 8..end]);
+        }
+        at = (end + 3) & !3;
+    }
+    json.ok_or_else(|| bad("no JSON chunk"))
+}
+
+/// Checks index references the gltf crate's own validation reads before checking them
+/// (mesh primitive attributes, targets and indices must name existing accessors).
+fn check_references(path: &Path, json: &[u8]) -> Result<(), LoadError> {
+    // Lossy: serde_json skips ignored strings without UTF-8 checks, so the gltf parser may accept
+    // bytes a strict parse rejects. Still-invalid JSON is reported by the gltf parser itself.
+    let text = String::from_utf8_lossy(json);
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Ok(());
+    };
+    let accessors = v
+        .get("accessors")
+        .and_then(|a| a.as_array())
+        .map_or(0, |a| a.len()) as u64;
+    let check = |value: &serde_json::Value, what: &str| -> Result<(), LoadError> {
+        match value.as_u64() {
+            Some(i) if i < accessors => Ok(()),
+            _ => Err(corrupt(
+                path,
+                format!("{what} refers to accessor {value}, but there are {accessors}"),
+            )),
+        }
+    };
+    let meshes = v
+        .get("meshes")
+        .and_then(|m| m.as_array())
+        .map(|m| m.as_slice())
+        .unwrap_or(&[]);
+    for (mi, mesh) in meshes.iter().enumerate() {
+        let prims = mesh
+            .get("primitives")
+            .and_then(|p| p.as_array())
+            .map(|p| p.as_slice())
+            .unwrap_or(&[]);
+        for (pi, prim) in prims.iter().enumerate() {
+            let label = format!("mesh {mi} primitive {pi}");
+            let mut maps: Vec<&serde_json::Value> = prim.get("attributes").into_iter().collect();
+            maps.extend(
+                prim.get("targets")
+                    .and_then(|t| t.as_array())
+                    .into_iter()
+                    .flatten(),
+            );
+            for map in maps {
+                for (name, value) in map.as_object().into_iter().flatten() {
+                    check(value, &format!("{label} attribute {name}"))?;
+                }
+            }
+            if let Some(i) = prim.get("indices") {
+                check(i, &format!("{label} indices"))?;
+            }
+        }
+    }
+    Ok(())
+}
+
 fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
+    check_references(path, json_part(path, bytes)?)?;
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| invalid(path, e))?;
     for ext in gltf.extensions_required() {
         if !SUPPORTED_REQUIRED.contains(&ext) {
@@ -449,6 +550,48 @@ fn check_accessor(path: &Path, a: &gltf::Accessor) -> Result<(), LoadError> {
     Ok(())
 }
 
+/// Rejects attributes whose component type or dimensions glTF does not allow for their semantic
+/// (the gltf crate's readers assume them and can panic otherwise).
+fn check_attribute_types(
+    path: &Path,
+    label: &str,
+    prim: &gltf::Primitive,
+) -> Result<(), LoadError> {
+    use gltf::accessor::{DataType as T, Dimensions as D};
+    use gltf::Semantic as S;
+    let ok = |a: &gltf::Accessor, types: &[T], dims: &[D], what: &str| {
+        if types.contains(&a.data_type()) && dims.contains(&a.dimensions()) {
+            Ok(())
+        } else {
+            Err(corrupt(
+                path,
+                format!(
+                    "{label}: {what} accessor {} is {:?} {:?}, which glTF does not allow",
+                    a.index(),
+                    a.data_type(),
+                    a.dimensions()
+                ),
+            ))
+        }
+    };
+    for (semantic, a) in prim.attributes() {
+        match semantic {
+            S::Positions => ok(&a, &[T::F32], &[D::Vec3], "POSITION")?,
+            S::Normals => ok(&a, &[T::F32], &[D::Vec3], "NORMAL")?,
+            S::Tangents => ok(&a, &[T::F32], &[D::Vec4], "TANGENT")?,
+            S::TexCoords(_) => ok(&a, &[T::F32, T::U8, T::U16], &[D::Vec2], "TEXCOORD")?,
+            S::Colors(_) => ok(&a, &[T::F32, T::U8, T::U16], &[D::Vec3, D::Vec4], "COLOR")?,
+            S::Joints(_) => ok(&a, &[T::U8, T::U16], &[D::Vec4], "JOINTS")?,
+            S::Weights(_) => ok(&a, &[T::F32, T::U8, T::U16], &[D::Vec4], "WEIGHTS")?,
+            _ => {}
+        }
+    }
+    if let Some(a) = prim.indices() {
+        ok(&a, &[T::U8, T::U16, T::U32], &[D::Scalar], "indices")?;
+    }
+    Ok(())
+}
+
 fn read_primitive(
     path: &Path,
     scene: &mut Scene,
@@ -459,6 +602,7 @@ fn read_primitive(
 ) -> Result<Option<Primitive>, LoadError> {
     use gltf::mesh::Mode;
     let label = format!("mesh {} primitive {}", mesh.index(), prim.index());
+    check_attribute_types(path, &label, prim)?;
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
     let Some(positions) = reader.read_positions() else {
         scene.warn(format!("{label} has no POSITION; skipped"));
