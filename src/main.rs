@@ -3,7 +3,8 @@
 use anyhow::Context as _;
 use clap::Parser;
 use umbra::app::cli::{
-    load_scene, make_view, pcf_of, BenchArgs, Cli, Command, CompareArgs, RenderArgs, ViewArgsCmd,
+    load_scene, make_view, pcf_of, scene_options, BenchArgs, Cli, Command, CompareArgs, RenderArgs,
+    ViewArgsCmd,
 };
 use umbra::gpu::{Context, ContextDesc, Validation};
 use umbra::render::Renderer;
@@ -41,7 +42,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         device: a.device.clone(),
         ..Default::default()
     })?;
-    let mut renderer = Renderer::new(&ctx, &scene)?;
+    let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     let (w, h) = a.view.size;
     let n = a.repeat.max(1);
     let mut frames = Vec::with_capacity(n);
@@ -96,7 +97,7 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
         device: a.device.clone(),
         ..Default::default()
     })?;
-    let mut renderer = Renderer::new(&ctx, &scene)?;
+    let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     renderer.set_read_depth(true);
     let (w, h) = a.view.size;
     view.mode = ViewMode::Lit;
@@ -148,6 +149,7 @@ fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
         scene,
         view,
         size: a.view.size,
+        scene_options: scene_options(&a.view),
         vsync: !a.no_vsync,
         frames: a.frames,
         screenshot: a.screenshot,
@@ -173,7 +175,7 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
         device: a.device.clone(),
         ..Default::default()
     })?;
-    let mut renderer = Renderer::new(&ctx, &scene)?;
+    let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     let (w, h) = a.view.size;
     println!(
         "{} ({} triangles) at {w}x{h} on {}; medians of {} frames after 1 warm-up",

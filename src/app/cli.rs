@@ -217,6 +217,9 @@ pub struct ViewArgs {
     /// Disable shadows.
     #[arg(long)]
     pub no_shadows: bool,
+    /// Anisotropic filtering (1 = off); default 8 on GPUs, off on CPU devices (lavapipe).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub anisotropy: Option<u32>,
     /// Add a ground plane under the model (to see its shadow).
     #[arg(long)]
     pub ground: bool,
@@ -274,6 +277,13 @@ pub fn load_scene(path: Option<&PathBuf>, ground: bool) -> anyhow::Result<Scene>
         crate::scene::shapes::add_ground(&mut s);
     }
     Ok(s)
+}
+
+/// Upload options from arguments.
+pub fn scene_options(a: &ViewArgs) -> crate::render::SceneOptions {
+    crate::render::SceneOptions {
+        anisotropy: a.anisotropy,
+    }
 }
 
 /// Builds the view from arguments.

@@ -35,6 +35,8 @@ pub struct ViewerOptions {
     pub view: View,
     /// Window inner size.
     pub size: (u32, u32),
+    /// Upload options (texture filtering).
+    pub scene_options: crate::render::SceneOptions,
     /// FIFO presentation (vsync).
     pub vsync: bool,
     /// Render this many frames, then exit (with `screenshot`, save the last one).
@@ -170,6 +172,7 @@ impl App {
             size.width,
             size.height,
             self.opts.vsync,
+            &self.opts.scene_options,
         )?;
         let view = self.opts.view.clone();
         let bounds = self

@@ -5,7 +5,7 @@
 use super::camera_pass::CameraPass;
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
-use super::settings::{View, ViewMode};
+use super::settings::{SceneOptions, View, ViewMode};
 use super::shadow_pass::ShadowPass;
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
@@ -47,10 +47,11 @@ impl FrameCore {
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
+        options: &SceneOptions,
         color_format: vk::Format,
         slots: usize,
     ) -> Result<Self, GpuError> {
-        let gpu = GpuScene::new(ctx, scene)?;
+        let gpu = GpuScene::new(ctx, scene, options)?;
         let shadow = ShadowPass::new(ctx)?;
         let camera = CameraPass::new(ctx, &gpu, color_format, slots)?;
         let query_pool = unsafe {

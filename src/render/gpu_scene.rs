@@ -1,6 +1,7 @@
 //! A scene uploaded to the GPU: one position stream (shared by the shadow pass), one attribute
 //! stream, one index buffer, textures with mipmaps, and a descriptor set per material.
 
+use super::settings::SceneOptions;
 use super::uniforms::MaterialUniform;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
@@ -75,7 +76,12 @@ pub struct GpuScene {
 
 impl GpuScene {
     /// Uploads `scene`.
-    pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self, GpuError> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        options: &SceneOptions,
+    ) -> Result<Self, GpuError> {
+        let anisotropy = options.resolved_anisotropy(ctx);
         // Geometry: one entry per mesh primitive, shared by all instances.
         let mut positions: Vec<[f32; 3]> = Vec::new();
         let mut attrs: Vec<VertexAttributes> = Vec::new();
@@ -191,12 +197,8 @@ impl GpuScene {
             .address_mode_u(vk::SamplerAddressMode::REPEAT)
             .address_mode_v(vk::SamplerAddressMode::REPEAT)
             .address_mode_w(vk::SamplerAddressMode::REPEAT)
-            .anisotropy_enable(ctx.anisotropy)
-            .max_anisotropy(if ctx.anisotropy {
-                8.0f32.min(ctx.properties.limits.max_sampler_anisotropy)
-            } else {
-                1.0
-            })
+            .anisotropy_enable(anisotropy > 1.0)
+            .max_anisotropy(anisotropy)
             .max_lod(vk::LOD_CLAMP_NONE);
         let sampler =
             unsafe { ctx.device.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;

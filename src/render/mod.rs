@@ -13,4 +13,4 @@ pub mod uniforms;
 pub mod window;
 
 pub use renderer::{FrameStats, RenderedFrame, Renderer};
-pub use settings::{Pcf, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};
+pub use settings::{Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};

@@ -3,7 +3,7 @@
 use super::camera_pass::DEPTH_FORMAT;
 use super::core::{Attachment, FrameCore};
 use super::frame::FramePlan;
-use super::settings::View;
+use super::settings::{SceneOptions, View};
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
@@ -127,7 +127,16 @@ pub fn rgba_from_readback(bytes: &[u8], width: u32, height: u32, bgra: bool) -> 
 impl Renderer {
     /// Uploads `scene` and creates the passes.
     pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self, GpuError> {
-        let core = FrameCore::new(ctx, scene, OFFSCREEN_FORMAT, 1)?;
+        Self::with_options(ctx, scene, &SceneOptions::default())
+    }
+
+    /// Uploads `scene` with `options` and creates the passes.
+    pub fn with_options(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        options: &SceneOptions,
+    ) -> Result<Self, GpuError> {
+        let core = FrameCore::new(ctx, scene, options, OFFSCREEN_FORMAT, 1)?;
         let cmd = ctx.allocate_command_buffer()?;
         Ok(Self {
             core,

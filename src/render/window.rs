@@ -5,7 +5,7 @@
 use super::camera_pass::DEPTH_FORMAT;
 use super::core::{Attachment, FrameCore};
 use super::renderer::{copy_to_buffer, rgba_from_readback, transfer_to_host_barrier};
-use super::settings::View;
+use super::settings::{SceneOptions, View};
 use super::swapchain::Swapchain;
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
@@ -60,9 +60,10 @@ impl WindowRenderer {
         width: u32,
         height: u32,
         vsync: bool,
+        options: &SceneOptions,
     ) -> Result<Self, GpuError> {
         let swapchain = Swapchain::new(ctx, surface, width, height, vsync)?;
-        let core = FrameCore::new(ctx, scene, swapchain.format, FRAMES_IN_FLIGHT)?;
+        let core = FrameCore::new(ctx, scene, options, swapchain.format, FRAMES_IN_FLIGHT)?;
         let mut frames = Vec::new();
         for i in 0..FRAMES_IN_FLIGHT {
             let cmd = ctx.allocate_command_buffer()?;
