@@ -2,6 +2,7 @@
 //! loaded from glTF 2.0 or built in code. Repairs (normals, tangents) happen here, with warnings.
 
 pub mod demo;
+mod gltf_input;
 pub mod gltf_load;
 pub mod material;
 pub mod shapes;
