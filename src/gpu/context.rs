@@ -128,13 +128,23 @@ unsafe extern "system" fn debug_callback(
         vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
             | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
     );
+    // Loader chatter (GENERAL only) goes to debug: the error it leads to is reported on its own.
+    let general_only = kind == vk::DebugUtilsMessageTypeFlagsEXT::GENERAL;
     if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
-        log::error!("vulkan {kind:?}: {msg}");
+        if general_only {
+            log::debug!("vulkan {kind:?}: {msg}");
+        } else {
+            log::error!("vulkan {kind:?}: {msg}");
+        }
         if !log.is_null() {
             (*log).errors.fetch_add(1, Ordering::SeqCst);
         }
     } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
-        log::warn!("vulkan {kind:?}: {msg}");
+        if general_only {
+            log::debug!("vulkan {kind:?}: {msg}");
+        } else {
+            log::warn!("vulkan {kind:?}: {msg}");
+        }
         if !log.is_null() {
             (*log).warnings.fetch_add(1, Ordering::SeqCst);
         }
@@ -283,7 +293,15 @@ impl Context {
         if has_debug_utils {
             info = info.push_next(&mut chained_messenger_info);
         }
-        let instance = unsafe { entry.create_instance(&info, None) }.vk("vkCreateInstance")?;
+        let instance = match unsafe { entry.create_instance(&info, None) } {
+            Ok(i) => i,
+            Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => {
+                return Err(GpuError::NoDevice(
+                    "no Vulkan driver found; install one (apt-get install mesa-vulkan-drivers for lavapipe)".into(),
+                ))
+            }
+            Err(e) => return Err(GpuError::Vk { call: "vkCreateInstance", result: e }),
+        };
         let debug_utils = if has_debug_utils {
             let du = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let m = unsafe { du.create_debug_utils_messenger(&messenger_info, None) };
