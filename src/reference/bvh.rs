@@ -218,28 +218,15 @@ impl Bvh {
             sp -= 1;
             let n = &self.nodes[stack[sp] as usize];
             if n.count > 0 {
-                for k in n.first..n.first + n.count {
-                    let t = &self.tris[k as usize];
-                    if let Some(h) = ray_triangle_edges(
-                        ray,
-                        t.a,
-                        t.e1,
-                        t.e2,
-                        t.scale * ray.dir.length(),
-                        t_min,
-                        t_max,
-                    ) {
-                        t_max = h.t;
-                        best = Some(Hit {
-                            t: h.t,
-                            triangle: self.ids[k as usize],
-                            u: h.u,
-                            v: h.v,
-                        });
-                        if any {
-                            return best;
-                        }
-                    }
+                if self.test_range(
+                    n.first as usize..(n.first + n.count) as usize,
+                    ray,
+                    t_min,
+                    &mut t_max,
+                    any,
+                    &mut best,
+                ) {
+                    return best;
                 }
                 continue;
             }
@@ -272,29 +259,39 @@ impl Bvh {
 
     fn brute(&self, ray: &Ray, t_min: f32, mut t_max: f32, any: bool) -> Option<Hit> {
         let mut best = None;
-        for (k, t) in self.tris.iter().enumerate() {
-            if let Some(h) = ray_triangle_edges(
-                ray,
-                t.a,
-                t.e1,
-                t.e2,
-                t.scale * ray.dir.length(),
-                t_min,
-                t_max,
-            ) {
-                t_max = h.t;
-                best = Some(Hit {
+        self.test_range(0..self.tris.len(), ray, t_min, &mut t_max, any, &mut best);
+        best
+    }
+
+    /// Tests triangles `range` (in BVH order), keeping the nearest hit in `best` and shrinking
+    /// `t_max`; returns true when `any` is set and something was hit.
+    fn test_range(
+        &self,
+        range: std::ops::Range<usize>,
+        ray: &Ray,
+        t_min: f32,
+        t_max: &mut f32,
+        any: bool,
+        best: &mut Option<Hit>,
+    ) -> bool {
+        let len = ray.dir.length();
+        for k in range {
+            let t = &self.tris[k];
+            if let Some(h) = ray_triangle_edges(ray, t.a, t.e1, t.e2, t.scale * len, t_min, *t_max)
+            {
+                *t_max = h.t;
+                *best = Some(Hit {
                     t: h.t,
                     triangle: self.ids[k],
                     u: h.u,
                     v: h.v,
                 });
                 if any {
-                    return best;
+                    return true;
                 }
             }
         }
-        best
+        false
     }
 
     /// Brute force over every triangle (for testing the hierarchy).
