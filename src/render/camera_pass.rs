@@ -5,7 +5,7 @@ use super::gpu_scene::{GpuScene, VertexAttributes};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
-use super::uniforms::{FrameUniform, SceneImmediates};
+use super::uniforms::FrameUniform;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{
     allocate_sets, create_module, scene as sh, set_layout, ReflectedBinding,
@@ -292,13 +292,12 @@ impl CameraPass {
                             vk::CullModeFlags::BACK
                         },
                     );
-                    let pc = SceneImmediates::new(dr.world_from_model);
                     d.cmd_push_constants(
                         cmd,
                         self.layout,
                         vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                         0,
-                        bytemuck::bytes_of(&pc),
+                        bytemuck::bytes_of(&dr.immediates),
                     );
                     d.cmd_draw_indexed(cmd, dr.index_count, 1, dr.first_index, dr.vertex_offset, 0);
                 }

@@ -2,7 +2,7 @@
 //! stream, one index buffer, textures with mipmaps, and a descriptor set per material.
 
 use super::settings::SceneOptions;
-use super::uniforms::MaterialUniform;
+use super::uniforms::{MaterialUniform, SceneImmediates};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
 use crate::gpu::{Buffer, Image};
@@ -43,6 +43,8 @@ pub struct Draw {
     pub material: usize,
     /// Model → world.
     pub world_from_model: Mat4,
+    /// Camera-pass immediates (transform and normal matrix), computed once at upload.
+    pub immediates: SceneImmediates,
     /// World-space bounds (for culling).
     pub world_bounds: Aabb,
     /// Draw both faces.
@@ -135,6 +137,7 @@ impl GpuScene {
                     vertex_offset,
                     material,
                     world_from_model: inst.world_from_model,
+                    immediates: SceneImmediates::new(inst.world_from_model),
                     world_bounds: b.transformed(&inst.world_from_model),
                     double_sided: scene
                         .materials

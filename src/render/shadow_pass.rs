@@ -48,6 +48,7 @@ pub struct ShadowPass {
     module: vk::ShaderModule,
     pipeline: vk::Pipeline,
     pipeline_format: vk::Format,
+    hardware_filtering: bool,
     /// The shadow map (None before the first `ensure_map`).
     pub map: Option<Image>,
     state: Access,
@@ -64,6 +65,7 @@ impl ShadowPass {
             module,
             pipeline: vk::Pipeline::null(),
             pipeline_format: vk::Format::UNDEFINED,
+            hardware_filtering: false,
             map: None,
             state: Access::Undefined,
         })
@@ -103,6 +105,10 @@ impl ShadowPass {
                 },
             )?;
             self.pipeline_format = fmt;
+            self.hardware_filtering = self
+                .ctx
+                .format_features(fmt)
+                .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
         }
         let size = size.clamp(1, 16384);
         if self
@@ -136,9 +142,7 @@ impl ShadowPass {
 
     /// Whether the map's format supports hardware linear filtering of comparisons.
     pub fn hardware_filtering(&self) -> bool {
-        self.ctx
-            .format_features(self.pipeline_format)
-            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
+        self.hardware_filtering
     }
 
     /// Records the pass; leaves the map ready for fragment-shader sampling. Returns casters drawn.
