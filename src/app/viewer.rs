@@ -181,7 +181,7 @@ impl App {
             .framing
             .unwrap_or_else(|| self.opts.scene.bounds());
         let controller = Controller::from_camera(&view.camera, &bounds);
-        let lights = effective_lights(&self.opts.scene, &view);
+        let lights = effective_lights(&self.opts.scene.lights, &view);
         let sun_dir = lights
             .iter()
             .find(|l| l.kind == LightKind::Directional)

@@ -9,7 +9,7 @@ use super::settings::{SceneOptions, View, ViewMode};
 use super::shadow_pass::ShadowPass;
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::scene::Scene;
+use crate::scene::{Light, Scene};
 use ash::vk;
 use std::sync::Arc;
 
@@ -30,8 +30,8 @@ pub struct Attachment {
 pub struct FrameCore {
     /// The context.
     pub ctx: Arc<Context>,
-    /// CPU scene.
-    pub scene: Scene,
+    /// The scene's own lights (the view may add the default sun or override the sun).
+    pub lights: Vec<Light>,
     /// GPU scene.
     pub gpu: GpuScene,
     /// Shadow depth pass.
@@ -65,7 +65,7 @@ impl FrameCore {
         .vk("vkCreateQueryPool")?;
         Ok(Self {
             ctx: ctx.clone(),
-            scene: scene.clone(),
+            lights: scene.lights.clone(),
             gpu,
             shadow,
             camera,
@@ -95,7 +95,7 @@ impl FrameCore {
         let mut v = view.clone();
         v.shadow.map_size = map_size;
         let plan = plan_frame(
-            &self.scene,
+            &self.lights,
             &self.gpu.bounds,
             &v,
             width as f32 / height.max(1) as f32,

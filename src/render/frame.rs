@@ -6,7 +6,7 @@ use super::uniforms::{FrameUniform, LightUniform, MAX_LIGHTS};
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
 use crate::math::shadow_fit::{fit_directional, fit_spot, CameraFrustum, DirectionalFitInput};
 use crate::math::Aabb;
-use crate::scene::{Camera, Light, LightKind, Scene};
+use crate::scene::{Camera, Light, LightKind};
 use glam::{Mat4, Vec3, Vec4};
 
 /// Elevation of the default sun used when a scene has no light (degrees).
@@ -16,10 +16,10 @@ pub const DEFAULT_SUN_AZIMUTH_DEG: f32 = 35.0;
 /// Intensity of the default sun.
 pub const DEFAULT_SUN_INTENSITY: f32 = 1.7;
 
-/// The lights a view is shaded with: the scene's, or the default sun; `sun_direction` overrides
-/// the first directional light's direction.
-pub fn effective_lights(scene: &Scene, view: &View) -> Vec<Light> {
-    let mut lights = scene.lights.clone();
+/// The lights a view is shaded with: the scene's `lights`, or the default sun when there are
+/// none; `sun_direction` and `sun_intensity` override the first directional light's.
+pub fn effective_lights(scene_lights: &[Light], view: &View) -> Vec<Light> {
+    let mut lights = scene_lights.to_vec();
     if lights.is_empty() {
         lights.push(Light::sun(
             Light::sun_direction(
@@ -91,15 +91,15 @@ pub struct FramePlan {
     pub clip_from_world: Mat4,
 }
 
-/// Plans a frame for `view` of a scene with `bounds`, rendered at `aspect`.
+/// Plans a frame for `view` of a scene with `scene_lights` and `bounds`, rendered at `aspect`.
 pub fn plan_frame(
-    scene: &Scene,
+    scene_lights: &[Light],
     bounds: &Aabb,
     view: &View,
     aspect: f32,
     hw_compare: bool,
 ) -> FramePlan {
-    let lights = effective_lights(scene, view);
+    let lights = effective_lights(scene_lights, view);
     let proj = camera_projection(&view.camera, aspect);
     let clip_from_world = proj * view.camera.view_from_world();
     let shadow_light = lights
@@ -201,12 +201,12 @@ mod tests {
         let mut s = demo_scene();
         s.lights.clear();
         let mut v = View::new(s.default_camera(1.5));
-        let p = plan_frame(&s, &s.bounds(), &v, 1.5, false);
+        let p = plan_frame(&s.lights, &s.bounds(), &v, 1.5, false);
         assert_eq!(p.lights.len(), 1);
         assert_eq!(p.shadow_light, Some(0));
         assert!(p.texel_world > 0.0);
         v.sun_direction = Some(Vec3::new(0.0, -1.0, 0.0));
-        let p = plan_frame(&s, &s.bounds(), &v, 1.5, false);
+        let p = plan_frame(&s.lights, &s.bounds(), &v, 1.5, false);
         assert_eq!(p.lights[0].direction, Vec3::NEG_Y);
         assert_eq!(p.uniform.modes[3], 1);
     }

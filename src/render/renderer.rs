@@ -151,11 +151,6 @@ impl Renderer {
         &self.core.ctx
     }
 
-    /// The scene (CPU copy).
-    pub fn scene(&self) -> &Scene {
-        &self.core.scene
-    }
-
     /// Also read back the camera depth buffer (into `RenderedFrame::depth`).
     pub fn set_read_depth(&mut self, on: bool) {
         self.read_depth = on;
