@@ -9,6 +9,7 @@ use super::settings::{SceneOptions, View, ViewMode};
 use super::shadow_pass::ShadowPass;
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::Image;
 use crate::scene::{Light, Scene};
 use ash::vk;
 use std::sync::Arc;
@@ -16,14 +17,35 @@ use std::sync::Arc;
 /// Linear colour where nothing is drawn (the CPU reference uses it too).
 pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
 
-/// An attachment the core renders into, with the access it was last used with.
+/// An image rendered into, with the access it was last used with; `transition` records the
+/// barrier to the next access and remembers it, so no caller tracks layouts by hand.
 pub struct Attachment {
     /// Image.
     pub image: vk::Image,
     /// View.
     pub view: vk::ImageView,
-    /// Last access (updated by `record`).
+    /// Colour or depth.
+    pub aspect: vk::ImageAspectFlags,
+    /// Last access.
     pub state: Access,
+}
+
+impl Attachment {
+    /// An attachment for a not yet used `Image`.
+    pub fn of(image: &Image) -> Self {
+        Self {
+            image: image.raw,
+            view: image.view,
+            aspect: image.aspect,
+            state: Access::Undefined,
+        }
+    }
+
+    /// Records a barrier from the last access to `to`, and remembers `to`.
+    pub fn transition(&mut self, device: &ash::Device, cmd: vk::CommandBuffer, to: Access) {
+        image_barrier(device, cmd, self.image, self.aspect, 0..1, self.state, to);
+        self.state = to;
+    }
 }
 
 /// Scene + passes + per-slot uniforms and timestamps.
@@ -151,26 +173,8 @@ impl FrameCore {
                 );
             }
         }
-        image_barrier(
-            d,
-            cmd,
-            color.image,
-            vk::ImageAspectFlags::COLOR,
-            0..1,
-            color.state,
-            Access::ColorAttachment,
-        );
-        image_barrier(
-            d,
-            cmd,
-            depth.image,
-            vk::ImageAspectFlags::DEPTH,
-            0..1,
-            depth.state,
-            Access::DepthAttachment,
-        );
-        color.state = Access::ColorAttachment;
-        depth.state = Access::DepthAttachment;
+        color.transition(d, cmd, Access::ColorAttachment);
+        depth.transition(d, cmd, Access::DepthAttachment);
         self.camera.record(
             cmd,
             slot,

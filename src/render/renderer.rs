@@ -4,7 +4,7 @@ use super::camera_pass::DEPTH_FORMAT;
 use super::core::{Attachment, FrameCore};
 use super::frame::FramePlan;
 use super::settings::{SceneOptions, View};
-use crate::gpu::barrier::{image_barrier, Access};
+use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
 use crate::scene::Scene;
@@ -55,8 +55,8 @@ pub struct RenderedFrame {
 struct Target {
     color: Image,
     depth: Image,
-    color_state: Access,
-    depth_state: Access,
+    color_at: Attachment,
+    depth_at: Attachment,
     readback: Buffer,
     depth_readback: Buffer,
 }
@@ -207,10 +207,10 @@ impl Renderer {
             MemoryLocation::GpuToCpu,
         )?;
         self.target = Some(Target {
+            color_at: Attachment::of(&color),
+            depth_at: Attachment::of(&depth),
             color,
             depth,
-            color_state: Access::Undefined,
-            depth_state: Access::Undefined,
             readback,
             depth_readback,
         });
@@ -237,31 +237,17 @@ impl Renderer {
         let cmd = self.cmd;
         let extent = vk::Extent2D { width, height };
         let t = self.target.as_mut().expect("target");
-        let mut color = Attachment {
-            image: t.color.raw,
-            view: t.color.view,
-            state: t.color_state,
-        };
-        let mut depth = Attachment {
-            image: t.depth.raw,
-            view: t.depth.view,
-            state: t.depth_state,
-        };
         ctx.begin_one_time(cmd)?;
-        let casters = self
-            .core
-            .record(cmd, 0, view, &plan, &mut color, &mut depth, extent);
-        image_barrier(
-            d,
+        let casters = self.core.record(
             cmd,
-            color.image,
-            vk::ImageAspectFlags::COLOR,
-            0..1,
-            color.state,
-            Access::TransferSrc,
+            0,
+            view,
+            &plan,
+            &mut t.color_at,
+            &mut t.depth_at,
+            extent,
         );
-        t.color_state = Access::TransferSrc;
-        t.depth_state = depth.state;
+        t.color_at.transition(d, cmd, Access::TransferSrc);
         copy_to_buffer(
             d,
             cmd,
@@ -271,16 +257,7 @@ impl Renderer {
             t.readback.raw,
         );
         if self.read_depth {
-            image_barrier(
-                d,
-                cmd,
-                depth.image,
-                vk::ImageAspectFlags::DEPTH,
-                0..1,
-                depth.state,
-                Access::TransferSrc,
-            );
-            t.depth_state = Access::TransferSrc;
+            t.depth_at.transition(d, cmd, Access::TransferSrc);
             copy_to_buffer(
                 d,
                 cmd,

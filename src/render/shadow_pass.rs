@@ -1,13 +1,14 @@
 //! The light-space depth pass: position-only stream, depth clamp on, reversed-z (clear 0, GREATER),
 //! depth bias pushing casters away from the light (negative factors under reversed-z).
 
+use super::core::Attachment;
 use super::gpu_scene::GpuScene;
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
 use super::settings::{ShadowFormat, ShadowSettings};
 use super::uniforms::ShadowImmediates;
-use crate::gpu::barrier::{image_barrier, Access};
+use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{create_module, shadow as sh};
 use crate::gpu::Image;
@@ -51,7 +52,8 @@ pub struct ShadowPass {
     hardware_filtering: bool,
     /// The shadow map (None before the first `ensure_map`).
     pub map: Option<Image>,
-    state: Access,
+    /// The map's attachment state (set with the map).
+    map_at: Option<Attachment>,
 }
 
 impl ShadowPass {
@@ -67,7 +69,7 @@ impl ShadowPass {
             pipeline_format: vk::Format::UNDEFINED,
             hardware_filtering: false,
             map: None,
-            state: Access::Undefined,
+            map_at: None,
         })
     }
 
@@ -132,11 +134,9 @@ impl ShadowPass {
                 height: size,
             },
             1,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
-                | vk::ImageUsageFlags::SAMPLED
-                | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
         )?);
-        self.state = Access::Undefined;
+        self.map_at = self.map.as_ref().map(Attachment::of);
         Ok(true)
     }
 
@@ -154,18 +154,12 @@ impl ShadowPass {
         s: &ShadowSettings,
         draw: bool,
     ) -> usize {
-        let Some(map) = &self.map else { return 0 };
+        let (Some(map), Some(at)) = (&self.map, self.map_at.as_mut()) else {
+            return 0;
+        };
         let d = &self.ctx.device;
         self.ctx.begin_label(cmd, "shadow depth pass");
-        image_barrier(
-            d,
-            cmd,
-            map.raw,
-            vk::ImageAspectFlags::DEPTH,
-            0..1,
-            self.state,
-            Access::DepthAttachment,
-        );
+        at.transition(d, cmd, Access::DepthAttachment);
         let depth_attachment = depth_clear_attachment(map.view);
         let rendering = vk::RenderingInfo::default()
             .render_area(vk::Rect2D {
@@ -214,16 +208,7 @@ impl ShadowPass {
             }
             d.cmd_end_rendering(cmd);
         }
-        image_barrier(
-            d,
-            cmd,
-            map.raw,
-            vk::ImageAspectFlags::DEPTH,
-            0..1,
-            Access::DepthAttachment,
-            Access::DepthFragmentSampled,
-        );
-        self.state = Access::DepthFragmentSampled;
+        at.transition(d, cmd, Access::DepthFragmentSampled);
         self.ctx.end_label(cmd);
         drawn
     }

@@ -7,7 +7,7 @@ use super::core::{Attachment, FrameCore};
 use super::renderer::{copy_to_buffer, rgba_from_readback, transfer_to_host_barrier};
 use super::settings::{SceneOptions, View};
 use super::swapchain::Swapchain;
-use crate::gpu::barrier::{image_barrier, Access};
+use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
 use crate::scene::Scene;
@@ -43,8 +43,7 @@ pub struct WindowRenderer {
     /// The swapchain.
     pub swapchain: Swapchain,
     frames: Vec<FrameSync>,
-    depth: Option<Image>,
-    depth_state: Access,
+    depth: Option<(Image, Attachment)>,
     frame: usize,
     wanted: (u32, u32),
     screenshot: Option<Buffer>,
@@ -91,7 +90,6 @@ impl WindowRenderer {
             swapchain,
             frames,
             depth: None,
-            depth_state: Access::Undefined,
             frame: 0,
             wanted: (width, height),
             screenshot: None,
@@ -117,18 +115,19 @@ impl WindowRenderer {
             self.depth = None;
             return Ok(());
         }
-        if self.depth.as_ref().is_some_and(|d| d.extent == e) {
+        if self.depth.as_ref().is_some_and(|(d, _)| d.extent == e) {
             return Ok(());
         }
-        self.depth = Some(Image::new(
+        let image = Image::new(
             &self.core.ctx,
             "window depth",
             DEPTH_FORMAT,
             e,
             1,
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        )?);
-        self.depth_state = Access::Undefined;
+        )?;
+        let at = Attachment::of(&image);
+        self.depth = Some((image, at));
         Ok(())
     }
 
@@ -175,32 +174,20 @@ impl WindowRenderer {
             }
         }
         let cmd = sync.cmd;
-        let depth_img = self.depth.as_ref().expect("depth exists with a swapchain");
+        let (_, depth) = self.depth.as_mut().expect("depth exists with a swapchain");
+        // Acquired images come from presentation; their old contents are not needed.
         let mut color = Attachment {
             image: self.swapchain.images[index as usize],
             view: self.swapchain.views[index as usize],
+            aspect: vk::ImageAspectFlags::COLOR,
             state: Access::Present,
-        };
-        let mut depth = Attachment {
-            image: depth_img.raw,
-            view: depth_img.view,
-            state: self.depth_state,
         };
         ctx.begin_one_time(cmd)?;
         let casters = self
             .core
-            .record(cmd, f, view, &plan, &mut color, &mut depth, extent);
-        self.depth_state = depth.state;
+            .record(cmd, f, view, &plan, &mut color, depth, extent);
         if want_copy {
-            image_barrier(
-                d,
-                cmd,
-                color.image,
-                vk::ImageAspectFlags::COLOR,
-                0..1,
-                Access::ColorAttachment,
-                Access::TransferSrc,
-            );
+            color.transition(d, cmd, Access::TransferSrc);
             copy_to_buffer(
                 d,
                 cmd,
@@ -210,26 +197,8 @@ impl WindowRenderer {
                 self.screenshot.as_ref().expect("buffer").raw,
             );
             transfer_to_host_barrier(d, cmd);
-            image_barrier(
-                d,
-                cmd,
-                color.image,
-                vk::ImageAspectFlags::COLOR,
-                0..1,
-                Access::TransferSrc,
-                Access::Present,
-            );
-        } else {
-            image_barrier(
-                d,
-                cmd,
-                color.image,
-                vk::ImageAspectFlags::COLOR,
-                0..1,
-                Access::ColorAttachment,
-                Access::Present,
-            );
         }
+        color.transition(d, cmd, Access::Present);
         unsafe {
             d.end_command_buffer(cmd).vk("vkEndCommandBuffer")?;
             let waits = [vk::SemaphoreSubmitInfo::default()
