@@ -7,7 +7,7 @@ use umbra::app::cli::{
     ViewArgsCmd,
 };
 use umbra::gpu::{Context, ContextDesc, Validation};
-use umbra::render::Renderer;
+use umbra::render::{FrameStats, Renderer};
 
 fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
@@ -45,22 +45,19 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     let (w, h) = a.view.size;
     let n = a.repeat.max(1);
-    let mut frames = Vec::with_capacity(n);
-    for _ in 0..n {
-        frames.push(renderer.render(&view, w, h)?);
+    // Only the last frame's pixels are kept; the others contribute their timings.
+    let mut all = Vec::with_capacity(n);
+    let mut frame = renderer.render(&view, w, h)?;
+    for _ in 1..n {
+        all.push(frame.stats);
+        frame = renderer.render(&view, w, h)?;
     }
-    let frame = frames.pop().expect("one frame");
+    all.push(frame.stats.clone());
     frame
         .image
         .save(&a.output)
         .with_context(|| format!("writing {}", a.output.display()))?;
-    let mut all: Vec<_> = frames.iter().map(|f| f.stats.clone()).collect();
-    all.push(frame.stats.clone());
-    let median = |f: &dyn Fn(&umbra::render::FrameStats) -> Option<f64>| -> Option<f64> {
-        let mut v: Vec<f64> = all.iter().filter_map(f).collect();
-        v.sort_by(f64::total_cmp);
-        (!v.is_empty()).then(|| v[v.len() / 2])
-    };
+    let median = |f: &dyn Fn(&FrameStats) -> Option<f64>| median_of(&all, f);
     let wall = median(&|s| Some(s.wall_ms)).unwrap_or(0.0);
     let gpu = match (median(&|s| s.gpu_shadow_ms), median(&|s| s.gpu_camera_ms)) {
         (Some(a), Some(b)) => format!(
@@ -159,13 +156,11 @@ fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
     })
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+/// The median of `f` over the frames that have a value for it.
+fn median_of(frames: &[FrameStats], f: &dyn Fn(&FrameStats) -> Option<f64>) -> Option<f64> {
+    let mut v: Vec<f64> = frames.iter().filter_map(f).collect();
     v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[v.len() / 2]
-    }
+    (!v.is_empty()).then(|| v[v.len() / 2])
 }
 
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
@@ -205,14 +200,12 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
             for _ in 0..a.repeat.max(1) {
                 frames.push(renderer.render(&v, w, h)?.stats);
             }
-            let m = |f: &dyn Fn(&umbra::render::FrameStats) -> f64| {
-                median(frames.iter().map(f).collect())
-            };
-            let sh = m(&|s| s.gpu_shadow_ms.unwrap_or(f64::NAN));
-            let cam = m(&|s| s.gpu_camera_ms.unwrap_or(f64::NAN));
-            let tot =
-                m(&|s| s.gpu_shadow_ms.unwrap_or(f64::NAN) + s.gpu_camera_ms.unwrap_or(f64::NAN));
-            let wall = m(&|s| s.wall_ms);
+            let m =
+                |f: &dyn Fn(&FrameStats) -> Option<f64>| median_of(&frames, f).unwrap_or(f64::NAN);
+            let sh = m(&|s| s.gpu_shadow_ms);
+            let cam = m(&|s| s.gpu_camera_ms);
+            let tot = m(&|s| Some(s.gpu_shadow_ms? + s.gpu_camera_ms?));
+            let wall = m(&|s| Some(s.wall_ms));
             let map_label = if map == 0 {
                 "off".to_string()
             } else {

@@ -101,6 +101,7 @@ struct State {
     ctx: Arc<Context>,
     window: Arc<Window>,
     controller: Controller,
+    bounds: crate::math::Aabb,
     view: View,
     sun: SunAngles,
     camera_index: Option<usize>,
@@ -175,6 +176,7 @@ impl App {
             &self.opts.scene_options,
         )?;
         let view = self.opts.view.clone();
+        // What the camera frames and scales its speeds by (the model, not a helper ground).
         let bounds = self
             .opts
             .scene
@@ -198,6 +200,7 @@ impl App {
             ctx,
             window,
             controller,
+            bounds,
             view,
             sun: SunAngles::from_direction(sun_dir),
             camera_index: None,
@@ -319,8 +322,7 @@ impl App {
             KeyAction::Setting(a) => println!("{}", apply(a, &mut s.view, &mut s.sun)),
             KeyAction::Frame => {
                 s.camera_index = None;
-                s.controller
-                    .frame(&opts.scene.framing.unwrap_or_else(|| opts.scene.bounds()));
+                s.controller.frame(&s.bounds);
                 println!("camera: framing the scene");
             }
             KeyAction::ToggleFly => {
@@ -338,7 +340,7 @@ impl App {
                         .unwrap_or(0);
                     s.camera_index = Some(i);
                     s.view.camera = opts.scene.cameras[i];
-                    s.controller = Controller::from_camera(&s.view.camera, &opts.scene.bounds());
+                    s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
                     println!("camera: glTF camera {i}");
                 }
             }
@@ -401,8 +403,7 @@ impl ApplicationHandler for App {
                 };
                 if let (Some(b), Some(s)) = (b, self.state.as_mut()) {
                     if s.camera_index.take().is_some() {
-                        s.controller =
-                            Controller::from_camera(&s.view.camera, &self.opts.scene.bounds());
+                        s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
                     }
                     s.controller.handle(if state == ElementState::Pressed {
                         Input::Press(b)

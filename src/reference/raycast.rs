@@ -25,7 +25,6 @@ pub struct ReferenceScene<'a> {
     pub bvh: Bvh,
     refs: Vec<TriRef>,
     normal_mats: Vec<Mat3>,
-    linear: Vec<Vec<Vec4>>,
     srgb_lut: [f32; 256],
     eps: f32,
 }
@@ -102,14 +101,12 @@ impl<'a> ReferenceScene<'a> {
         for (i, v) in srgb_lut.iter_mut().enumerate() {
             *v = srgb_decode(i as f32 / 255.0);
         }
-        let linear = Vec::new();
         let eps = (scene.bounds().diagonal() * 2e-5).max(1e-6);
         Self {
             scene,
             bvh,
             refs,
             normal_mats,
-            linear,
             srgb_lut,
             eps,
         }
@@ -137,7 +134,6 @@ impl<'a> ReferenceScene<'a> {
         let Some(t) = tex.and_then(|i| self.scene.textures.get(i)) else {
             return default;
         };
-        let _ = &self.linear;
         let x = uv.x * t.width as f32 - 0.5;
         let y = uv.y * t.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
@@ -268,10 +264,7 @@ impl<'a> ReferenceScene<'a> {
         let p = ray.at(h.t);
         let nm = self.normal_mats[r.instance as usize];
         let m3 = Mat3::from_mat4(inst.world_from_model);
-        let pw: Vec<Vec3> = idx
-            .iter()
-            .map(|&i| inst.world_from_model.transform_point3(prim.positions[i]))
-            .collect();
+        let pw = idx.map(|i| inst.world_from_model.transform_point3(prim.positions[i]));
         let mut ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
         let mut n_geo = (nm * lerp3(&prim.normals)).normalize_or(ng);
         let uv = prim.uvs[idx[0]] * w.x + prim.uvs[idx[1]] * w.y + prim.uvs[idx[2]] * w.z;

@@ -242,16 +242,17 @@ impl CameraPass {
         unsafe {
             d.cmd_begin_rendering(cmd, &rendering);
             set_viewport(&self.ctx, cmd, extent);
+            // Both pipelines share the layout, so set 0 (frame) is bound once for either.
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout,
+                0,
+                &[frame_set],
+                &[],
+            );
             if shadow_map_view {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.map_pipeline);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.layout,
-                    0,
-                    &[frame_set],
-                    &[],
-                );
                 d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
                 d.cmd_draw(cmd, 3, 1, 0, 0);
             } else if !scene.draws.is_empty() {
@@ -263,14 +264,6 @@ impl CameraPass {
                     &[0, 0],
                 );
                 d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.layout,
-                    0,
-                    &[frame_set],
-                    &[],
-                );
                 let mut bound_material = usize::MAX;
                 for dr in &scene.draws {
                     if dr.material != bound_material {
