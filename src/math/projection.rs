@@ -58,6 +58,21 @@ pub fn perspective_infinite_reversed(fov_y: f32, aspect: f32, near: f32) -> Mat4
     )
 }
 
+/// NDC x/y of image position (`x`, `y`) in pixels (x right, y down; pixel centres at +0.5) in a
+/// `w`×`h` image. NDC y points up: the Y flip of the framebuffer lives here and in
+/// `ndc_to_pixel`, and in the shaders' naga `ADJUST_COORDINATE_SPACE`.
+pub fn pixel_to_ndc(x: f32, y: f32, w: u32, h: u32) -> glam::Vec2 {
+    glam::Vec2::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / h as f32 * 2.0)
+}
+
+/// Image position in pixels of NDC x/y (the inverse of `pixel_to_ndc`).
+pub fn ndc_to_pixel(ndc: glam::Vec2, w: u32, h: u32) -> (f32, f32) {
+    (
+        (ndc.x * 0.5 + 0.5) * w as f32,
+        (0.5 - ndc.y * 0.5) * h as f32,
+    )
+}
+
 /// Depth (after the divide) that a projection gives a view-space point at distance `d` on the axis.
 pub fn depth_at(proj: &Mat4, d: f32) -> f32 {
     let c = *proj * Vec4::new(0.0, 0.0, -d, 1.0);
@@ -130,6 +145,20 @@ mod tests {
         let right = p * Vec4::new(1.0, 0.0, -5.0, 1.0);
         assert!(up.y / up.w > 0.0 && up.w > 0.0);
         assert!(right.x / right.w > 0.0);
+    }
+
+    #[test]
+    fn pixel_ndc_round_trip_and_y_down_images() {
+        let n = pixel_to_ndc(0.5, 0.5, 4, 2);
+        assert!(
+            n.x < 0.0 && n.y > 0.0,
+            "the top-left pixel is left and up in NDC: {n}"
+        );
+        assert_eq!(pixel_to_ndc(2.0, 1.0, 4, 2), glam::Vec2::ZERO);
+        for (x, y) in [(0.5, 0.5), (3.5, 1.5), (1.25, 0.75)] {
+            let (px, py) = ndc_to_pixel(pixel_to_ndc(x, y, 4, 2), 4, 2);
+            assert!((px - x).abs() < 1e-6 && (py - y).abs() < 1e-6);
+        }
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! and FLIP).
 
 use super::raycast::ReferenceFrame;
+use crate::math::projection::pixel_to_ndc;
 use crate::render::frame::FramePlan;
 use glam::Vec4;
 
@@ -106,9 +107,8 @@ pub fn compare(
         if d <= 0.0 {
             return None;
         }
-        let nx = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
-        let ny = 1.0 - (y as f32 + 0.5) / h as f32 * 2.0;
-        let p = inv * Vec4::new(nx, ny, d, 1.0);
+        let n = pixel_to_ndc(x as f32 + 0.5, y as f32 + 0.5, w, h);
+        let p = inv * Vec4::new(n.x, n.y, d, 1.0);
         let dist = (p.truncate() / p.w).distance(eye);
         let r = reference.distance[i];
         ((dist - r).abs() <= 0.01 * r + 1e-4).then_some(vis)

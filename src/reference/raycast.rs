@@ -2,6 +2,7 @@
 //! (same pixel centres, lights and material constants) as a GPU frame.
 
 use super::bvh::{Bvh, Hit};
+use crate::math::projection::pixel_to_ndc;
 use crate::math::ray::Ray;
 use crate::render::frame::FramePlan;
 use crate::scene::{blinn_phong_params, shade_blinn_phong, LightKind, Scene, Texture};
@@ -214,9 +215,8 @@ impl<'a> ReferenceScene<'a> {
                     (i as u32 % width) as f32 + 0.5,
                     (i as u32 / width) as f32 + 0.5,
                 );
-                let nx = x / width as f32 * 2.0 - 1.0;
-                let ny = 1.0 - y / height as f32 * 2.0;
-                let far = inv * Vec4::new(nx, ny, 1e-3, 1.0);
+                let n = pixel_to_ndc(x, y, width, height);
+                let far = inv * Vec4::new(n.x, n.y, 1e-3, 1.0);
                 let dir = (far.truncate() / far.w - eye).normalize_or(Vec3::NEG_Z);
                 let ray = Ray::new(eye, dir);
                 match self.bvh.intersect(&ray, 0.0, f32::INFINITY) {

@@ -6,6 +6,7 @@ use glam::{Mat4, Vec3, Vec4};
 use std::path::PathBuf;
 use std::sync::Arc;
 use umbra::gpu::{Context, ContextDesc, Validation};
+use umbra::math::projection::{ndc_to_pixel, pixel_to_ndc};
 
 /// A context with the Khronos validation layer (synchronization validation on). Fails if the
 /// layer is missing: GPU tests never run unvalidated.
@@ -49,18 +50,16 @@ pub fn project(clip_from_world: &Mat4, p: Vec3, w: u32, h: u32) -> Option<(f32, 
     if c.w <= 0.0 {
         return None;
     }
-    let n = c.truncate() / c.w;
-    Some(((n.x * 0.5 + 0.5) * w as f32, (0.5 - n.y * 0.5) * h as f32))
+    Some(ndc_to_pixel(c.truncate().truncate() / c.w, w, h))
 }
 
 /// The world-space ray through the centre of pixel (x, y).
 pub fn pixel_ray(clip_from_world: &Mat4, x: u32, y: u32, w: u32, h: u32) -> (Vec3, Vec3) {
     let inv = clip_from_world.inverse();
-    let nx = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
-    let ny = 1.0 - (y as f32 + 0.5) / h as f32 * 2.0;
+    let n = pixel_to_ndc(x as f32 + 0.5, y as f32 + 0.5, w, h);
     // Reversed-z: depth 1 is the near plane, small depth is far away.
-    let a = inv * Vec4::new(nx, ny, 1.0, 1.0);
-    let b = inv * Vec4::new(nx, ny, 0.01, 1.0);
+    let a = inv * Vec4::new(n.x, n.y, 1.0, 1.0);
+    let b = inv * Vec4::new(n.x, n.y, 0.01, 1.0);
     let a = a.truncate() / a.w;
     let b = b.truncate() / b.w;
     (a, (b - a).normalize())
