@@ -505,28 +505,34 @@ impl Context {
         Ok(result)
     }
 
-    /// Submits one command buffer and blocks until it completes.
+    /// Submits one command buffer and blocks until it completes (with a temporary fence).
     pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<(), GpuError> {
-        unsafe {
-            let fence = self
-                .device
+        let fence = unsafe {
+            self.device
                 .create_fence(&vk::FenceCreateInfo::default(), None)
-                .vk("vkCreateFence")?;
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-            let r = self
-                .device
+        }
+        .vk("vkCreateFence")?;
+        let r = self.submit_and_wait_with(cmd, fence);
+        unsafe { self.device.destroy_fence(fence, None) };
+        r
+    }
+
+    /// Submits one command buffer, signalling the unsignalled `fence`, waits for it and resets it.
+    pub fn submit_and_wait_with(
+        &self,
+        cmd: vk::CommandBuffer,
+        fence: vk::Fence,
+    ) -> Result<(), GpuError> {
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+        unsafe {
+            self.device
                 .queue_submit2(self.queue, &submit, fence)
-                .vk("vkQueueSubmit2");
-            let w = if r.is_ok() {
-                self.device
-                    .wait_for_fences(&[fence], true, u64::MAX)
-                    .vk("vkWaitForFences")
-            } else {
-                Ok(())
-            };
-            self.device.destroy_fence(fence, None);
-            r.and(w)
+                .vk("vkQueueSubmit2")?;
+            self.device
+                .wait_for_fences(&[fence], true, u64::MAX)
+                .vk("vkWaitForFences")?;
+            self.device.reset_fences(&[fence]).vk("vkResetFences")
         }
     }
 

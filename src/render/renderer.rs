@@ -66,6 +66,7 @@ pub struct Renderer {
     core: FrameCore,
     target: Option<Target>,
     cmd: vk::CommandBuffer,
+    fence: vk::Fence,
     read_depth: bool,
 }
 
@@ -138,10 +139,16 @@ impl Renderer {
     ) -> Result<Self, GpuError> {
         let core = FrameCore::new(ctx, scene, options, OFFSCREEN_FORMAT, 1)?;
         let cmd = ctx.allocate_command_buffer()?;
+        let fence = unsafe {
+            ctx.device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+        }
+        .vk("vkCreateFence")?;
         Ok(Self {
             core,
             target: None,
             cmd,
+            fence,
             read_depth: false,
         })
     }
@@ -269,7 +276,7 @@ impl Renderer {
         }
         transfer_to_host_barrier(d, cmd);
         unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
-        ctx.submit_and_wait(cmd)?;
+        ctx.submit_and_wait_with(cmd, self.fence)?;
         let times = self.core.gpu_times(0);
         let stats = FrameStats {
             gpu_shadow_ms: times.map(|t| t.0),
@@ -312,5 +319,6 @@ impl Drop for Renderer {
             let _ = self.core.ctx.device.device_wait_idle();
         }
         self.core.ctx.free_command_buffer(self.cmd);
+        unsafe { self.core.ctx.device.destroy_fence(self.fence, None) };
     }
 }
