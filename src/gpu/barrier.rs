@@ -19,7 +19,10 @@ pub enum Access {
     FragmentSampled,
     /// A depth image sampled in a fragment shader (shadow map lookups).
     DepthFragmentSampled,
-    /// Presented to a swapchain.
+    /// A swapchain image just acquired: its old contents are not needed, and the first use must
+    /// wait at colour-attachment output, the stage the acquire semaphore is waited at.
+    Acquired,
+    /// Handed to presentation.
     Present,
 }
 
@@ -59,12 +62,17 @@ pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk:
             A::SHADER_SAMPLED_READ,
             vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
         ),
+        Access::Acquired => (
+            S::COLOR_ATTACHMENT_OUTPUT,
+            A::NONE,
+            vk::ImageLayout::UNDEFINED,
+        ),
         Access::Present => (S::NONE, A::NONE, vk::ImageLayout::PRESENT_SRC_KHR),
     }
 }
 
-/// Records one image barrier from `from` to `to` over the given mip levels.
-/// `src_stage_override` lets a swapchain transition wait at the acquire semaphore's stage.
+/// Records one image barrier from `from` to `to` over the given mip levels; stages, accesses and
+/// layouts all come from `access_info`.
 pub fn image_barrier(
     device: &ash::Device,
     cmd: vk::CommandBuffer,
@@ -81,25 +89,12 @@ pub fn image_barrier(
         & (vk::AccessFlags2::TRANSFER_WRITE
             | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
             | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE);
-    let src_stage = if from == Access::Present {
-        vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT
-    } else {
-        src_stage
-    };
     let barrier = vk::ImageMemoryBarrier2::default()
         .src_stage_mask(src_stage)
         .src_access_mask(src_access)
-        .dst_stage_mask(if to == Access::Present {
-            vk::PipelineStageFlags2::NONE
-        } else {
-            dst_stage
-        })
+        .dst_stage_mask(dst_stage)
         .dst_access_mask(dst_access)
-        .old_layout(if from == Access::Present {
-            vk::ImageLayout::UNDEFINED
-        } else {
-            old_layout
-        })
+        .old_layout(old_layout)
         .new_layout(new_layout)
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
@@ -123,6 +118,15 @@ mod tests {
     #[test]
     fn table_layouts_and_stages() {
         assert_eq!(access_info(Access::Undefined).2, vk::ImageLayout::UNDEFINED);
+        // An acquired swapchain image discards its contents and waits where the acquire
+        // semaphore is waited at.
+        let acquired = access_info(Access::Acquired);
+        assert_eq!(acquired.2, vk::ImageLayout::UNDEFINED);
+        assert_eq!(acquired.0, vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT);
+        assert_eq!(
+            access_info(Access::Present).2,
+            vk::ImageLayout::PRESENT_SRC_KHR
+        );
         assert_eq!(
             access_info(Access::DepthFragmentSampled).2,
             vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL

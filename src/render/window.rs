@@ -7,7 +7,7 @@ use super::core::{Attachment, FrameCore};
 use super::renderer::{copy_to_buffer, rgba_from_readback, transfer_to_host_barrier};
 use super::settings::{SceneOptions, View};
 use super::swapchain::Swapchain;
-use crate::gpu::barrier::Access;
+use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
 use crate::scene::Scene;
@@ -175,12 +175,11 @@ impl WindowRenderer {
         }
         let cmd = sync.cmd;
         let (_, depth) = self.depth.as_mut().expect("depth exists with a swapchain");
-        // Acquired images come from presentation; their old contents are not needed.
         let mut color = Attachment {
             image: self.swapchain.images[index as usize],
             view: self.swapchain.views[index as usize],
             aspect: vk::ImageAspectFlags::COLOR,
-            state: Access::Present,
+            state: Access::Acquired,
         };
         ctx.begin_one_time(cmd)?;
         let casters = self
@@ -203,7 +202,8 @@ impl WindowRenderer {
             d.end_command_buffer(cmd).vk("vkEndCommandBuffer")?;
             let waits = [vk::SemaphoreSubmitInfo::default()
                 .semaphore(sync.acquired)
-                .stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)];
+                // The same stage the acquired image's first barrier waits at (barrier table).
+                .stage_mask(access_info(Access::Acquired).0)];
             let signals = [vk::SemaphoreSubmitInfo::default()
                 .semaphore(self.swapchain.render_finished[index as usize])
                 .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
