@@ -3,6 +3,7 @@
 //! frame the bounds) and fly (WASD + Q/E, mouse look with the left button, Shift for speed).
 //! Speeds scale with the scene's size.
 
+use crate::math::projection::framing_distance;
 use crate::math::Aabb;
 use crate::scene::Camera;
 use glam::Vec3;
@@ -95,7 +96,7 @@ pub const ZOOM_STEP: f32 = 0.9;
 pub const FLY_SPEED: f32 = 0.25;
 
 impl Controller {
-    /// A controller that frames `bounds` (orbit mode).
+    /// A controller that frames `bounds` (orbit mode) in a square or wider view.
     pub fn framing(bounds: &Aabb) -> Self {
         let mut c = Self {
             mode: Mode::Orbit,
@@ -110,7 +111,7 @@ impl Controller {
             drag: None,
             cursor: None,
         };
-        c.frame(bounds);
+        c.frame(bounds, 1.0);
         c
     }
 
@@ -133,16 +134,12 @@ impl Controller {
         c
     }
 
-    /// Orbit to frame `bounds` (the `F` key).
-    pub fn frame(&mut self, bounds: &Aabb) {
-        let (center, radius) = if bounds.is_empty() {
-            (Vec3::ZERO, 1.0)
-        } else {
-            (bounds.center(), (bounds.diagonal() * 0.5).max(1e-6))
-        };
+    /// Orbit to frame `bounds` in a view of `aspect` (the `F` key).
+    pub fn frame(&mut self, bounds: &Aabb, aspect: f32) {
+        let (center, radius) = bounds.bounding_sphere();
         self.scale = radius * 2.0;
         self.target = center;
-        self.distance = radius / (self.fov_y * 0.5).sin() * 1.05;
+        self.distance = framing_distance(radius, self.fov_y, aspect);
         self.mode = Mode::Orbit;
     }
 

@@ -322,7 +322,11 @@ impl App {
             KeyAction::Setting(a) => println!("{}", apply(a, &mut s.view, &mut s.sun)),
             KeyAction::Frame => {
                 s.camera_index = None;
-                s.controller.frame(&s.bounds);
+                let size = s.window.inner_size();
+                s.controller.frame(
+                    &s.bounds,
+                    size.width.max(1) as f32 / size.height.max(1) as f32,
+                );
                 println!("camera: framing the scene");
             }
             KeyAction::ToggleFly => {

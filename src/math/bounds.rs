@@ -80,6 +80,16 @@ impl Aabb {
         }
     }
 
+    /// Centre and radius of the sphere through the corners; the unit sphere at the origin for
+    /// an empty box (so framing an empty scene still gives a usable camera).
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        if self.is_empty() {
+            (Vec3::ZERO, 1.0)
+        } else {
+            (self.center(), (self.diagonal() * 0.5).max(1e-6))
+        }
+    }
+
     /// The 8 corners.
     pub fn corners(&self) -> [Vec3; 8] {
         let (a, b) = (self.min, self.max);

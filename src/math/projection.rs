@@ -73,6 +73,13 @@ pub fn ndc_to_pixel(ndc: glam::Vec2, w: u32, h: u32) -> (f32, f32) {
     )
 }
 
+/// Distance from which a camera with vertical field of view `fov_y` and `aspect` sees a sphere of
+/// `radius` whole, with a 5 % margin (the narrower of the two fields of view decides).
+pub fn framing_distance(radius: f32, fov_y: f32, aspect: f32) -> f32 {
+    let fov_x = 2.0 * ((fov_y * 0.5).tan() * aspect).atan();
+    radius / (fov_y.min(fov_x) * 0.5).sin() * 1.05
+}
+
 /// Depth (after the divide) that a projection gives a view-space point at distance `d` on the axis.
 pub fn depth_at(proj: &Mat4, d: f32) -> f32 {
     let c = *proj * Vec4::new(0.0, 0.0, -d, 1.0);
@@ -158,6 +165,25 @@ mod tests {
         for (x, y) in [(0.5, 0.5), (3.5, 1.5), (1.25, 0.75)] {
             let (px, py) = ndc_to_pixel(pixel_to_ndc(x, y, 4, 2), 4, 2);
             assert!((px - x).abs() < 1e-6 && (py - y).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn framing_distance_fits_the_sphere_in_both_directions() {
+        for aspect in [0.5f32, 1.0, 16.0 / 9.0] {
+            let fov_y = 0.8f32;
+            let d = framing_distance(2.0, fov_y, aspect);
+            let fov_x = 2.0 * ((fov_y * 0.5).tan() * aspect).atan();
+            // The sphere's angular radius is inside both half-angles, with the 5 % margin.
+            let angular = (2.0 / d).asin();
+            assert!(
+                angular <= fov_y * 0.5 + 1e-6 && angular <= fov_x * 0.5 + 1e-6,
+                "{aspect}"
+            );
+            assert!(
+                (angular - fov_y.min(fov_x) * 0.5).abs() < 0.05,
+                "{aspect}: not wasteful"
+            );
         }
     }
 

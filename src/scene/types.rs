@@ -1,5 +1,6 @@
 //! Scene data types.
 
+use crate::math::projection::framing_distance;
 use crate::math::Aabb;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
@@ -290,18 +291,9 @@ impl Scene {
     /// A camera that frames the bounds from the front-right, above.
     pub fn default_camera(&self, aspect: f32) -> Camera {
         let b = self.framing.unwrap_or_else(|| self.bounds());
-        let (center, radius) = if b.is_empty() {
-            (Vec3::ZERO, 1.0)
-        } else {
-            (b.center(), (b.diagonal() * 0.5).max(1e-6))
-        };
+        let (center, radius) = b.bounding_sphere();
         let fov_y = 45f32.to_radians();
-        let fov_min = if aspect < 1.0 {
-            2.0 * ((fov_y * 0.5).tan() * aspect).atan()
-        } else {
-            fov_y
-        };
-        let dist = radius / (fov_min * 0.5).sin() * 1.05;
+        let dist = framing_distance(radius, fov_y, aspect);
         let dir = Vec3::new(0.55, 0.45, 1.0).normalize();
         Camera::look_at(
             center + dir * dist,
