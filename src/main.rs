@@ -29,9 +29,6 @@ fn main() {
 
 fn render(a: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
-    for w in &scene.warnings {
-        eprintln!("warning: {}: {w}", scene.name);
-    }
     let view = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
         validation: if a.validation {
@@ -138,9 +135,6 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
 
 fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
-    for w in &scene.warnings {
-        eprintln!("warning: {}: {w}", scene.name);
-    }
     let view = make_view(&scene, &a.view)?;
     umbra::app::viewer::run(umbra::app::viewer::ViewerOptions {
         scene,

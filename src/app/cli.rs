@@ -267,12 +267,16 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::from_array(v))
 }
 
-/// Loads SCENE or builds the demo; adds a ground plane when asked.
+/// Loads SCENE or builds the demo, prints its warnings (`warning: NAME: …` on stderr, one per
+/// line), and adds a ground plane when asked.
 pub fn load_scene(path: Option<&PathBuf>, ground: bool) -> anyhow::Result<Scene> {
     let mut s = match path {
         Some(p) => load_gltf(p)?,
         None => demo_scene(),
     };
+    for w in &s.warnings {
+        eprintln!("warning: {}: {w}", s.name);
+    }
     if ground {
         crate::scene::shapes::add_ground(&mut s);
     }
