@@ -27,6 +27,7 @@ where
 
 /// Tangent-space normal `tn` (already unpacked to [-1,1] and scaled) to world space, with the glTF
 /// convention: bitangent = sign · (n × t). `t` need not be orthogonal to `n` (Gram–Schmidt here).
+/// Returns `n` itself (normalised) when `t` is parallel to `n` or the result degenerates.
 pub fn perturb_normal(n: Vec3, t: Vec3, sign: f32, tn: Vec3) -> Vec3 {
     let n = n.normalize_or_zero();
     let t = (t - n * n.dot(t)).normalize_or_zero();
@@ -34,7 +35,7 @@ pub fn perturb_normal(n: Vec3, t: Vec3, sign: f32, tn: Vec3) -> Vec3 {
         return n;
     }
     let b = n.cross(t) * if sign < 0.0 { -1.0 } else { 1.0 };
-    (t * tn.x + b * tn.y + n * tn.z).normalize_or_zero()
+    (t * tn.x + b * tn.y + n * tn.z).normalize_or(n)
 }
 
 /// Tangent-space normal of a height field from its slopes along the tangent-space x and y axes

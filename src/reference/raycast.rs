@@ -2,6 +2,7 @@
 //! (same pixel centres, lights and material constants) as a GPU frame.
 
 use super::bvh::{Bvh, Hit};
+use crate::math::interp::perturb_normal;
 use crate::math::projection::pixel_to_ndc;
 use crate::math::ray::Ray;
 use crate::render::frame::FramePlan;
@@ -281,27 +282,22 @@ impl<'a> ReferenceScene<'a> {
             let t4 = prim.tangents[idx[0]] * w.x
                 + prim.tangents[idx[1]] * w.y
                 + prim.tangents[idx[2]] * w.z;
+            // A mirroring transform flips the bitangent, as in the vertex shader.
             let det_sign = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
-            let t = m3 * t4.truncate();
-            let t = t - n_geo * n_geo.dot(t);
-            if t.length_squared() > 1e-12 {
-                let t = t.normalize();
-                let sign = if prim.tangents[idx[0]].w * det_sign >= 0.0 {
-                    1.0
-                } else {
-                    -1.0
-                };
-                let b = n_geo.cross(t) * sign;
-                let s = self.sample(
-                    mat.normal_texture.map(|t| t.texture),
-                    uv,
-                    false,
-                    Vec4::new(0.5, 0.5, 1.0, 1.0),
-                );
-                let tn = s.truncate() * 2.0 - Vec3::ONE;
-                let tn = Vec3::new(tn.x * mat.normal_scale, tn.y * mat.normal_scale, tn.z);
-                n = (t * tn.x + b * tn.y + n_geo * tn.z).normalize_or(n_geo);
-            }
+            let s = self.sample(
+                mat.normal_texture.map(|t| t.texture),
+                uv,
+                false,
+                Vec4::new(0.5, 0.5, 1.0, 1.0),
+            );
+            let tn = s.truncate() * 2.0 - Vec3::ONE;
+            let tn = Vec3::new(tn.x * mat.normal_scale, tn.y * mat.normal_scale, tn.z);
+            n = perturb_normal(
+                n_geo,
+                m3 * t4.truncate(),
+                prim.tangents[idx[0]].w * det_sign,
+                tn,
+            );
         }
         // Back faces (seen only on double-sided materials on the GPU) flip like the shader does.
         if ng.dot(ray.dir) > 0.0 && n_geo.dot(ray.dir) > 0.0 {
