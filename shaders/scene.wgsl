@@ -38,7 +38,7 @@ struct Frame {
     // x: shadow-map size in texels, y: normal-offset bias in texels,
     // z: world size of one texel (directional) or per unit distance (spot), w: 1 if shadows on
     shadow: vec4<f32>,
-    // xyz: shadowed light position (spot), w: index of the shadowed light
+    // w: index of the shadowed light (MAX_LIGHTS + 1 when none); xyz unused
     shadow_light: vec4<f32>,
     // x: constant bias in shadow texels, applied towards the light
     bias: vec4<f32>,
@@ -131,15 +131,12 @@ fn bilinear_compare(p: vec2<f32>, depth: f32, size: i32) -> f32 {
     return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
 }
 
-// Filtered shadow-map visibility of world point `p` with geometric normal `ng`, light direction `l`.
-fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>) -> f32 {
-    if frame.shadow.w < 0.5 {
-        return 1.0;
-    }
+// Filtered shadow-map visibility of world point `p` with geometric normal `ng`, for the shadowed
+// light `light` whose direction at `p` is `l` (call only when shadows are on).
+fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) -> f32 {
     var texel_world = frame.shadow.z;
-    let li = u32(frame.shadow_light.w);
-    if frame.lights[li].position.w == LIGHT_SPOT {
-        texel_world = frame.shadow.z * distance(frame.shadow_light.xyz, p);
+    if light.position.w == LIGHT_SPOT {
+        texel_world = frame.shadow.z * distance(light.position.xyz, p);
     }
     // Normal offset: move the lookup point off the surface by a number of shadow texels, more at
     // grazing angles where acne appears.
@@ -257,7 +254,7 @@ fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0)
         var vis = select(0.0, 1.0, dot(n_geo, l) > 0.0);
         if u32(frame.shadow_light.w) == i {
             if frame.shadow.w > 0.5 {
-                vis *= shadow_visibility(p, n_geo, l);
+                vis *= shadow_visibility(p, n_geo, l, light);
             }
             shadow_term = vis;
         }

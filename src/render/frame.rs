@@ -150,9 +150,13 @@ pub fn plan_frame(
                 0.0
             },
         ),
-        shadow_light: shadow_light
-            .map(|i| lights[i].position.extend(i as f32))
-            .unwrap_or(Vec4::new(0.0, 0.0, 0.0, -1.0)),
+        // No shadowed light: an index the shader's light loop never reaches.
+        shadow_light: Vec4::new(
+            0.0,
+            0.0,
+            0.0,
+            shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32),
+        ),
         bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
         modes: [
             view.mode.shader_value(),
@@ -162,10 +166,6 @@ pub fn plan_frame(
         ],
         lights: [LightUniform::default(); MAX_LIGHTS],
     };
-    if shadow_light.is_none() {
-        // No light index matches: w = a value no loop index reaches.
-        u.shadow_light.w = MAX_LIGHTS as f32 + 1.0;
-    }
     for (i, l) in lights.iter().enumerate() {
         let (kind, cone) = match l.kind {
             LightKind::Directional => (0.0, Vec4::ZERO),

@@ -36,7 +36,7 @@ pub struct FrameUniform {
     pub ambient: Vec4,
     /// x map size, y normal offset (texels), z texel world size (or per unit distance), w enabled.
     pub shadow: Vec4,
-    /// xyz shadowed light position, w its index.
+    /// w: index of the shadowed light (`MAX_LIGHTS + 1` when none); xyz unused.
     pub shadow_light: Vec4,
     /// x constant bias in shadow texels (towards the light).
     pub bias: Vec4,
