@@ -277,14 +277,7 @@ impl CameraPass {
                         );
                         bound_material = dr.material;
                     }
-                    d.cmd_set_cull_mode(
-                        cmd,
-                        if dr.double_sided {
-                            vk::CullModeFlags::NONE
-                        } else {
-                            vk::CullModeFlags::BACK
-                        },
-                    );
+                    d.cmd_set_cull_mode(cmd, dr.cull_mode());
                     d.cmd_push_constants(
                         cmd,
                         self.layout,

@@ -51,6 +51,17 @@ pub struct Draw {
     pub double_sided: bool,
 }
 
+impl Draw {
+    /// Cull mode for both passes: double-sided materials draw (and cast from) both faces.
+    pub fn cull_mode(&self) -> vk::CullModeFlags {
+        if self.double_sided {
+            vk::CullModeFlags::NONE
+        } else {
+            vk::CullModeFlags::BACK
+        }
+    }
+}
+
 /// The GPU copy of a scene.
 pub struct GpuScene {
     ctx: Arc<Context>,

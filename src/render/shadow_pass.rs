@@ -187,14 +187,7 @@ impl ShadowPass {
                         light_clip_from_world: *light_clip_from_world,
                         world_from_model: dr.world_from_model,
                     };
-                    d.cmd_set_cull_mode(
-                        cmd,
-                        if dr.double_sided {
-                            vk::CullModeFlags::NONE
-                        } else {
-                            vk::CullModeFlags::BACK
-                        },
-                    );
+                    d.cmd_set_cull_mode(cmd, dr.cull_mode());
                     d.cmd_push_constants(
                         cmd,
                         self.layout,
