@@ -145,6 +145,7 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
         bindings.push(name);
     }
     writeln!(code, "    /// Every resource binding of the module.").unwrap();
+    writeln!(code, "    #[allow(dead_code)]").unwrap();
     writeln!(
         code,
         "    pub const BINDINGS: &[ReflectedBinding] = &[{}];",

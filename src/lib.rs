@@ -1,26 +1,42 @@
 //! umbra: a real-time shadow-mapping raster engine on Vulkan.
 //!
-//! Layers, in one direction only: [`math`] → [`scene`] → [`gpu`] → [`render`].
+//! Layers, in one direction only: [`math`] → [`scene`] → [`gpu`] → [`render`], with the CPU
+//! ray-cast [`reference`] beside them (feature `reference`).
+//!
+//! The crate root re-exports what an offscreen image test needs. With
+//! `default-features = false` umbra builds without the command line, the viewer and the
+//! reference (no clap, winit, rayon or nv-flip).
 //!
 //! Render a frame offscreen (this example runs in the test suite, on lavapipe, with validation):
 //!
 //! ```
-//! use umbra::{gpu::{Context, ContextDesc, Validation}, render::{Renderer, View}, scene::demo::demo_scene};
+//! use umbra::{demo_scene, Context, ContextDesc, Renderer, Validation, View};
 //!
 //! let scene = demo_scene();
 //! let ctx = Context::new(&ContextDesc { validation: Validation::Required, ..Default::default() })?;
+//! let log = ctx.validation_log.clone();
 //! let mut renderer = Renderer::new(&ctx, &scene)?;
 //! let frame = renderer.render(&View::new(scene.cameras[0]), 64, 36)?;
 //! assert_eq!(frame.image.dimensions(), (64, 36));
 //! assert!(frame.stats.casters_drawn > 0);
-//! assert_eq!(ctx.validation_log.problem_count(), 0);
 //! frame.image.save(std::env::temp_dir().join("umbra-doc-demo.png"))?;
+//! // Count validation messages after everything is destroyed (leaks are reported then).
+//! drop(renderer);
+//! drop(ctx);
+//! assert_eq!(log.problem_count(), 0);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod app;
 pub mod gpu;
 pub mod math;
+#[cfg(feature = "reference")]
 pub mod reference;
 pub mod render;
 pub mod scene;
+
+pub use gpu::{Context, ContextDesc, GpuError, Validation, ValidationLog};
+pub use render::{
+    FramePlan, FrameStats, Pcf, RenderedFrame, Renderer, SceneOptions, ShadowFit, ShadowFormat,
+    ShadowSettings, View, ViewMode,
+};
+pub use scene::{demo::demo_scene, load_gltf, Camera, Light, LightKind, LoadError, Scene};

@@ -1,11 +1,14 @@
 //! The `umbra` binary: parse, call the library, report. Errors print one line and exit 1.
 
+mod app;
+
 use anyhow::Context as _;
+#[cfg(feature = "reference")]
+use app::cli::CompareArgs;
+#[cfg(feature = "viewer")]
+use app::cli::ViewArgsCmd;
+use app::cli::{load_scene, make_view, pcf_of, scene_options, BenchArgs, Cli, Command, RenderArgs};
 use clap::Parser;
-use umbra::app::cli::{
-    load_scene, make_view, pcf_of, scene_options, BenchArgs, Cli, Command, CompareArgs, RenderArgs,
-    ViewArgsCmd,
-};
 use umbra::gpu::{Context, ContextDesc, Validation};
 use umbra::render::{FrameStats, Renderer};
 
@@ -16,7 +19,9 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(a) => render(a),
+        #[cfg(feature = "reference")]
         Command::Compare(a) => compare(a),
+        #[cfg(feature = "viewer")]
         Command::View(a) => view(a),
         Command::Bench(a) => bench(a),
     };
@@ -73,15 +78,20 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         "rendered {} ({} triangles, {} casters drawn) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
         scene.name, s.triangles, s.casters_drawn, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
     );
-    if ctx.validation_log.problem_count() > 0 {
+    // Count after the renderer and the context are gone, so destroy-time and leak messages count.
+    let log = ctx.validation_log.clone();
+    drop(renderer);
+    drop(ctx);
+    if log.problem_count() > 0 {
         anyhow::bail!(
             "{} validation message(s) of warning or error severity",
-            ctx.validation_log.problem_count()
+            log.problem_count()
         );
     }
     Ok(())
 }
 
+#[cfg(feature = "reference")]
 fn compare(a: CompareArgs) -> anyhow::Result<()> {
     use umbra::reference::{compare as compare_frames, ReferenceScene};
     use umbra::render::ViewMode;
@@ -133,10 +143,11 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+#[cfg(feature = "viewer")]
 fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
     let view = make_view(&scene, &a.view)?;
-    umbra::app::viewer::run(umbra::app::viewer::ViewerOptions {
+    app::viewer::run(app::viewer::ViewerOptions {
         scene,
         view,
         size: a.view.size,

@@ -215,6 +215,75 @@ fn index_out_of_range() {
     assert_one_line_error(&p, "out of range");
 }
 
+/// Image, texture and sampler objects that name nothing (an empty `images` entry panicked inside
+/// gltf 1.4.1 before the pre-check): one error line each.
+#[test]
+fn images_and_textures_without_a_source() {
+    let d = tmp("images");
+    let bin = triangle_bytes([0, 1, 2]);
+    let cases = [
+        (
+            "empty_image",
+            json!([{}]),
+            json!([{"source": 0}]),
+            "exactly one source",
+        ),
+        (
+            "both_sources",
+            json!([{"uri": "a.png", "bufferView": 0, "mimeType": "image/png"}]),
+            json!([{"source": 0}]),
+            "exactly one source",
+        ),
+        (
+            "view_without_mime",
+            json!([{"bufferView": 0}]),
+            json!([{"source": 0}]),
+            "exactly one source",
+        ),
+        (
+            "missing_image",
+            json!([]),
+            json!([{"source": 3}]),
+            "texture 0 source",
+        ),
+        (
+            "missing_sampler",
+            json!([{"uri": "a.png"}]),
+            json!([{"source": 0, "sampler": 2}]),
+            "texture 0 sampler",
+        ),
+    ];
+    for (name, images, textures, expect) in cases {
+        let mut j = triangle_json(json!({"uri": data_uri(&bin), "byteLength": bin.len()}), 3);
+        j["images"] = images;
+        j["textures"] = textures;
+        j["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+        j["meshes"][0]["primitives"][0]["material"] = json!(0);
+        let p = d.join(format!("{name}.gltf"));
+        std::fs::write(&p, j.to_string()).unwrap();
+        assert_one_line_error(&p, expect);
+    }
+}
+
+/// glTF 1.0 and files without `asset.version` are refused (they used to render an empty image
+/// with exit 0).
+#[test]
+fn gltf_1_and_missing_version() {
+    let d = tmp("version");
+    let p = d.join("v1.gltf");
+    std::fs::write(&p, br#"{"asset":{"version":"1.0"}}"#).unwrap();
+    assert_one_line_error(&p, "gltf version 1.0 is not supported");
+    let p = d.join("noversion.gltf");
+    std::fs::write(&p, br#"{"asset":{}}"#).unwrap();
+    assert_one_line_error(&p, "asset.version is missing");
+    let bin = triangle_bytes([0, 1, 2]);
+    let mut j = triangle_json(json!({"uri": data_uri(&bin), "byteLength": bin.len()}), 3);
+    j["asset"] = json!({"version": "1.0"});
+    let p = d.join("v1_with_mesh.gltf");
+    std::fs::write(&p, j.to_string()).unwrap();
+    assert_one_line_error(&p, "gltf version 1.0 is not supported");
+}
+
 #[test]
 fn bad_arguments() {
     let d = tmp("args");

@@ -69,24 +69,17 @@ fn corrupted_files_never_panic() {
     }));
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fuzz");
     std::fs::create_dir_all(&dir).unwrap();
-    let corpus = common::corpus();
-    let seeds = [
-        ("Box.glb", std::fs::read(corpus.join("Box.glb")).unwrap()),
-        (
-            "cube.gltf",
-            std::fs::read(corpus.join("cube/cube.gltf")).unwrap(),
-        ),
-        (
-            "barycentric.gltf",
-            std::fs::read(corpus.join("barycentric/barycentric.gltf")).unwrap(),
-        ),
-        (
-            "gltf_primitives.glb",
-            std::fs::read(corpus.join("gltf_primitives.glb")).unwrap(),
-        ),
-    ];
-    // cube.gltf refers to cube.bin next to it.
-    std::fs::copy(corpus.join("cube/cube.bin"), dir.join("cube.bin")).unwrap();
+    // Seeds: the generated corpus (external .bin and PNG files, .glb with embedded images, data
+    // URIs, samplers, textures, every material texture slot, sparse accessors, strips and fans,
+    // KHR_lights_punctual, KHR_materials_unlit, cameras), written next to the mutated copies so
+    // their external files resolve.
+    let seeds: Vec<(String, Vec<u8>)> = common::corpus::write_corpus(&dir)
+        .into_iter()
+        .map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            (name, std::fs::read(&p).unwrap())
+        })
+        .collect();
     let mut rng = Rng(0x5DEE_CE66_D1CE_4E5B);
     let (mut ok, mut err) = (0, 0);
     let start = std::time::Instant::now();

@@ -165,3 +165,39 @@ fn viewer_without_a_display_fails_with_one_line() {
         "{err}"
     );
 }
+
+/// Soak: 500+ frames with 60 scripted resizes (0×0 among them) and no memory growth after
+/// warm-up (< 2 MB, reported by the viewer itself), no validation message.
+#[test]
+fn viewer_soak_with_resizes_keeps_memory_flat() {
+    let x = Xvfb::start();
+    let sizes = ["320x240", "400x300", "0x0", "200x150", "640x360", "300x200"];
+    let script: Vec<&str> = sizes.iter().cycle().take(60).copied().collect();
+    let script = script.join(",");
+    let (ok, log) = umbra(
+        &[
+            "view",
+            "--frames",
+            "500",
+            "--size",
+            "160x120",
+            "--no-vsync",
+            "--validation",
+            "--resize-script",
+            &script,
+        ],
+        Some(&x.display),
+    );
+    assert!(ok, "viewer failed:\n{log}");
+    let line = log
+        .lines()
+        .find(|l| l.contains("resident memory"))
+        .unwrap_or_else(|| panic!("no memory report:\n{log}"));
+    eprintln!("{line}");
+    let growth: f64 = line
+        .rsplit("growth ")
+        .next()
+        .and_then(|g| g.trim_end_matches(" MB)").parse().ok())
+        .unwrap();
+    assert!(growth < 2.0, "viewer memory grew: {line}");
+}

@@ -1,8 +1,8 @@
 //! Viewer key actions on the view settings, as pure logic; each returns the line to print.
 
-use crate::render::{Pcf, View, ViewMode};
-use crate::scene::Light;
 use glam::Vec3;
+use umbra::render::{Pcf, View, ViewMode};
+use umbra::scene::Light;
 
 /// What a key does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -120,7 +120,7 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Camera;
+    use umbra::scene::Camera;
 
     fn view() -> View {
         View::new(Camera::look_at(

@@ -1,11 +1,11 @@
 //! Argument parsing (clap) and turning arguments into a scene and a view.
 
-use crate::render::{Pcf, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};
-use crate::scene::{demo::demo_scene, load_gltf, Camera, Scene};
 use anyhow::{anyhow, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 use std::path::PathBuf;
+use umbra::render::{Pcf, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};
+use umbra::scene::{demo::demo_scene, load_gltf, Camera, Scene};
 
 /// umbra: real-time shadow-mapping renderer (Vulkan).
 #[derive(Parser, Debug)]
@@ -23,8 +23,10 @@ pub enum Command {
     Render(RenderArgs),
     /// Render on the GPU and by CPU ray casting, print shadow and image error as one JSON line,
     /// and write gpu.png, reference.png and diff.png (false shadow red, false light blue).
+    #[cfg(feature = "reference")]
     Compare(CompareArgs),
     /// Open a window and render continuously (the demo scene without SCENE).
+    #[cfg(feature = "viewer")]
     View(ViewArgsCmd),
     /// Time frames offscreen over shadow-map sizes and PCF kernels (medians of N frames) and
     /// print a Markdown table.
@@ -64,6 +66,7 @@ pub fn pcf_of(p: PcfArg) -> Pcf {
 }
 
 /// `umbra view`.
+#[cfg(feature = "viewer")]
 #[derive(Args, Debug)]
 pub struct ViewArgsCmd {
     /// glTF 2.0 file; the built-in demo scene when omitted.
@@ -99,6 +102,7 @@ fn parse_size_or_zero(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// `umbra compare`.
+#[cfg(feature = "reference")]
 #[derive(Args, Debug)]
 pub struct CompareArgs {
     /// glTF 2.0 file; the built-in demo scene when omitted.
@@ -240,10 +244,10 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     if w == 0 || h == 0 {
         return Err(format!("size {w}x{h} must be at least 1x1"));
     }
-    if w > crate::render::renderer::MAX_SIDE || h > crate::render::renderer::MAX_SIDE {
+    if w > umbra::render::MAX_SIDE || h > umbra::render::MAX_SIDE {
         return Err(format!(
             "size {w}x{h} exceeds {0}x{0}",
-            crate::render::renderer::MAX_SIDE
+            umbra::render::MAX_SIDE
         ));
     }
     Ok((w, h))
@@ -278,14 +282,14 @@ pub fn load_scene(path: Option<&PathBuf>, ground: bool) -> anyhow::Result<Scene>
         eprintln!("warning: {}: {w}", s.name);
     }
     if ground {
-        crate::scene::shapes::add_ground(&mut s);
+        umbra::scene::shapes::add_ground(&mut s);
     }
     Ok(s)
 }
 
 /// Upload options from arguments.
-pub fn scene_options(a: &ViewArgs) -> crate::render::SceneOptions {
-    crate::render::SceneOptions {
+pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
+    umbra::render::SceneOptions {
         anisotropy: a.anisotropy,
     }
 }

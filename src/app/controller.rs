@@ -3,10 +3,10 @@
 //! frame the bounds) and fly (WASD + Q/E, mouse look with the left button, Shift for speed).
 //! Speeds scale with the scene's size.
 
-use crate::math::projection::framing_distance;
-use crate::math::Aabb;
-use crate::scene::Camera;
 use glam::Vec3;
+use umbra::math::projection::framing_distance;
+use umbra::math::Aabb;
+use umbra::scene::Camera;
 
 /// Mouse buttons the controllers use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -9,22 +9,20 @@
 
 use super::actions::{apply, Action, SunAngles};
 use super::controller::{Button, Controller, Input, MoveKey};
-use crate::gpu::{Context, ContextDesc, Validation};
-use crate::render::frame::effective_lights;
-use crate::render::window::{DrawResult, WindowRenderer};
-use crate::render::View;
-use crate::scene::{LightKind, Scene};
 use anyhow::{anyhow, Context as _};
-use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
-use std::ffi::CStr;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
+use umbra::gpu::{Context, ContextDesc, Validation};
+use umbra::render::View;
+use umbra::render::{effective_lights, surface_extensions, DrawResult, WindowRenderer};
+use umbra::scene::{LightKind, Scene};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
 /// How to run the viewer.
@@ -36,7 +34,7 @@ pub struct ViewerOptions {
     /// Window inner size.
     pub size: (u32, u32),
     /// Upload options (texture filtering).
-    pub scene_options: crate::render::SceneOptions,
+    pub scene_options: umbra::render::SceneOptions,
     /// FIFO presentation (vsync).
     pub vsync: bool,
     /// Render this many frames, then exit (with `screenshot`, save the last one).
@@ -53,6 +51,15 @@ pub struct ViewerOptions {
 
 /// Frames between two resize-script steps.
 const SCRIPT_STEP_FRAMES: u64 = 4;
+/// Frames after which resident memory is sampled for the end-of-run report.
+const WARM_UP_FRAMES: u64 = 100;
+
+/// Resident set size of this process in bytes (Linux; None elsewhere).
+fn resident_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/statm").ok()?;
+    let pages: u64 = s.split_whitespace().nth(1)?.parse().ok()?;
+    Some(pages * 4096)
+}
 
 /// What a key does in the viewer.
 enum KeyAction {
@@ -101,11 +108,13 @@ struct State {
     ctx: Arc<Context>,
     window: Arc<Window>,
     controller: Controller,
-    bounds: crate::math::Aabb,
+    bounds: umbra::math::Aabb,
     view: View,
     sun: SunAngles,
     camera_index: Option<usize>,
     drawn: u64,
+    /// Resident memory (bytes) after the warm-up frames, for the end-of-run report.
+    rss_warm: Option<u64>,
     ticks: u64,
     first_draw: Option<Instant>,
     last_frame: Instant,
@@ -142,12 +151,7 @@ impl App {
             .display_handle()
             .map_err(|e| anyhow!("no display handle: {e}"))?
             .as_raw();
-        let exts = ash_window::enumerate_required_extensions(display)
-            .map_err(|e| anyhow!("no Vulkan surface support for this display: {e:?}"))?;
-        let instance_extensions = exts
-            .iter()
-            .map(|&p| unsafe { CStr::from_ptr(p) }.to_owned())
-            .collect();
+        let instance_extensions = surface_extensions(display)?;
         let ctx = Context::new(&ContextDesc {
             validation: if self.opts.validation {
                 Validation::Required
@@ -162,14 +166,12 @@ impl App {
             .window_handle()
             .map_err(|e| anyhow!("no window handle: {e}"))?
             .as_raw();
-        let surface =
-            unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, handle, None) }
-                .map_err(|e| anyhow!("cannot create a Vulkan surface: {e:?}"))?;
         let size = window.inner_size();
         let renderer = WindowRenderer::new(
             &ctx,
             &self.opts.scene,
-            surface,
+            display,
+            handle,
             size.width,
             size.height,
             self.opts.vsync,
@@ -205,6 +207,7 @@ impl App {
             sun: SunAngles::from_direction(sun_dir),
             camera_index: None,
             drawn: 0,
+            rss_warm: None,
             ticks: 0,
             first_draw: None,
             last_frame: Instant::now(),
@@ -260,6 +263,9 @@ impl App {
         let cpu = t0.elapsed().as_secs_f64() * 1e3;
         if let DrawResult::Drawn { screenshot, .. } = result {
             s.drawn += 1;
+            if s.drawn == WARM_UP_FRAMES {
+                s.rss_warm = resident_bytes();
+            }
             s.first_draw.get_or_insert(t0);
             s.cpu_ms.push(cpu);
             s.frame_ms.push(dt as f64 * 1e3);
@@ -482,6 +488,15 @@ pub fn run(opts: ViewerOptions) -> anyhow::Result<()> {
                 s.drawn,
                 (s.drawn - 1) as f64 / secs,
                 if app.opts.vsync { "on" } else { "off" }
+            );
+        }
+        if let (Some(warm), Some(end)) = (s.rss_warm, resident_bytes()) {
+            println!(
+                "viewer: resident memory {:.1} MB after {WARM_UP_FRAMES} frames, {:.1} MB after {} (growth {:.2} MB)",
+                warm as f64 / 1e6,
+                end as f64 / 1e6,
+                s.drawn,
+                (end as f64 - warm as f64) / 1e6
             );
         }
         // Keep the log past the teardown, so messages from destroying objects count too.

@@ -21,8 +21,10 @@ pub enum Access {
     DepthFragmentSampled,
     /// A swapchain image just acquired: its old contents are not needed, and the first use must
     /// wait at colour-attachment output, the stage the acquire semaphore is waited at.
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
     Acquired,
     /// Handed to presentation.
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
     Present,
 }
 

@@ -1,10 +1,11 @@
 //! The thin, safe layer over ash: context (instance, device, allocator, validation), resources that
-//! free themselves, named barriers, and shader modules with reflected bindings.
+//! free themselves, named barriers, and shader modules with reflected bindings. Only the context
+//! and its options are public.
 
-pub mod barrier;
-pub mod context;
-pub mod resources;
-pub mod shaders;
+pub(crate) mod barrier;
+pub(crate) mod context;
+pub(crate) mod resources;
+pub(crate) mod shaders;
 
 pub use context::{Context, ContextDesc, GpuError, Validation, ValidationLog};
-pub use resources::{Buffer, Image};
+pub(crate) use resources::{Buffer, Image};

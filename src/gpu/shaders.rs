@@ -4,7 +4,8 @@
 use super::context::{Context, GpuError, VkCheck};
 use ash::vk;
 
-/// Kind of a shader resource binding.
+/// Kind of a shader resource binding (every kind build.rs can emit, used by these shaders or not).
+#[allow(dead_code)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BindingKind {
     /// `var<uniform>`.
@@ -23,7 +24,9 @@ pub enum BindingKind {
     Other,
 }
 
-/// One resource binding as declared in WGSL.
+/// One resource binding as declared in WGSL (the whole reflection is kept; not every field is
+/// read outside diagnostics).
+#[allow(dead_code)]
 #[derive(Clone, Copy, Debug)]
 pub struct ReflectedBinding {
     /// Variable name.

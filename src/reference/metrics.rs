@@ -97,7 +97,7 @@ pub fn compare(
 ) -> (Metrics, image::RgbaImage) {
     let (w, h) = (reference.width, reference.height);
     let inv = plan.clip_from_world.inverse();
-    let eye = plan.uniform.camera_position.truncate();
+    let eye = plan.camera_position;
     let idx = |x: i32, y: i32| (y as u32 * w + x as u32) as usize;
     // Same surface point: both see something, at distances within 1% (+ a small absolute term).
     let same = |x: u32, y: u32| -> Option<bool> {

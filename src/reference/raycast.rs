@@ -184,7 +184,7 @@ impl<'a> ReferenceScene<'a> {
         if !facing {
             return (false, dir, radiance);
         }
-        if plan.shadow_light != Some(i) || plan.uniform.shadow.w < 0.5 {
+        if plan.shadow_light != Some(i) || !plan.shadows_on {
             return (true, dir, radiance);
         }
         // Start the shadow ray off the surface, on the light's side of the true face.
@@ -205,7 +205,7 @@ impl<'a> ReferenceScene<'a> {
         ambient: Vec3,
     ) -> ReferenceFrame {
         let inv = plan.clip_from_world.inverse();
-        let eye = plan.uniform.camera_position.truncate();
+        let eye = plan.camera_position;
         let n = (width * height) as usize;
         let c = crate::render::core::CLEAR_COLOR;
         let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];

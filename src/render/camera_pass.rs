@@ -254,6 +254,7 @@ impl CameraPass {
             if shadow_map_view {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.map_pipeline);
                 d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
+                d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
                 d.cmd_draw(cmd, 3, 1, 0, 0);
             } else if !scene.draws.is_empty() {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
@@ -278,6 +279,7 @@ impl CameraPass {
                         bound_material = dr.material;
                     }
                     d.cmd_set_cull_mode(cmd, dr.cull_mode());
+                    d.cmd_set_front_face(cmd, dr.front_face());
                     d.cmd_push_constants(
                         cmd,
                         self.layout,

@@ -155,7 +155,7 @@ impl FrameCore {
                 );
             }
         }
-        let shadows_on = plan.uniform.shadow.w > 0.5;
+        let shadows_on = plan.shadows_on;
         let casters = self.shadow.record(
             cmd,
             &self.gpu,

@@ -77,8 +77,14 @@ pub fn fitting_frustum(camera: &Camera, aspect: f32, bounds: &Aabb) -> CameraFru
 /// The result of planning a frame.
 #[derive(Clone, Debug)]
 pub struct FramePlan {
-    /// The uniform block for the camera pass.
-    pub uniform: FrameUniform,
+    /// The uniform block for the camera pass (its packed fields have named copies below).
+    pub(crate) uniform: FrameUniform,
+    /// Whether this frame draws and samples a shadow map.
+    pub shadows_on: bool,
+    /// Side of the shadow map in texels.
+    pub shadow_map_size: u32,
+    /// The camera's world position.
+    pub camera_position: Vec3,
     /// Lights shading this frame.
     pub lights: Vec<Light>,
     /// Index of the light with the shadow map, if any.
@@ -135,6 +141,7 @@ pub fn plan_frame(
             LightKind::Point => {}
         }
     }
+    let shadows_on = view.shadow.enabled && shadow_light.is_some();
     let mut u = FrameUniform {
         clip_from_world,
         light_clip_from_world,
@@ -144,11 +151,7 @@ pub fn plan_frame(
             size as f32,
             view.shadow.normal_offset,
             texel_world,
-            if view.shadow.enabled && shadow_light.is_some() {
-                1.0
-            } else {
-                0.0
-            },
+            if shadows_on { 1.0 } else { 0.0 },
         ),
         // No shadowed light: an index the shader's light loop never reaches.
         shadow_light: Vec4::new(
@@ -183,6 +186,9 @@ pub fn plan_frame(
     }
     FramePlan {
         uniform: u,
+        shadows_on,
+        shadow_map_size: size,
+        camera_position: view.camera.position(),
         lights,
         shadow_light,
         light_clip_from_world,

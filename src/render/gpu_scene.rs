@@ -49,6 +49,8 @@ pub struct Draw {
     pub world_bounds: Aabb,
     /// Draw both faces.
     pub double_sided: bool,
+    /// The transform mirrors (negative determinant): its triangles wind clockwise on screen.
+    pub mirrored: bool,
 }
 
 impl Draw {
@@ -58,6 +60,16 @@ impl Draw {
             vk::CullModeFlags::NONE
         } else {
             vk::CullModeFlags::BACK
+        }
+    }
+
+    /// Front face for both passes: counter-clockwise, or clockwise under a mirroring transform
+    /// (negative scale), so culling and the shader's `front_facing` keep their meaning.
+    pub fn front_face(&self) -> vk::FrontFace {
+        if self.mirrored {
+            vk::FrontFace::CLOCKWISE
+        } else {
+            vk::FrontFace::COUNTER_CLOCKWISE
         }
     }
 }
@@ -154,6 +166,7 @@ impl GpuScene {
                         .materials
                         .get(material)
                         .is_some_and(|m| m.double_sided),
+                    mirrored: glam::Mat3::from_mat4(inst.world_from_model).determinant() < 0.0,
                 });
             }
         }

@@ -1,16 +1,22 @@
-//! Rendering: one module per pass, the per-frame plan, and the offscreen renderer.
+//! Rendering: one module per pass, the per-frame plan, and the offscreen renderer. Passes,
+//! pipelines and uniform layouts are internal; the public types are re-exported here.
 
-pub mod camera_pass;
-pub mod core;
-pub mod frame;
-pub mod gpu_scene;
-pub mod pipeline;
-pub mod renderer;
-pub mod settings;
-pub mod shadow_pass;
-pub mod swapchain;
-pub mod uniforms;
-pub mod window;
+pub(crate) mod camera_pass;
+pub(crate) mod core;
+pub(crate) mod frame;
+pub(crate) mod gpu_scene;
+pub(crate) mod pipeline;
+pub(crate) mod renderer;
+pub(crate) mod settings;
+pub(crate) mod shadow_pass;
+#[cfg(feature = "viewer")]
+pub(crate) mod swapchain;
+pub(crate) mod uniforms;
+#[cfg(feature = "viewer")]
+pub(crate) mod window;
 
-pub use renderer::{FrameStats, RenderedFrame, Renderer};
+pub use frame::{effective_lights, FramePlan};
+pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 pub use settings::{Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};
+#[cfg(feature = "viewer")]
+pub use window::{surface_extensions, DrawResult, WindowRenderer};

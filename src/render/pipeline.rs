@@ -78,6 +78,7 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         vk::DynamicState::VIEWPORT,
         vk::DynamicState::SCISSOR,
         vk::DynamicState::CULL_MODE,
+        vk::DynamicState::FRONT_FACE,
     ];
     if d.depth_bias {
         dyn_states.push(vk::DynamicState::DEPTH_BIAS);

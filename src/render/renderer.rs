@@ -13,8 +13,6 @@ use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use super::core::CLEAR_COLOR;
-
 /// Colour format of offscreen frames (sRGB-encoded on write).
 pub const OFFSCREEN_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 /// Largest offscreen side.

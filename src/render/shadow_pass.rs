@@ -188,6 +188,7 @@ impl ShadowPass {
                         world_from_model: dr.world_from_model,
                     };
                     d.cmd_set_cull_mode(cmd, dr.cull_mode());
+                    d.cmd_set_front_face(cmd, dr.front_face());
                     d.cmd_push_constants(
                         cmd,
                         self.layout,

@@ -37,7 +37,7 @@ impl Swapchain {
         height: u32,
         vsync: bool,
     ) -> Result<Self, GpuError> {
-        let surface_loader = ash::khr::surface::Instance::new(&ctx.entry, &ctx.instance);
+        let surface_loader = ash::khr::surface::Instance::new(&ctx.instance.entry, &ctx.instance);
         let supported = unsafe {
             surface_loader.get_physical_device_surface_support(
                 ctx.physical,

@@ -13,7 +13,21 @@ use crate::gpu::{Buffer, Image};
 use crate::scene::Scene;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
+use raw_window_handle::{RawDisplayHandle, RawWindowHandle};
+use std::ffi::{CStr, CString};
 use std::sync::Arc;
+
+/// The instance extensions a Vulkan surface on `display` needs (for
+/// [`ContextDesc::instance_extensions`](crate::gpu::ContextDesc::instance_extensions)).
+pub fn surface_extensions(display: RawDisplayHandle) -> Result<Vec<CString>, GpuError> {
+    let exts = ash_window::enumerate_required_extensions(display).map_err(|e| {
+        GpuError::Unsupported(format!("no Vulkan surface support for this display: {e:?}"))
+    })?;
+    Ok(exts
+        .iter()
+        .map(|&p| unsafe { CStr::from_ptr(p) }.to_owned())
+        .collect())
+}
 
 /// Frames recorded ahead of the GPU.
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -41,7 +55,7 @@ pub enum DrawResult {
 pub struct WindowRenderer {
     core: FrameCore,
     /// The swapchain.
-    pub swapchain: Swapchain,
+    pub(crate) swapchain: Swapchain,
     frames: Vec<FrameSync>,
     depth: Option<(Image, Attachment)>,
     frame: usize,
@@ -51,16 +65,24 @@ pub struct WindowRenderer {
 }
 
 impl WindowRenderer {
-    /// Creates the swapchain on `surface` (taking ownership) and the passes for its format.
+    /// Creates a surface for the window, a swapchain of `width`×`height` on it and the passes
+    /// for its format. `ctx` must have been created with [`surface_extensions`] of the display
+    /// and `swapchain: true`; the window must outlive the renderer.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
-        surface: vk::SurfaceKHR,
+        display: RawDisplayHandle,
+        window: RawWindowHandle,
         width: u32,
         height: u32,
         vsync: bool,
         options: &SceneOptions,
     ) -> Result<Self, GpuError> {
+        let surface = unsafe {
+            ash_window::create_surface(&ctx.instance.entry, &ctx.instance, display, window, None)
+        }
+        .vk("vkCreateSurfaceKHR")?;
         let swapchain = Swapchain::new(ctx, surface, width, height, vsync)?;
         let core = FrameCore::new(ctx, scene, options, swapchain.format, FRAMES_IN_FLIGHT)?;
         let mut frames = Vec::new();

@@ -74,6 +74,8 @@ pub(super) fn check_references(path: &Path, json: &[u8]) -> Result<(), LoadError
             )),
         }
     };
+    check_asset_version(path, &v)?;
+    check_images_and_textures(path, &v)?;
     let meshes = v
         .get("meshes")
         .and_then(|m| m.as_array())
@@ -101,6 +103,80 @@ pub(super) fn check_references(path: &Path, json: &[u8]) -> Result<(), LoadError
             }
             if let Some(i) = prim.get("indices") {
                 check(i, &format!("{label} indices"))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// glTF 2.x only: `asset.version` must be present and of major version 2 (glTF 1.0 files parse
+/// as JSON but mean something else).
+fn check_asset_version(path: &Path, v: &serde_json::Value) -> Result<(), LoadError> {
+    let version = v
+        .get("asset")
+        .and_then(|a| a.get("version"))
+        .and_then(|x| x.as_str());
+    match version {
+        Some(ver) if ver.split('.').next() == Some("2") => Ok(()),
+        Some(ver) => Err(invalid(
+            path,
+            format!("glTF version {ver} is not supported (glTF 2.0 only)"),
+        )),
+        None => Err(invalid(
+            path,
+            "asset.version is missing (not a glTF 2.0 file)",
+        )),
+    }
+}
+
+/// The number of entries of the top-level array `key`.
+fn count_of(v: &serde_json::Value, key: &str) -> u64 {
+    v.get(key)
+        .and_then(|a| a.as_array())
+        .map_or(0, |a| a.len() as u64)
+}
+
+/// Images must have exactly one source (`uri`, or `bufferView` with `mimeType`) naming something
+/// that exists; textures must name existing images and samplers (gltf 1.4.1 unwraps these).
+fn check_images_and_textures(path: &Path, v: &serde_json::Value) -> Result<(), LoadError> {
+    let views = count_of(v, "bufferViews");
+    let images = count_of(v, "images");
+    let samplers = count_of(v, "samplers");
+    let list = |key: &str| {
+        v.get(key)
+            .and_then(|a| a.as_array())
+            .map(|a| a.as_slice())
+            .unwrap_or(&[])
+    };
+    for (i, img) in list("images").iter().enumerate() {
+        let uri = img.get("uri");
+        let view = img.get("bufferView");
+        let ok = match (uri, view) {
+            (Some(u), None) => u.is_string(),
+            (None, Some(b)) => {
+                b.as_u64().is_some_and(|b| b < views)
+                    && img.get("mimeType").is_some_and(|m| m.is_string())
+            }
+            _ => false,
+        };
+        if !ok {
+            return Err(corrupt(
+                path,
+                format!(
+                    "image {i} needs exactly one source: a uri, or a bufferView (of {views}) with a mimeType"
+                ),
+            ));
+        }
+    }
+    for (i, t) in list("textures").iter().enumerate() {
+        for (key, n) in [("source", images), ("sampler", samplers)] {
+            if let Some(x) = t.get(key) {
+                if x.as_u64().is_none_or(|x| x >= n) {
+                    return Err(corrupt(
+                        path,
+                        format!("texture {i} {key} refers to {x}, but there are {n}"),
+                    ));
+                }
             }
         }
     }

@@ -2,20 +2,63 @@
 //! image statistics and artifact output.
 #![allow(dead_code)]
 
+pub mod corpus;
+pub mod gltf_builder;
+
 use glam::{Mat4, Vec3, Vec4};
 use std::path::PathBuf;
 use std::sync::Arc;
 use umbra::gpu::{Context, ContextDesc, Validation};
 use umbra::math::projection::{ndc_to_pixel, pixel_to_ndc};
 
+/// A validated context for one test. It derefs to `Arc<Context>`; when it goes out of scope it
+/// drops the context (it must hold the last reference) and fails the test if any warning or error
+/// arrived, destroy-time messages (leaked objects) included.
+pub struct TestContext {
+    ctx: Option<Arc<Context>>,
+    log: Arc<umbra::ValidationLog>,
+}
+
+impl std::ops::Deref for TestContext {
+    type Target = Arc<Context>;
+    fn deref(&self) -> &Arc<Context> {
+        self.ctx.as_ref().unwrap()
+    }
+}
+
+impl Drop for TestContext {
+    fn drop(&mut self) {
+        let ctx = self.ctx.take().unwrap();
+        if std::thread::panicking() {
+            return;
+        }
+        assert_eq!(
+            Arc::strong_count(&ctx),
+            1,
+            "something still holds the context at the end of the test"
+        );
+        drop(ctx);
+        assert_eq!(
+            self.log.problem_count(),
+            0,
+            "validation messages (counted after the context was destroyed): {:#?}",
+            self.log.messages()
+        );
+    }
+}
+
 /// A context with the Khronos validation layer (synchronization validation on). Fails if the
 /// layer is missing: GPU tests never run unvalidated.
-pub fn context() -> Arc<Context> {
-    Context::new(&ContextDesc {
+pub fn context() -> TestContext {
+    let ctx = Context::new(&ContextDesc {
         validation: Validation::Required,
         ..Default::default()
     })
-    .unwrap_or_else(|e| panic!("cannot create a validated Vulkan context: {e}"))
+    .unwrap_or_else(|e| panic!("cannot create a validated Vulkan context: {e}"));
+    TestContext {
+        log: ctx.validation_log.clone(),
+        ctx: Some(ctx),
+    }
 }
 
 /// Fails the test if the validation layer reported any warning or error.
@@ -84,12 +127,4 @@ pub fn linear_to_srgb(c: f32) -> f32 {
         } else {
             1.055 * c.powf(1.0 / 2.4) - 0.055
         }
-}
-
-/// The corpus folder: UMBRA_GLTF_CORPUS, else ../shared/gltf beside the checkout.
-pub fn corpus() -> PathBuf {
-    if let Ok(p) = std::env::var("UMBRA_GLTF_CORPUS") {
-        return PathBuf::from(p);
-    }
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/gltf")
 }
