@@ -54,7 +54,9 @@ struct Material {
     emissive: vec4<f32>,
     // x: metallic, y: roughness, z: 1 if a normal map is used, w: 1 if unlit
     params: vec4<f32>,
-    // x: alpha cutoff (masked materials; 0 = opaque)
+    // x: alpha cutoff (masked materials; 0 = opaque); y: texture slots present, bit 0 base
+    // colour, bit 1 metallic-roughness, bit 2 emissive (an empty slot's default is white, so
+    // skipping its fetch gives the same value)
     extra: vec4<f32>,
 }
 
@@ -196,16 +198,40 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(hi, lo, c <= vec3<f32>(0.04045));
 }
 
+// The material's base colour at `uv`. Texture fetches happen only for the slots a material fills
+// (uniform branches: on lavapipe each skipped fetch saves filtering work for every fragment).
+fn base_color(uv: vec2<f32>) -> vec4<f32> {
+    var base = material.base_color;
+    if (u32(material.extra.y) & 1u) != 0u {
+        base *= textureSample(base_color_tex, material_sampler, uv);
+    }
+    return base;
+}
+
+// Opaque materials. No discard in this entry point: a discard anywhere in a fragment shader makes
+// llvmpipe test depth after shading, so hidden fragments would be shaded too.
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    let base = material.base_color * textureSample(base_color_tex, material_sampler, in.uv);
-    if material.extra.x > 0.0 && base.a < material.extra.x {
+    return shade(in, front_facing, base_color(in.uv));
+}
+
+// Alpha-masked materials: discard below the cutoff, then shade.
+@fragment
+fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let base = base_color(in.uv);
+    if base.a < material.extra.x {
         discard;
     }
+    return shade(in, front_facing, base);
+}
+
+// Blinn-Phong with normal mapping and shadows for the fragment `in` of base colour `base`.
+fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> vec4<f32> {
+    let flags = u32(material.extra.y);
     var n_geo = normalize(in.normal);
     var n = n_geo;
-    let normal_sample = textureSample(normal_tex, material_sampler, in.uv).xyz;
     if material.params.z > 0.5 {
+        let normal_sample = textureSample(normal_tex, material_sampler, in.uv).xyz;
         let t_raw = in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz);
         if dot(t_raw, t_raw) > 1e-12 {
             let t = normalize(t_raw);
@@ -219,7 +245,10 @@ fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0)
         n_geo = -n_geo;
         n = -n;
     }
-    let mr = textureSample(metal_rough_tex, material_sampler, in.uv);
+    var mr = vec4<f32>(1.0);
+    if (flags & 2u) != 0u {
+        mr = textureSample(metal_rough_tex, material_sampler, in.uv);
+    }
     let metallic = clamp(material.params.x * mr.b, 0.0, 1.0);
     let roughness = clamp(material.params.y * mr.g, 0.03, 1.0);
     // glTF metallic-roughness -> Blinn-Phong (same mapping as src/scene/material.rs).
@@ -228,7 +257,10 @@ fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0)
     let alpha = roughness * roughness;
     let shininess = clamp(2.0 / (alpha * alpha) - 2.0, 1.0, 2048.0);
     let ka = base.rgb;
-    let emissive = material.emissive.rgb * textureSample(emissive_tex, material_sampler, in.uv).rgb;
+    var emissive = material.emissive.rgb;
+    if (flags & 4u) != 0u {
+        emissive *= textureSample(emissive_tex, material_sampler, in.uv).rgb;
+    }
 
     let p = in.world_position;
     let v = normalize(frame.camera_position.xyz - p);

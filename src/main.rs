@@ -33,7 +33,7 @@ fn main() {
 }
 
 fn render(a: RenderArgs) -> anyhow::Result<()> {
-    let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
+    let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let view = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
         validation: if a.validation {
@@ -95,7 +95,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
 fn compare(a: CompareArgs) -> anyhow::Result<()> {
     use umbra::reference::{compare as compare_frames, ReferenceScene};
     use umbra::render::ViewMode;
-    let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
+    let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut view = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
         device: a.device.clone(),
@@ -145,7 +145,7 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
 
 #[cfg(feature = "viewer")]
 fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
-    let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
+    let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let view = make_view(&scene, &a.view)?;
     app::viewer::run(app::viewer::ViewerOptions {
         scene,
@@ -169,7 +169,7 @@ fn median_of(frames: &[FrameStats], f: &dyn Fn(&FrameStats) -> Option<f64>) -> O
 }
 
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
-    let scene = load_scene(a.scene.as_ref(), a.view.ground)?;
+    let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let base = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
         device: a.device.clone(),

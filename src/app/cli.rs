@@ -172,6 +172,14 @@ pub enum PcfArg {
 /// View options shared by the subcommands.
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
+    /// Draw everything: no frustum culling, no back-face culling of closed double-sided meshes
+    /// (to measure what they save; the image is the same).
+    #[arg(long)]
+    pub no_culling: bool,
+    /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided
+    /// primitives) or `spheres:N` (an N×N grid of 1,200-triangle spheres).
+    #[arg(long)]
+    pub synthetic: Option<String>,
     /// Image size WxH.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -273,11 +281,19 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
 
 /// Loads SCENE or builds the demo, prints its warnings (`warning: NAME: …` on stderr, one per
 /// line), and adds a ground plane when asked.
-pub fn load_scene(path: Option<&PathBuf>, ground: bool) -> anyhow::Result<Scene> {
-    let mut s = match path {
-        Some(p) => load_gltf(p)?,
-        None => demo_scene(),
+pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene> {
+    use umbra::scene::synthetic::{double_sided_scene, sphere_grid};
+    let mut s = match (path, a.synthetic.as_deref()) {
+        (Some(_), Some(_)) => bail!("give either SCENE or --synthetic, not both"),
+        (Some(p), None) => load_gltf(p)?,
+        (None, None) => demo_scene(),
+        (None, Some("double-sided")) => double_sided_scene(),
+        (None, Some(name)) => match name.strip_prefix("spheres:").map(str::parse::<u32>) {
+            Some(Ok(n)) if (1..=256).contains(&n) => sphere_grid(n),
+            _ => bail!("--synthetic {name}: expected double-sided or spheres:N with N in 1..=256"),
+        },
     };
+    let ground = a.ground;
     for w in &s.warnings {
         eprintln!("warning: {}: {w}", s.name);
     }
@@ -291,6 +307,7 @@ pub fn load_scene(path: Option<&PathBuf>, ground: bool) -> anyhow::Result<Scene>
 pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
     umbra::render::SceneOptions {
         anisotropy: a.anisotropy,
+        culling: !a.no_culling,
     }
 }
 

@@ -45,6 +45,12 @@ impl Aabb {
         self.max = self.max.max(p);
     }
 
+    /// True when `p` is inside the box grown by `margin` on every side.
+    pub fn contains(&self, p: Vec3, margin: f32) -> bool {
+        p.cmpge(self.min - Vec3::splat(margin)).all()
+            && p.cmple(self.max + Vec3::splat(margin)).all()
+    }
+
     /// The smallest box holding both.
     pub fn union(&self, o: &Aabb) -> Aabb {
         Aabb {
@@ -113,6 +119,22 @@ impl Aabb {
         Aabb::from_points(self.corners().iter().map(|c| m.transform_point3(*c)))
     }
 
+    /// True when the box lies wholly outside one plane of the clip volume of `clip_from_world`
+    /// (Vulkan clip space: −w ≤ x, y ≤ w, 0 ≤ z ≤ w). Conservative: a box that is not reported
+    /// outside may still be invisible. Works for perspective (also infinite, reversed-z) and
+    /// orthographic matrices, and for boxes behind the eye.
+    pub fn outside_clip_volume(&self, clip_from_world: &Mat4) -> bool {
+        let r = clip_from_world.transpose(); // rows of the matrix as columns
+        let (r0, r1, r2, r3) = (r.x_axis, r.y_axis, r.z_axis, r.w_axis);
+        let planes = [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2];
+        planes.iter().any(|p| {
+            let n = p.truncate();
+            // The box corner farthest along the plane's normal.
+            let v = Vec3::select(n.cmpge(Vec3::ZERO), self.max, self.min);
+            n.dot(v) + p.w < 0.0
+        })
+    }
+
     /// True when the boxes overlap (touching counts).
     pub fn overlaps(&self, o: &Aabb) -> bool {
         !self.intersection(o).is_empty()
@@ -136,6 +158,27 @@ mod tests {
         assert!(a.overlaps(&b));
         // A flat box is not empty.
         assert!(!Aabb::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0)).is_empty());
+    }
+
+    #[test]
+    fn outside_clip_volume_culls_only_invisible_boxes() {
+        use crate::math::projection::perspective_infinite_reversed;
+        let view = Mat4::look_at_rh(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y);
+        let clip = perspective_infinite_reversed(60f32.to_radians(), 1.5, 0.1) * view;
+        let unit = |c: Vec3| Aabb::new(c - Vec3::splat(0.5), c + Vec3::splat(0.5));
+        assert!(!unit(Vec3::new(0.0, 0.0, -5.0)).outside_clip_volume(&clip)); // ahead
+        assert!(!unit(Vec3::new(0.0, 0.0, -1e6)).outside_clip_volume(&clip)); // far (infinite)
+        assert!(!unit(Vec3::new(0.0, 0.0, 0.0)).outside_clip_volume(&clip)); // around the eye
+        assert!(unit(Vec3::new(0.0, 0.0, 5.0)).outside_clip_volume(&clip)); // behind
+        assert!(unit(Vec3::new(20.0, 0.0, -5.0)).outside_clip_volume(&clip)); // right
+        assert!(unit(Vec3::new(0.0, -20.0, -5.0)).outside_clip_volume(&clip)); // below
+                                                                               // Straddling the left plane: kept.
+        assert!(!unit(Vec3::new(-4.6, 0.0, -5.0)).outside_clip_volume(&clip));
+        // Orthographic (the shadow fit's kind): [-1,1]² × [0,1] box of the light.
+        let ortho = Mat4::orthographic_rh(-1.0, 1.0, -1.0, 1.0, 0.0, 10.0);
+        assert!(!unit(Vec3::new(0.0, 0.0, -3.0)).outside_clip_volume(&ortho));
+        assert!(unit(Vec3::new(3.0, 0.0, -3.0)).outside_clip_volume(&ortho));
+        assert!(unit(Vec3::new(0.0, 0.0, 3.0)).outside_clip_volume(&ortho));
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
-use super::gpu_scene::{GpuScene, VertexAttributes};
+use super::gpu_scene::{Draw, GpuScene, VertexAttributes};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
@@ -12,6 +12,7 @@ use crate::gpu::shaders::{
 };
 use crate::gpu::Buffer;
 use ash::vk;
+use glam::{Mat4, Vec3};
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
@@ -31,6 +32,7 @@ pub struct CameraPass {
     frame_layout: vk::DescriptorSetLayout,
     module: vk::ShaderModule,
     pipeline: vk::Pipeline,
+    masked_pipeline: vk::Pipeline,
     map_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
@@ -102,6 +104,9 @@ impl CameraPass {
             depth_test: true,
         };
         let pipeline = create_pipeline(ctx, &desc)?;
+        desc.name = "camera pipeline (alpha mask)";
+        desc.fragment = Some((module, sh::ENTRY_FS_MASKED));
+        let masked_pipeline = create_pipeline(ctx, &desc)?;
         desc.name = "shadow-map view pipeline";
         desc.vertex = (module, sh::ENTRY_VS_FULLSCREEN);
         desc.fragment = Some((module, sh::ENTRY_FS_SHADOW_MAP));
@@ -149,6 +154,7 @@ impl CameraPass {
             frame_layout,
             module,
             pipeline,
+            masked_pipeline,
             map_pipeline,
             pool,
             slots: slot_list,
@@ -218,7 +224,8 @@ impl CameraPass {
         extent: vk::Extent2D,
         clear: [f32; 4],
         shadow_map_view: bool,
-    ) {
+        cull: &CameraCull,
+    ) -> usize {
         let d = &self.ctx.device;
         self.ctx.begin_label(cmd, "camera pass");
         let color_att = [vk::RenderingAttachmentInfo::default()
@@ -239,6 +246,7 @@ impl CameraPass {
             .color_attachments(&color_att)
             .depth_attachment(&depth_att);
         let frame_set = self.slots[slot].set;
+        let mut drawn = 0;
         unsafe {
             d.cmd_begin_rendering(cmd, &rendering);
             set_viewport(&self.ctx, cmd, extent);
@@ -257,7 +265,6 @@ impl CameraPass {
                 d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
                 d.cmd_draw(cmd, 3, 1, 0, 0);
             } else if !scene.draws.is_empty() {
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
                 d.cmd_bind_vertex_buffers(
                     cmd,
                     0,
@@ -266,7 +273,18 @@ impl CameraPass {
                 );
                 d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
                 let mut bound_material = usize::MAX;
-                for dr in &scene.draws {
+                let mut bound_pipeline = vk::Pipeline::null();
+                for dr in draw_order(scene, cull) {
+                    let pipeline = if dr.masked {
+                        self.masked_pipeline
+                    } else {
+                        self.pipeline
+                    };
+                    if pipeline != bound_pipeline {
+                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                        bound_pipeline = pipeline;
+                    }
+                    drawn += 1;
                     if dr.material != bound_material {
                         d.cmd_bind_descriptor_sets(
                             cmd,
@@ -278,7 +296,7 @@ impl CameraPass {
                         );
                         bound_material = dr.material;
                     }
-                    d.cmd_set_cull_mode(cmd, dr.cull_mode());
+                    d.cmd_set_cull_mode(cmd, dr.cull_mode(Some(cull.eye)));
                     d.cmd_set_front_face(cmd, dr.front_face());
                     d.cmd_push_constants(
                         cmd,
@@ -293,7 +311,36 @@ impl CameraPass {
             d.cmd_end_rendering(cmd);
         }
         self.ctx.end_label(cmd);
+        drawn
     }
+}
+
+/// The draws the camera can see (unless culling is off), opaque ones first and front to back
+/// (nearest bounds first, so llvmpipe's early depth test rejects more hidden fragments before
+/// shading), then the alpha-masked ones.
+fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
+    let mut v: Vec<(bool, f32, &Draw)> = scene
+        .draws
+        .iter()
+        .filter(|dr| {
+            !scene.frustum_culling || !dr.world_bounds.outside_clip_volume(&cull.clip_from_world)
+        })
+        .map(|dr| {
+            let nearest = cull.eye.0.clamp(dr.world_bounds.min, dr.world_bounds.max);
+            (dr.masked, nearest.distance_squared(cull.eye.0), dr)
+        })
+        .collect();
+    v.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    v.into_iter().map(|(_, _, dr)| dr).collect()
+}
+
+/// What the camera pass needs to skip work: the camera's world → clip (draws whose bounds lie
+/// outside it are not recorded) and its eye with the near plane's reach (for `Draw::cull_mode`).
+pub struct CameraCull {
+    /// The camera's world → clip.
+    pub clip_from_world: Mat4,
+    /// Eye position and the distance from it to the near plane's farthest corner.
+    pub eye: (Vec3, f32),
 }
 
 impl Drop for CameraPass {
@@ -302,6 +349,7 @@ impl Drop for CameraPass {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
             d.destroy_pipeline(self.pipeline, None);
+            d.destroy_pipeline(self.masked_pipeline, None);
             d.destroy_pipeline(self.map_pipeline, None);
             d.destroy_shader_module(self.module, None);
             d.destroy_pipeline_layout(self.layout, None);

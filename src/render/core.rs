@@ -2,7 +2,7 @@
 //! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
 //! record exactly the same commands, so the window and the capture give the same pixels.
 
-use super::camera_pass::CameraPass;
+use super::camera_pass::{CameraCull, CameraPass};
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
 use super::settings::{SceneOptions, View, ViewMode};
@@ -10,7 +10,7 @@ use super::shadow_pass::ShadowPass;
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::Image;
-use crate::scene::{Light, Scene};
+use crate::scene::{Light, LightKind, Scene};
 use ash::vk;
 use std::sync::Arc;
 
@@ -128,7 +128,7 @@ impl FrameCore {
     }
 
     /// Records the shadow pass and the camera pass with timestamps; leaves `color` as a colour
-    /// attachment and `depth` as a depth attachment. Returns the casters drawn.
+    /// attachment and `depth` as a depth attachment. Returns what was drawn.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -139,7 +139,7 @@ impl FrameCore {
         color: &mut Attachment,
         depth: &mut Attachment,
         extent: vk::Extent2D,
-    ) -> usize {
+    ) -> PassCounts {
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         let q = 3 * slot as u32;
@@ -156,12 +156,20 @@ impl FrameCore {
             }
         }
         let shadows_on = plan.shadows_on;
+        // The shadowed light's eye: none for a directional light (outside everything); a spot
+        // light's position with its projection's near distance.
+        let light_eye = plan
+            .shadow_light
+            .map(|i| &plan.lights[i])
+            .filter(|l| l.kind != LightKind::Directional)
+            .map(|l| (l.position, (self.gpu.bounds.diagonal() * 1e-3).max(1e-3)));
         let casters = self.shadow.record(
             cmd,
             &self.gpu,
             &plan.light_clip_from_world,
             &view.shadow,
             shadows_on,
+            light_eye,
         );
         unsafe {
             if timestamps {
@@ -175,7 +183,16 @@ impl FrameCore {
         }
         color.transition(d, cmd, Access::ColorAttachment);
         depth.transition(d, cmd, Access::DepthAttachment);
-        self.camera.record(
+        let aspect = extent.width as f32 / extent.height.max(1) as f32;
+        let t = (view.camera.fov_y * 0.5).tan();
+        let cull = CameraCull {
+            clip_from_world: plan.clip_from_world,
+            eye: (
+                plan.camera_position,
+                view.camera.near * (1.0 + t * t * (1.0 + aspect * aspect)).sqrt(),
+            ),
+        };
+        let camera_draws = self.camera.record(
             cmd,
             slot,
             &self.gpu,
@@ -184,6 +201,7 @@ impl FrameCore {
             extent,
             CLEAR_COLOR,
             view.mode == ViewMode::ShadowMap,
+            &cull,
         );
         unsafe {
             if timestamps {
@@ -196,7 +214,10 @@ impl FrameCore {
             }
         }
         self.timestamps_written[slot] = timestamps;
-        casters
+        PassCounts {
+            casters,
+            camera_draws,
+        }
     }
 
     /// GPU milliseconds (shadow pass, camera pass) of slot `slot`'s last frame, which must have
@@ -223,6 +244,15 @@ impl FrameCore {
             t[2].wrapping_sub(t[1]) as f64 * period,
         ))
     }
+}
+
+/// Draws recorded in one frame, after culling.
+#[derive(Clone, Copy, Debug)]
+pub struct PassCounts {
+    /// Casters drawn into the shadow map.
+    pub casters: usize,
+    /// Draws in the camera pass.
+    pub camera_draws: usize,
 }
 
 impl Drop for FrameCore {

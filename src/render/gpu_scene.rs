@@ -7,10 +7,11 @@ use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
 use crate::gpu::{Buffer, Image};
 use crate::math::Aabb;
+use crate::scene::topology::is_closed;
 use crate::scene::{AlphaMode, Scene};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -28,7 +29,8 @@ pub struct VertexAttributes {
 }
 
 /// (first index, index count, vertex offset, material, object bounds) of one uploaded primitive.
-type PrimitiveRange = (u32, u32, i32, usize, Aabb);
+/// First index, index count, vertex offset, material, bounds, closed (see `Draw::closed`).
+type PrimitiveRange = (u32, u32, i32, usize, Aabb, bool);
 
 /// One indexed draw (a primitive of an instance).
 #[derive(Clone, Copy, Debug)]
@@ -51,15 +53,26 @@ pub struct Draw {
     pub double_sided: bool,
     /// The transform mirrors (negative determinant): its triangles wind clockwise on screen.
     pub mirrored: bool,
+    /// The material is alpha-masked (drawn with the discarding pipeline).
+    pub masked: bool,
+    /// The primitive is closed and consistently wound (`scene::topology::is_closed`): seen from
+    /// outside its bounds, culling back faces changes no pixel even if it is double-sided.
+    pub closed: bool,
 }
 
 impl Draw {
-    /// Cull mode for both passes: double-sided materials draw (and cast from) both faces.
-    pub fn cull_mode(&self) -> vk::CullModeFlags {
-        if self.double_sided {
-            vk::CullModeFlags::NONE
-        } else {
+    /// Cull mode for a pass seen from `eye` = (position, near-plane reach) (None: a directional
+    /// light, outside everything); the reach keeps the near plane from cutting into a closed
+    /// mesh that is then treated as seen from outside. Single-sided materials cull back faces; double-sided ones draw (and cast
+    /// from) both faces, unless the primitive is closed and the eye is outside its bounds, where
+    /// back faces are hidden behind front faces anyway and culling them saves half the
+    /// rasterisation.
+    pub fn cull_mode(&self, eye: Option<(Vec3, f32)>) -> vk::CullModeFlags {
+        let outside = eye.is_none_or(|(e, reach)| !self.world_bounds.contains(e, reach));
+        if !self.double_sided || (self.closed && outside) {
             vk::CullModeFlags::BACK
+        } else {
+            vk::CullModeFlags::NONE
         }
     }
 
@@ -72,6 +85,15 @@ impl Draw {
             vk::FrontFace::COUNTER_CLOCKWISE
         }
     }
+}
+
+/// Which of a material's texture slots hold a texture (`Material.extra.y` in scene.wgsl): bit 0
+/// base colour, bit 1 metallic-roughness, bit 2 emissive. The shader skips the fetch of an empty
+/// slot, whose default texture is white (a factor of 1), so the result is the same.
+pub fn texture_flags(m: &crate::scene::Material) -> u32 {
+    m.base_color_texture.is_some() as u32
+        | (m.metallic_roughness_texture.is_some() as u32) << 1
+        | (m.emissive_texture.is_some() as u32) << 2
 }
 
 /// The GPU copy of a scene.
@@ -93,6 +115,8 @@ pub struct GpuScene {
     pub bounds: Aabb,
     /// Triangles drawn per frame.
     pub triangles: usize,
+    /// Whether draws outside the camera's view are skipped (`SceneOptions::culling`).
+    pub frustum_culling: bool,
     pool: vk::DescriptorPool,
     sampler: vk::Sampler,
     _material_buffers: Vec<Buffer>,
@@ -142,6 +166,13 @@ impl GpuScene {
                     base,
                     p.material.min(scene.materials.len().saturating_sub(1)),
                     p.bounds(),
+                    // Only double-sided materials can use it; skip the check for the others.
+                    options.culling
+                        && scene
+                            .materials
+                            .get(p.material)
+                            .is_some_and(|m| m.double_sided)
+                        && is_closed(&p.positions, &p.indices),
                 ));
             }
             ranges.push(r);
@@ -149,7 +180,9 @@ impl GpuScene {
         let mut draws = Vec::new();
         let mut triangles = 0;
         for inst in &scene.instances {
-            for &(first_index, index_count, vertex_offset, material, b) in &ranges[inst.mesh] {
+            for &(first_index, index_count, vertex_offset, material, b, closed) in
+                &ranges[inst.mesh]
+            {
                 if index_count == 0 {
                     continue;
                 }
@@ -167,6 +200,11 @@ impl GpuScene {
                         .get(material)
                         .is_some_and(|m| m.double_sided),
                     mirrored: glam::Mat3::from_mat4(inst.world_from_model).determinant() < 0.0,
+                    closed,
+                    masked: scene
+                        .materials
+                        .get(material)
+                        .is_some_and(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
                 });
             }
         }
@@ -248,7 +286,7 @@ impl GpuScene {
                     } else {
                         0.0
                     },
-                    0.0,
+                    texture_flags(m) as f32,
                     0.0,
                     0.0,
                 ),
@@ -311,6 +349,7 @@ impl GpuScene {
             material_sets: sets,
             bounds: scene.bounds(),
             triangles,
+            frustum_culling: options.culling,
             pool,
             sampler,
             _material_buffers: material_buffers,

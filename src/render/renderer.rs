@@ -29,8 +29,10 @@ pub struct FrameStats {
     pub wall_ms: f64,
     /// Casters drawn into the shadow map (after culling).
     pub casters_drawn: usize,
-    /// Draws in the camera pass.
+    /// Draws in the camera pass (after frustum culling).
     pub draws: usize,
+    /// Draws in the scene (instances × primitives), before culling.
+    pub draws_total: usize,
     /// Triangles in the scene.
     pub triangles: usize,
     /// Whether comparisons were filtered in hardware.
@@ -243,7 +245,7 @@ impl Renderer {
         let extent = vk::Extent2D { width, height };
         let t = self.target.as_mut().expect("target");
         ctx.begin_one_time(cmd)?;
-        let casters = self.core.record(
+        let counts = self.core.record(
             cmd,
             0,
             view,
@@ -280,8 +282,9 @@ impl Renderer {
             gpu_shadow_ms: times.map(|t| t.0),
             gpu_camera_ms: times.map(|t| t.1),
             wall_ms: 0.0,
-            casters_drawn: casters,
-            draws: self.core.gpu.draws.len(),
+            casters_drawn: counts.casters,
+            draws: counts.camera_draws,
+            draws_total: self.core.gpu.draws.len(),
             triangles: self.core.gpu.triangles,
             hardware_compare: self.core.shadow.hardware_filtering(),
         };

@@ -115,11 +115,24 @@ impl Default for ShadowSettings {
 }
 
 /// Options fixed when a scene is uploaded.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SceneOptions {
     /// Anisotropic texture filtering (1 = off). `None`: 8× on GPUs, off on CPU devices, where
     /// it more than doubles lavapipe's camera pass (demo, 1280×720: 80 → 37 ms without shadows).
     pub anisotropy: Option<u32>,
+    /// Skip work that cannot change the image: draws outside the camera's view, and back faces
+    /// of closed double-sided meshes seen from outside. On by default; off only to measure what
+    /// it saves.
+    pub culling: bool,
+}
+
+impl Default for SceneOptions {
+    fn default() -> Self {
+        Self {
+            anisotropy: None,
+            culling: true,
+        }
+    }
 }
 
 impl SceneOptions {

@@ -153,6 +153,7 @@ impl ShadowPass {
         light_clip_from_world: &Mat4,
         s: &ShadowSettings,
         draw: bool,
+        eye: Option<(glam::Vec3, f32)>,
     ) -> usize {
         let (Some(map), Some(at)) = (&self.map, self.map_at.as_mut()) else {
             return 0;
@@ -187,7 +188,7 @@ impl ShadowPass {
                         light_clip_from_world: *light_clip_from_world,
                         world_from_model: dr.world_from_model,
                     };
-                    d.cmd_set_cull_mode(cmd, dr.cull_mode());
+                    d.cmd_set_cull_mode(cmd, dr.cull_mode(eye));
                     d.cmd_set_front_face(cmd, dr.front_face());
                     d.cmd_push_constants(
                         cmd,

@@ -56,7 +56,7 @@ pub struct MaterialUniform {
     pub emissive: Vec4,
     /// x metallic, y roughness, z has normal map, w unlit.
     pub params: Vec4,
-    /// x alpha cutoff.
+    /// x alpha cutoff, y texture slots present (`gpu_scene::texture_flags`).
     pub extra: Vec4,
 }
 

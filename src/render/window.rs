@@ -206,7 +206,8 @@ impl WindowRenderer {
         ctx.begin_one_time(cmd)?;
         let casters = self
             .core
-            .record(cmd, f, view, &plan, &mut color, depth, extent);
+            .record(cmd, f, view, &plan, &mut color, depth, extent)
+            .casters;
         if want_copy {
             color.transition(d, cmd, Access::TransferSrc);
             copy_to_buffer(

@@ -6,7 +6,9 @@ mod gltf_input;
 pub mod gltf_load;
 pub mod material;
 pub mod shapes;
+pub mod synthetic;
 pub mod tangents;
+pub mod topology;
 mod types;
 
 pub use gltf_load::{load_gltf, LoadError};
