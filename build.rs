@@ -74,17 +74,42 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
     })?;
     let options = naga::back::spv::Options {
         lang_version: (1, 3),
+        // No DEBUG flag: it embeds the WGSL source in each of the (up to 256) variants.
         flags: naga::back::spv::WriterFlags::ADJUST_COORDINATE_SPACE
-            | naga::back::spv::WriterFlags::LABEL_VARYINGS
-            | naga::back::spv::WriterFlags::DEBUG,
+            | naga::back::spv::WriterFlags::LABEL_VARYINGS,
         ..Default::default()
     };
-    let words = naga::back::spv::write_vec(&module, &info, &options, None)
-        .map_err(|e| format!("{}:1:1: error: SPIR-V output: {e}", path.display()))?;
+    // Boolean `override`s specialise the shader: one SPIR-V per combination (bit i of the
+    // variant index = the i-th override, in declaration order), since naga's SPIR-V writer has
+    // no specialization constants. The driver then drops the dead branches, which matters on
+    // llvmpipe: it executes both sides of every branch, uniform or not.
     let stem = path.file_stem().unwrap().to_string_lossy().to_string();
-    let spv_path = Path::new(out_dir).join(format!("{stem}.spv"));
-    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-    std::fs::write(&spv_path, bytes).map_err(|e| e.to_string())?;
+    let overrides: Vec<String> = module
+        .overrides
+        .iter()
+        .map(|(_, o)| o.name.clone().unwrap_or_default())
+        .collect();
+    if overrides.len() > 8 {
+        return Err(format!(
+            "{}:1:1: error: at most 8 boolean overrides (one SPIR-V per combination)",
+            path.display()
+        ));
+    }
+    let variants = 1usize << overrides.len();
+    for mask in 0..variants {
+        let mut constants = naga::back::PipelineConstants::default();
+        for (i, name) in overrides.iter().enumerate() {
+            constants.insert(name.clone(), ((mask >> i) & 1) as f64);
+        }
+        let (m, i) =
+            naga::back::pipeline_constants::process_overrides(&module, &info, None, &constants)
+                .map_err(|e| format!("{}:1:1: error: overrides: {e}", path.display()))?;
+        let words = naga::back::spv::write_vec(&m, &i, &options, None)
+            .map_err(|e| format!("{}:1:1: error: SPIR-V output: {e}", path.display()))?;
+        let spv_path = Path::new(out_dir).join(format!("{stem}_{mask}.spv"));
+        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        std::fs::write(&spv_path, bytes).map_err(|e| e.to_string())?;
+    }
 
     // Reflection.
     let mut layouter = naga::proc::Layouter::default();
@@ -97,9 +122,42 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
     writeln!(code, "    #[allow(unused_imports)] use super::*;").unwrap();
     writeln!(
         code,
-        "    /// SPIR-V words.\n    pub const SPIRV: &[u8] = include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{stem}.spv\"));"
+        "    /// SPIR-V of every override combination, indexed by the bit mask of `OVERRIDES`."
     )
     .unwrap();
+    let list: Vec<String> = (0..variants)
+        .map(|m| format!("include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{stem}_{m}.spv\"))"))
+        .collect();
+    writeln!(
+        code,
+        "    pub const VARIANTS: &[&[u8]] = &[{}];",
+        list.join(", ")
+    )
+    .unwrap();
+    writeln!(
+        code,
+        "    /// SPIR-V with every boolean override on.\n    pub const SPIRV: &[u8] = VARIANTS[{}];",
+        variants - 1
+    )
+    .unwrap();
+    writeln!(
+        code,
+        "    /// The boolean overrides, bit i of a variant index = `OVERRIDES[i]`.\n    #[allow(dead_code)]\n    pub const OVERRIDES: &[&str] = &[{}];",
+        overrides
+            .iter()
+            .map(|o| format!("\"{o}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+    .unwrap();
+    for (i, o) in overrides.iter().enumerate() {
+        writeln!(
+            code,
+            "    /// Variant bit of override `{o}`.\n    #[allow(dead_code)]\n    pub const BIT_{}: usize = 1 << {i};",
+            o.to_uppercase()
+        )
+        .unwrap();
+    }
     let mut bindings = Vec::new();
     let mut immediate_size = 0u32;
     for (handle, var) in module.global_variables.iter() {

@@ -19,4 +19,4 @@ cargo clippy --no-default-features --all-targets --quiet -- -D warnings
 cargo test --all-targets
 cargo test --doc
 # umbra as a user's dev-dependency with default-features = false (shares this target dir).
-cargo test --manifest-path examples/offscreen_user/Cargo.toml --target-dir target
+cargo test --manifest-path examples/offscreen_user/Cargo.toml --target-dir target --test offscreen

@@ -13,6 +13,29 @@ const LIGHT_DIRECTIONAL: f32 = 0.0;
 const LIGHT_POINT: f32 = 1.0;
 const LIGHT_SPOT: f32 = 2.0;
 
+// Specialisation (build.rs writes one SPIR-V per combination; the renderer picks per draw):
+// which texture slots the material fills (an empty slot's default texture is white, a factor of 1,
+// so leaving its fetch out gives the same value), whether the frame has exactly one light, and
+// whether the frame samples a shadow map.
+// The PCF kernel and the comparison path are per frame too: PCF_BIT0 + 2 * PCF_BIT1 selects 0, 1,
+// 3 or 5 bilinear taps per side (none, 2x2, 3x3, 5x5); HW_COMPARE uses hardware filtering.
+override HAS_BASE_TEX: bool = true;
+override HAS_NORMAL_MAP: bool = true;
+override HAS_OTHER_TEX: bool = true; // metallic-roughness or emissive
+override SINGLE_LIGHT: bool = false;
+override SHADOWS: bool = true;
+override HW_COMPARE: bool = false;
+override PCF_BIT0: bool = true;
+override PCF_BIT1: bool = false;
+
+// Bilinear taps per side of the PCF kernel (0 = one nearest comparison).
+fn pcf_taps() -> i32 {
+    if PCF_BIT1 {
+        return select(3, 5, PCF_BIT0);
+    }
+    return select(0, 1, PCF_BIT0);
+}
+
 const VIEW_LIT: u32 = 0u;
 const VIEW_SHADOW: u32 = 1u;
 const VIEW_NORMALS: u32 = 2u;
@@ -54,9 +77,7 @@ struct Material {
     emissive: vec4<f32>,
     // x: metallic, y: roughness, z: 1 if a normal map is used, w: 1 if unlit
     params: vec4<f32>,
-    // x: alpha cutoff (masked materials; 0 = opaque); y: texture slots present, bit 0 base
-    // colour, bit 1 metallic-roughness, bit 2 emissive (an empty slot's default is white, so
-    // skipping its fetch gives the same value)
+    // x: alpha cutoff (masked materials; 0 = opaque)
     extra: vec4<f32>,
 }
 
@@ -120,7 +141,7 @@ fn compare_texel(c: vec2<i32>, depth: f32, size: i32) -> f32 {
 
 // Bilinearly weighted 2x2 comparison at a position given in texel units (texel centres at +0.5).
 fn bilinear_compare(p: vec2<f32>, depth: f32, size: i32) -> f32 {
-    if frame.modes.z == 1u {
+    if HW_COMPARE {
         return textureSampleCompareLevel(shadow_map, shadow_sampler, p / f32(size), depth);
     }
     let t = p - vec2<f32>(0.5);
@@ -159,13 +180,13 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) ->
     let depth = clamp(ndc.z, 0.0, 1.0);
     let size = i32(frame.shadow.x);
     let p_texel = uv * frame.shadow.x;
-    let kernel = i32(frame.modes.y);
+    let kernel = pcf_taps();
     if kernel == 0 {
         return compare_texel(vec2<i32>(floor(p_texel)), depth, size);
     }
     let half = (kernel - 1) / 2;
     var sum = 0.0;
-    if frame.modes.z == 1u {
+    if HW_COMPARE {
         // Hardware bilinear comparisons, one per tap.
         for (var y = -half; y <= half; y++) {
             for (var x = -half; x <= half; x++) {
@@ -198,11 +219,10 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(hi, lo, c <= vec3<f32>(0.04045));
 }
 
-// The material's base colour at `uv`. Texture fetches happen only for the slots a material fills
-// (uniform branches: on lavapipe each skipped fetch saves filtering work for every fragment).
+// The material's base colour at `uv`.
 fn base_color(uv: vec2<f32>) -> vec4<f32> {
     var base = material.base_color;
-    if (u32(material.extra.y) & 1u) != 0u {
+    if HAS_BASE_TEX {
         base *= textureSample(base_color_tex, material_sampler, uv);
     }
     return base;
@@ -227,10 +247,9 @@ fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(
 
 // Blinn-Phong with normal mapping and shadows for the fragment `in` of base colour `base`.
 fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> vec4<f32> {
-    let flags = u32(material.extra.y);
     var n_geo = normalize(in.normal);
     var n = n_geo;
-    if material.params.z > 0.5 {
+    if HAS_NORMAL_MAP {
         let normal_sample = textureSample(normal_tex, material_sampler, in.uv).xyz;
         let t_raw = in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz);
         if dot(t_raw, t_raw) > 1e-12 {
@@ -246,7 +265,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> vec4<f32> {
         n = -n;
     }
     var mr = vec4<f32>(1.0);
-    if (flags & 2u) != 0u {
+    if HAS_OTHER_TEX {
         mr = textureSample(metal_rough_tex, material_sampler, in.uv);
     }
     let metallic = clamp(material.params.x * mr.b, 0.0, 1.0);
@@ -258,7 +277,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> vec4<f32> {
     let shininess = clamp(2.0 / (alpha * alpha) - 2.0, 1.0, 2048.0);
     let ka = base.rgb;
     var emissive = material.emissive.rgb;
-    if (flags & 4u) != 0u {
+    if HAS_OTHER_TEX {
         emissive *= textureSample(emissive_tex, material_sampler, in.uv).rgb;
     }
 
@@ -266,7 +285,8 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> vec4<f32> {
     let v = normalize(frame.camera_position.xyz - p);
     var color = ka * frame.ambient.rgb + emissive;
     var shadow_term = 1.0;
-    let count = min(frame.modes.w, MAX_LIGHTS);
+    // One light: a constant trip count the driver unrolls (a uniform count costs a real loop).
+    let count = select(min(frame.modes.w, MAX_LIGHTS), 1u, SINGLE_LIGHT);
     for (var i = 0u; i < count; i++) {
         let light = frame.lights[i];
         var l: vec3<f32>;
@@ -285,7 +305,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> vec4<f32> {
         }
         var vis = select(0.0, 1.0, dot(n_geo, l) > 0.0);
         if u32(frame.shadow_light.w) == i {
-            if frame.shadow.w > 0.5 {
+            if SHADOWS && frame.shadow.w > 0.5 {
                 vis *= shadow_visibility(p, n_geo, l, light);
             }
             shadow_term = vis;

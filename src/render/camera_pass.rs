@@ -1,6 +1,7 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
+use super::frame::FramePlan;
 use super::gpu_scene::{Draw, GpuScene, VertexAttributes};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
@@ -14,6 +15,7 @@ use crate::gpu::Buffer;
 use ash::vk;
 use glam::{Mat4, Vec3};
 use gpu_allocator::MemoryLocation;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// Depth format of the camera pass.
@@ -31,8 +33,11 @@ pub struct CameraPass {
     layout: vk::PipelineLayout,
     frame_layout: vk::DescriptorSetLayout,
     module: vk::ShaderModule,
-    pipeline: vk::Pipeline,
-    masked_pipeline: vk::Pipeline,
+    color_format: vk::Format,
+    /// Shader modules of the override variants created so far (by variant index).
+    variant_modules: HashMap<usize, vk::ShaderModule>,
+    /// Scene pipelines created so far, by (variant index, alpha-masked).
+    pipelines: HashMap<(usize, bool), vk::Pipeline>,
     map_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
@@ -89,30 +94,19 @@ impl CameraPass {
             "camera pipeline layout",
         )?;
         let module = create_module(ctx, sh::SPIRV, "scene.wgsl")?;
-        let (bindings, attributes) = vertex_layout();
-        let mut desc = PipelineDesc {
-            name: "camera pipeline",
+        let desc = PipelineDesc {
+            name: "shadow-map view pipeline",
             layout,
-            vertex: (module, sh::ENTRY_VS_MAIN),
-            fragment: Some((module, sh::ENTRY_FS_MAIN)),
-            bindings: &bindings,
-            attributes: &attributes,
+            vertex: (module, sh::ENTRY_VS_FULLSCREEN),
+            fragment: Some((module, sh::ENTRY_FS_SHADOW_MAP)),
+            bindings: &[],
+            attributes: &[],
             color_format: Some(color_format),
             depth_format: DEPTH_FORMAT,
             depth_clamp: false,
             depth_bias: false,
-            depth_test: true,
+            depth_test: false,
         };
-        let pipeline = create_pipeline(ctx, &desc)?;
-        desc.name = "camera pipeline (alpha mask)";
-        desc.fragment = Some((module, sh::ENTRY_FS_MASKED));
-        let masked_pipeline = create_pipeline(ctx, &desc)?;
-        desc.name = "shadow-map view pipeline";
-        desc.vertex = (module, sh::ENTRY_VS_FULLSCREEN);
-        desc.fragment = Some((module, sh::ENTRY_FS_SHADOW_MAP));
-        desc.bindings = &[];
-        desc.attributes = &[];
-        desc.depth_test = false;
         let map_pipeline = create_pipeline(ctx, &desc)?;
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, frame_layout, slots)?;
         let mut slot_list = Vec::new();
@@ -153,14 +147,73 @@ impl CameraPass {
             layout,
             frame_layout,
             module,
-            pipeline,
-            masked_pipeline,
+            color_format,
+            variant_modules: HashMap::new(),
+            pipelines: HashMap::new(),
             map_pipeline,
             pool,
             slots: slot_list,
             linear_sampler,
             nearest_sampler,
         })
+    }
+
+    /// Creates the scene pipelines this frame needs (once each): for every (material variant,
+    /// alpha-masked) pair of the scene's draws, specialised by the frame's bits (`frame_bits`:
+    /// one light, shadows). Creation compiles the shader, so it happens here, not per draw.
+    pub fn ensure_pipelines(
+        &mut self,
+        scene: &GpuScene,
+        frame_bits: usize,
+    ) -> Result<(), GpuError> {
+        for &(material_bits, masked) in &scene.pipeline_keys {
+            let variant = material_bits | frame_bits;
+            if self.pipelines.contains_key(&(variant, masked)) {
+                continue;
+            }
+            let module = match self.variant_modules.get(&variant) {
+                Some(&m) => m,
+                None => {
+                    let m = create_module(
+                        &self.ctx,
+                        sh::VARIANTS[variant],
+                        &format!("scene.wgsl variant {variant}"),
+                    )?;
+                    self.variant_modules.insert(variant, m);
+                    m
+                }
+            };
+            let (bindings, attributes) = vertex_layout();
+            let name = format!(
+                "camera pipeline variant {variant}{}",
+                if masked { " (alpha mask)" } else { "" }
+            );
+            let pipeline = create_pipeline(
+                &self.ctx,
+                &PipelineDesc {
+                    name: &name,
+                    layout: self.layout,
+                    vertex: (module, sh::ENTRY_VS_MAIN),
+                    fragment: Some((
+                        module,
+                        if masked {
+                            sh::ENTRY_FS_MASKED
+                        } else {
+                            sh::ENTRY_FS_MAIN
+                        },
+                    )),
+                    bindings: &bindings,
+                    attributes: &attributes,
+                    color_format: Some(self.color_format),
+                    depth_format: DEPTH_FORMAT,
+                    depth_clamp: false,
+                    depth_bias: false,
+                    depth_test: true,
+                },
+            )?;
+            self.pipelines.insert((variant, masked), pipeline);
+        }
+        Ok(())
     }
 
     /// Points slot `slot`'s set at the shadow map. Every binding is written (lavapipe crashes on
@@ -275,11 +328,8 @@ impl CameraPass {
                 let mut bound_material = usize::MAX;
                 let mut bound_pipeline = vk::Pipeline::null();
                 for dr in draw_order(scene, cull) {
-                    let pipeline = if dr.masked {
-                        self.masked_pipeline
-                    } else {
-                        self.pipeline
-                    };
+                    // Created by `ensure_pipelines` for this frame's bits.
+                    let pipeline = self.pipelines[&(dr.material_bits | cull.frame_bits, dr.masked)];
                     if pipeline != bound_pipeline {
                         d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
                         bound_pipeline = pipeline;
@@ -341,6 +391,27 @@ pub struct CameraCull {
     pub clip_from_world: Mat4,
     /// Eye position and the distance from it to the near plane's farthest corner.
     pub eye: (Vec3, f32),
+    /// The frame's shader variant bits (`frame_variant_bits`).
+    pub frame_bits: usize,
+}
+
+/// The shader variant bits a frame sets: one light (a constant loop), shadows sampled, the
+/// comparison path and the PCF kernel (constant loops instead of per-frame uniforms).
+pub fn frame_variant_bits(plan: &FramePlan) -> usize {
+    let [_, taps, hardware, _] = plan.uniform.modes;
+    let mut bits = 0;
+    for (on, bit) in [
+        (plan.lights.len() == 1, sh::BIT_SINGLE_LIGHT),
+        (plan.shadows_on, sh::BIT_SHADOWS),
+        (hardware == 1, sh::BIT_HW_COMPARE),
+        (taps == 1 || taps == 5, sh::BIT_PCF_BIT0),
+        (taps >= 3, sh::BIT_PCF_BIT1),
+    ] {
+        if on {
+            bits |= bit;
+        }
+    }
+    bits
 }
 
 impl Drop for CameraPass {
@@ -348,8 +419,12 @@ impl Drop for CameraPass {
         unsafe {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
-            d.destroy_pipeline(self.pipeline, None);
-            d.destroy_pipeline(self.masked_pipeline, None);
+            for (_, p) in self.pipelines.drain() {
+                d.destroy_pipeline(p, None);
+            }
+            for (_, m) in self.variant_modules.drain() {
+                d.destroy_shader_module(m, None);
+            }
             d.destroy_pipeline(self.map_pipeline, None);
             d.destroy_shader_module(self.module, None);
             d.destroy_pipeline_layout(self.layout, None);

@@ -2,7 +2,7 @@
 //! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
 //! record exactly the same commands, so the window and the capture give the same pixels.
 
-use super::camera_pass::{CameraCull, CameraPass};
+use super::camera_pass::{frame_variant_bits, CameraCull, CameraPass};
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
 use super::settings::{SceneOptions, View, ViewMode};
@@ -124,6 +124,8 @@ impl FrameCore {
             hw,
         );
         self.camera.write_frame(slot, &plan.uniform)?;
+        self.camera
+            .ensure_pipelines(&self.gpu, frame_variant_bits(&plan))?;
         Ok(plan)
     }
 
@@ -191,6 +193,7 @@ impl FrameCore {
                 plan.camera_position,
                 view.camera.near * (1.0 + t * t * (1.0 + aspect * aspect)).sqrt(),
             ),
+            frame_bits: frame_variant_bits(plan),
         };
         let camera_draws = self.camera.record(
             cmd,

@@ -55,6 +55,8 @@ pub struct Draw {
     pub mirrored: bool,
     /// The material is alpha-masked (drawn with the discarding pipeline).
     pub masked: bool,
+    /// The material's shader variant bits (`material_variant_bits`).
+    pub material_bits: usize,
     /// The primitive is closed and consistently wound (`scene::topology::is_closed`): seen from
     /// outside its bounds, culling back faces changes no pixel even if it is double-sided.
     pub closed: bool,
@@ -87,13 +89,25 @@ impl Draw {
     }
 }
 
-/// Which of a material's texture slots hold a texture (`Material.extra.y` in scene.wgsl): bit 0
-/// base colour, bit 1 metallic-roughness, bit 2 emissive. The shader skips the fetch of an empty
-/// slot, whose default texture is white (a factor of 1), so the result is the same.
-pub fn texture_flags(m: &crate::scene::Material) -> u32 {
-    m.base_color_texture.is_some() as u32
-        | (m.metallic_roughness_texture.is_some() as u32) << 1
-        | (m.emissive_texture.is_some() as u32) << 2
+/// The scene shader's variant bits for a material: which texture slots it fills (the shader
+/// leaves out the fetch of an empty slot, whose default texture is white, a factor of 1, so the
+/// result is the same) and whether it is normal-mapped.
+pub fn material_variant_bits(m: &crate::scene::Material) -> usize {
+    use crate::gpu::shaders::scene as sh;
+    let mut bits = 0;
+    for (filled, bit) in [
+        (m.base_color_texture.is_some(), sh::BIT_HAS_BASE_TEX),
+        (m.normal_texture.is_some(), sh::BIT_HAS_NORMAL_MAP),
+        (
+            m.metallic_roughness_texture.is_some() || m.emissive_texture.is_some(),
+            sh::BIT_HAS_OTHER_TEX,
+        ),
+    ] {
+        if filled {
+            bits |= bit;
+        }
+    }
+    bits
 }
 
 /// The GPU copy of a scene.
@@ -117,6 +131,9 @@ pub struct GpuScene {
     pub triangles: usize,
     /// Whether draws outside the camera's view are skipped (`SceneOptions::culling`).
     pub frustum_culling: bool,
+    /// The distinct (material variant bits, alpha-masked) pairs of the draws: the camera
+    /// pipelines the scene needs per frame variant.
+    pub pipeline_keys: Vec<(usize, bool)>,
     pool: vk::DescriptorPool,
     sampler: vk::Sampler,
     _material_buffers: Vec<Buffer>,
@@ -205,9 +222,17 @@ impl GpuScene {
                         .materials
                         .get(material)
                         .is_some_and(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
+                    material_bits: scene
+                        .materials
+                        .get(material)
+                        .map_or(0, material_variant_bits),
                 });
             }
         }
+        let mut pipeline_keys: Vec<(usize, bool)> =
+            draws.iter().map(|d| (d.material_bits, d.masked)).collect();
+        pipeline_keys.sort_unstable();
+        pipeline_keys.dedup();
         let vb = vk::BufferUsageFlags::VERTEX_BUFFER;
         let pos_buf =
             Buffer::device_local_with_data(ctx, "positions", vb, bytemuck::cast_slice(&positions))?;
@@ -286,7 +311,7 @@ impl GpuScene {
                     } else {
                         0.0
                     },
-                    texture_flags(m) as f32,
+                    0.0,
                     0.0,
                     0.0,
                 ),
@@ -350,6 +375,7 @@ impl GpuScene {
             bounds: scene.bounds(),
             triangles,
             frustum_culling: options.culling,
+            pipeline_keys,
             pool,
             sampler,
             _material_buffers: material_buffers,
