@@ -205,7 +205,9 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     }
 
     // Images (decoded once; a broken image becomes a warning and the material slot falls back).
-    let mut image_slots: Vec<Option<usize>> = Vec::new();
+    // Read in order, then decoded in parallel (PNG/JPEG decoding dominates loading textured
+    // models), then recorded in order so warnings and texture indices do not depend on timing.
+    let mut sources: Vec<(String, String, Result<Vec<u8>, LoadError>)> = Vec::new();
     for img in gltf.images() {
         let what = format!("image {}", img.index());
         let data = match img.source() {
@@ -215,26 +217,29 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             }
             gltf::image::Source::Uri { uri, .. } => read_uri(path, &base, uri, &what),
         };
-        let data = match data {
-            Ok(d) => d,
-            Err(e @ LoadError::OutsideFolder { .. }) => return Err(e),
-            Err(e) => {
+        if let Err(e @ LoadError::OutsideFolder { .. }) = data {
+            return Err(e);
+        }
+        sources.push((img.name().unwrap_or(&what).to_string(), what, data));
+    }
+    let decoded = decode_all(&sources);
+    let mut image_slots: Vec<Option<usize>> = Vec::new();
+    for ((name, what, data), result) in sources.iter().zip(decoded) {
+        match (data, result) {
+            (Err(e), _) => {
                 scene.warn(format!("{what} not loaded ({e}); using a default"));
                 image_slots.push(None);
-                continue;
             }
-        };
-        match decode_image(&data) {
-            Ok((w, h, rgba)) => {
+            (Ok(_), Ok((w, h, rgba))) => {
                 scene.textures.push(Texture {
-                    name: img.name().unwrap_or(&what).to_string(),
+                    name: name.clone(),
                     width: w,
                     height: h,
                     rgba,
                 });
                 image_slots.push(Some(scene.textures.len() - 1));
             }
-            Err(msg) => {
+            (Ok(_), Err(msg)) => {
                 scene.warn(format!(
                     "{what} could not be decoded ({msg}); using a default"
                 ));
@@ -402,6 +407,37 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         scene.warn("the scene has no mesh instances");
     }
     Ok(scene)
+}
+
+/// Decodes every readable image, on as many threads as the machine has (in order).
+fn decode_all(
+    sources: &[(String, String, Result<Vec<u8>, LoadError>)],
+) -> Vec<Result<(u32, u32, Vec<u8>), String>> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(sources.len())
+        .max(1);
+    let decode = |(_, _, data): &(String, String, Result<Vec<u8>, LoadError>)| match data {
+        Ok(d) => decode_image(d),
+        Err(_) => Err(String::new()),
+    };
+    if threads == 1 {
+        return sources.iter().map(decode).collect();
+    }
+    let chunk = sources.len().div_ceil(threads);
+    std::thread::scope(|s| {
+        let handles: Vec<_> = sources
+            .chunks(chunk)
+            .map(|part| s.spawn(move || part.iter().map(decode).collect::<Vec<_>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| vec![Err("decoder panicked".into()); chunk])
+            })
+            .collect()
+    })
 }
 
 fn read_primitive(
