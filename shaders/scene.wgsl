@@ -228,25 +228,50 @@ fn base_color(uv: vec2<f32>) -> vec4<f32> {
     return base;
 }
 
-// Opaque materials. No discard in this entry point: a discard anywhere in a fragment shader makes
-// llvmpipe test depth after shading, so hidden fragments would be shaded too.
+// Three entry points, so that each pipeline carries only what it needs (llvmpipe runs every
+// branch of a shader, taken or not):
+// - fs_main, opaque materials, the lit image. No discard: a discard anywhere in a fragment shader
+//   makes llvmpipe test depth after shading, so hidden fragments would be shaded too.
+// - fs_masked, alpha-masked materials: discard below the cutoff, then shade.
+// - fs_debug, the shadow-visibility and normals views, for every material.
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    return shade(in, front_facing, base_color(in.uv));
+    return vec4<f32>(shade(in, front_facing, base_color(in.uv)).color, 1.0);
 }
 
-// Alpha-masked materials: discard below the cutoff, then shade.
 @fragment
 fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let base = base_color(in.uv);
     if base.a < material.extra.x {
         discard;
     }
-    return shade(in, front_facing, base);
+    return vec4<f32>(shade(in, front_facing, base).color, 1.0);
+}
+
+@fragment
+fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let base = base_color(in.uv);
+    if material.extra.x > 0.0 && base.a < material.extra.x {
+        discard;
+    }
+    let s = shade(in, front_facing, base);
+    // Debug views write values that the sRGB target stores unchanged as bytes.
+    if frame.modes.x == VIEW_SHADOW {
+        return vec4<f32>(srgb_to_linear(vec3<f32>(s.shadow_term)), 1.0);
+    }
+    return vec4<f32>(srgb_to_linear(s.normal * 0.5 + vec3<f32>(0.5)), 1.0);
+}
+
+struct Shaded {
+    color: vec3<f32>,
+    // The shading normal (after normal mapping, facing the viewer).
+    normal: vec3<f32>,
+    // The shadowed light's visibility (1 without one).
+    shadow_term: f32,
 }
 
 // Blinn-Phong with normal mapping and shadows for the fragment `in` of base colour `base`.
-fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> vec4<f32> {
+fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     var n_geo = normalize(in.normal);
     var n = n_geo;
     if HAS_NORMAL_MAP {
@@ -318,18 +343,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> vec4<f32> {
     if material.params.w > 0.5 {
         color = base.rgb;
     }
-    switch frame.modes.x {
-        case 1u: {
-            // Debug views write values that the sRGB target stores unchanged as bytes.
-            return vec4<f32>(srgb_to_linear(vec3<f32>(shadow_term)), 1.0);
-        }
-        case 2u: {
-            return vec4<f32>(srgb_to_linear(n * 0.5 + vec3<f32>(0.5)), 1.0);
-        }
-        default: {
-            return vec4<f32>(color, 1.0);
-        }
-    }
+    return Shaded(color, n, shadow_term);
 }
 
 // Full-screen triangle for the shadow-map debug view.

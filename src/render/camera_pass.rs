@@ -36,8 +36,8 @@ pub struct CameraPass {
     color_format: vk::Format,
     /// Shader modules of the override variants created so far (by variant index).
     variant_modules: HashMap<usize, vk::ShaderModule>,
-    /// Scene pipelines created so far, by (variant index, alpha-masked).
-    pipelines: HashMap<(usize, bool), vk::Pipeline>,
+    /// Scene pipelines created so far, by (variant index, entry point).
+    pipelines: HashMap<(usize, Entry), vk::Pipeline>,
     map_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
@@ -165,10 +165,12 @@ impl CameraPass {
         &mut self,
         scene: &GpuScene,
         frame_bits: usize,
+        debug_view: bool,
     ) -> Result<(), GpuError> {
         for &(material_bits, masked) in &scene.pipeline_keys {
             let variant = material_bits | frame_bits;
-            if self.pipelines.contains_key(&(variant, masked)) {
+            let entry = Entry::of(masked, debug_view);
+            if self.pipelines.contains_key(&(variant, entry)) {
                 continue;
             }
             let module = match self.variant_modules.get(&variant) {
@@ -184,10 +186,7 @@ impl CameraPass {
                 }
             };
             let (bindings, attributes) = vertex_layout();
-            let name = format!(
-                "camera pipeline variant {variant}{}",
-                if masked { " (alpha mask)" } else { "" }
-            );
+            let name = format!("camera pipeline variant {variant} {entry:?}");
             let pipeline = create_pipeline(
                 &self.ctx,
                 &PipelineDesc {
@@ -196,10 +195,10 @@ impl CameraPass {
                     vertex: (module, sh::ENTRY_VS_MAIN),
                     fragment: Some((
                         module,
-                        if masked {
-                            sh::ENTRY_FS_MASKED
-                        } else {
-                            sh::ENTRY_FS_MAIN
+                        match entry {
+                            Entry::Opaque => sh::ENTRY_FS_MAIN,
+                            Entry::Masked => sh::ENTRY_FS_MASKED,
+                            Entry::Debug => sh::ENTRY_FS_DEBUG,
                         },
                     )),
                     bindings: &bindings,
@@ -211,7 +210,7 @@ impl CameraPass {
                     depth_test: true,
                 },
             )?;
-            self.pipelines.insert((variant, masked), pipeline);
+            self.pipelines.insert((variant, entry), pipeline);
         }
         Ok(())
     }
@@ -329,7 +328,8 @@ impl CameraPass {
                 let mut bound_pipeline = vk::Pipeline::null();
                 for dr in draw_order(scene, cull) {
                     // Created by `ensure_pipelines` for this frame's bits.
-                    let pipeline = self.pipelines[&(dr.material_bits | cull.frame_bits, dr.masked)];
+                    let entry = Entry::of(dr.masked, cull.debug_view);
+                    let pipeline = self.pipelines[&(dr.material_bits | cull.frame_bits, entry)];
                     if pipeline != bound_pipeline {
                         d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
                         bound_pipeline = pipeline;
@@ -393,6 +393,30 @@ pub struct CameraCull {
     pub eye: (Vec3, f32),
     /// The frame's shader variant bits (`frame_variant_bits`).
     pub frame_bits: usize,
+    /// The shadow-visibility or normals view (the debug entry point).
+    pub debug_view: bool,
+}
+
+/// The fragment entry point of a scene pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Entry {
+    /// `fs_main`: opaque materials, lit image, no discard (early depth on llvmpipe).
+    Opaque,
+    /// `fs_masked`: alpha-masked materials, lit image.
+    Masked,
+    /// `fs_debug`: the shadow-visibility and normals views.
+    Debug,
+}
+
+impl Entry {
+    /// The entry point for a draw of a masked or opaque material in a lit or debug view.
+    pub fn of(masked: bool, debug_view: bool) -> Entry {
+        match (debug_view, masked) {
+            (true, _) => Entry::Debug,
+            (false, true) => Entry::Masked,
+            (false, false) => Entry::Opaque,
+        }
+    }
 }
 
 /// The shader variant bits a frame sets: one light (a constant loop), shadows sampled, the

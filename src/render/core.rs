@@ -124,8 +124,11 @@ impl FrameCore {
             hw,
         );
         self.camera.write_frame(slot, &plan.uniform)?;
-        self.camera
-            .ensure_pipelines(&self.gpu, frame_variant_bits(&plan))?;
+        self.camera.ensure_pipelines(
+            &self.gpu,
+            frame_variant_bits(&plan),
+            is_debug_view(view.mode),
+        )?;
         Ok(plan)
     }
 
@@ -194,6 +197,7 @@ impl FrameCore {
                 view.camera.near * (1.0 + t * t * (1.0 + aspect * aspect)).sqrt(),
             ),
             frame_bits: frame_variant_bits(plan),
+            debug_view: is_debug_view(view.mode),
         };
         let camera_draws = self.camera.record(
             cmd,
@@ -247,6 +251,11 @@ impl FrameCore {
             t[2].wrapping_sub(t[1]) as f64 * period,
         ))
     }
+}
+
+/// Whether `mode` draws the scene with the debug entry point (shadow visibility, normals).
+fn is_debug_view(mode: ViewMode) -> bool {
+    matches!(mode, ViewMode::Shadow | ViewMode::Normals)
 }
 
 /// Draws recorded in one frame, after culling.
