@@ -207,7 +207,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     // Images (decoded once; a broken image becomes a warning and the material slot falls back).
     // Read in order, then decoded in parallel (PNG/JPEG decoding dominates loading textured
     // models), then recorded in order so warnings and texture indices do not depend on timing.
-    let mut sources: Vec<(String, String, Result<Vec<u8>, LoadError>)> = Vec::new();
+    let mut sources: Vec<ImageSource> = Vec::new();
     for img in gltf.images() {
         let what = format!("image {}", img.index());
         let data = match img.source() {
@@ -409,15 +409,16 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     Ok(scene)
 }
 
+/// An image's name, its label for messages ("image 3") and its encoded bytes (or why not).
+type ImageSource = (String, String, Result<Vec<u8>, LoadError>);
+
 /// Decodes every readable image, on as many threads as the machine has (in order).
-fn decode_all(
-    sources: &[(String, String, Result<Vec<u8>, LoadError>)],
-) -> Vec<Result<(u32, u32, Vec<u8>), String>> {
+fn decode_all(sources: &[ImageSource]) -> Vec<Result<(u32, u32, Vec<u8>), String>> {
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .min(sources.len())
         .max(1);
-    let decode = |(_, _, data): &(String, String, Result<Vec<u8>, LoadError>)| match data {
+    let decode = |(_, _, data): &ImageSource| match data {
         Ok(d) => decode_image(d),
         Err(_) => Err(String::new()),
     };
