@@ -411,9 +411,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
 
 /// An image's name, its label for messages ("image 3") and its encoded bytes (or why not).
 type ImageSource = (String, String, Result<Vec<u8>, LoadError>);
+/// A decoded image (width, height, RGBA8) or why it could not be decoded.
+type Decoded = Result<(u32, u32, Vec<u8>), String>;
 
 /// Decodes every readable image, on as many threads as the machine has (in order).
-fn decode_all(sources: &[ImageSource]) -> Vec<Result<(u32, u32, Vec<u8>), String>> {
+fn decode_all(sources: &[ImageSource]) -> Vec<Decoded> {
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .min(sources.len())
