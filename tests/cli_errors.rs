@@ -265,6 +265,24 @@ fn images_and_textures_without_a_source() {
     }
 }
 
+/// A sparse accessor without a buffer view and a huge count (found by 200,000-mutation fuzzing of
+/// the generated corpus: reading it tried to allocate 1.2 TB and aborted the process).
+#[test]
+fn huge_accessor_without_a_buffer_view() {
+    let d = tmp("viewless");
+    let bin = triangle_bytes([0, 1, 2]);
+    let mut j = triangle_json(json!({"uri": data_uri(&bin), "byteLength": bin.len()}), 3);
+    j["accessors"][0] = json!({
+        "componentType": 5126, "count": 99_999_999_999u64, "type": "VEC3",
+        "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0],
+        "sparse": {"count": 3, "indices": {"bufferView": 1, "componentType": 5123},
+                   "values": {"bufferView": 0}}
+    });
+    let p = d.join("viewless.gltf");
+    std::fs::write(&p, j.to_string()).unwrap();
+    assert_one_line_error(&p, "no buffer view");
+}
+
 /// glTF 1.0 and files without `asset.version` are refused (they used to render an empty image
 /// with exit 0).
 #[test]

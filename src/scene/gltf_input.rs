@@ -183,9 +183,23 @@ fn check_images_and_textures(path: &Path, v: &serde_json::Value) -> Result<(), L
     Ok(())
 }
 
+/// Largest accessor without a buffer view (all zeros, possibly with sparse values), in bytes: its
+/// count is not bounded by any data in the file, and reading it allocates all of it.
+pub(super) const MAX_VIEWLESS_ACCESSOR_BYTES: usize = 256 << 20;
+
 pub(super) fn check_accessor(path: &Path, a: &gltf::Accessor) -> Result<(), LoadError> {
     let elem = a.size();
     let count = a.count();
+    if a.view().is_none() && count.saturating_mul(elem) > MAX_VIEWLESS_ACCESSOR_BYTES {
+        return Err(corrupt(
+            path,
+            format!(
+                "accessor {} has {count} elements and no buffer view (over the {} MiB limit)",
+                a.index(),
+                MAX_VIEWLESS_ACCESSOR_BYTES >> 20
+            ),
+        ));
+    }
     if let Some(view) = a.view() {
         let stride = view.stride().unwrap_or(elem);
         let need = if count == 0 {
