@@ -75,7 +75,7 @@ struct Material {
     base_color: vec4<f32>,
     // rgb: emissive factor; w: normal-map scale
     emissive: vec4<f32>,
-    // x: metallic, y: roughness, z: 1 if a normal map is used, w: 1 if unlit
+    // x: metallic, y: roughness, z: unused (normal mapping is a shader variant), w: 1 if unlit
     params: vec4<f32>,
     // x: alpha cutoff (masked materials; 0 = opaque)
     extra: vec4<f32>,

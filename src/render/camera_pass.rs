@@ -384,8 +384,9 @@ fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
     v.into_iter().map(|(_, _, dr)| dr).collect()
 }
 
-/// What the camera pass needs to skip work: the camera's world → clip (draws whose bounds lie
-/// outside it are not recorded) and its eye with the near plane's reach (for `Draw::cull_mode`).
+/// What the camera pass needs per frame to do only the work the frame needs: the camera's world →
+/// clip (draws whose bounds lie outside it are not recorded), its eye with the near plane's reach
+/// (for `Draw::cull_mode`), and which shader variant and entry point to draw with.
 pub struct CameraCull {
     /// The camera's world → clip.
     pub clip_from_world: Mat4,

@@ -299,12 +299,7 @@ impl GpuScene {
             let u = MaterialUniform {
                 base_color: m.base_color,
                 emissive: m.emissive.extend(m.normal_scale),
-                params: Vec4::new(
-                    m.metallic,
-                    m.roughness,
-                    m.normal_texture.is_some() as u32 as f32,
-                    m.unlit as u32 as f32,
-                ),
+                params: Vec4::new(m.metallic, m.roughness, 0.0, m.unlit as u32 as f32),
                 extra: Vec4::new(
                     if let AlphaMode::Mask(c) = m.alpha_mode {
                         c.max(1e-6)

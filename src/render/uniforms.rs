@@ -54,7 +54,7 @@ pub struct MaterialUniform {
     pub base_color: Vec4,
     /// rgb emissive, w normal scale.
     pub emissive: Vec4,
-    /// x metallic, y roughness, z has normal map, w unlit.
+    /// x metallic, y roughness, z unused (normal mapping is a shader variant), w unlit.
     pub params: Vec4,
     /// x alpha cutoff, y texture slots present (`gpu_scene::texture_flags`).
     pub extra: Vec4,
