@@ -288,9 +288,14 @@ pub fn fit_spot(
     let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
     let view = Mat4::look_to_rh(position, d, up);
     let half = (outer_cone.clamp(0.01, 1.45) * 1.05).min(1.5);
-    let near = (scene_bounds.diagonal() * 1e-3).max(1e-3);
+    let near = spot_near(scene_bounds);
     let proj = perspective_infinite_reversed(2.0 * half, 1.0, near);
     (proj * view, half.tan())
+}
+
+/// Near-plane distance of a spot light's shadow projection over `scene_bounds`.
+pub fn spot_near(scene_bounds: &Aabb) -> f32 {
+    (scene_bounds.diagonal() * 1e-3).max(1e-3)
 }
 
 /// Light-space clip position of `p` (after the divide).

@@ -1,7 +1,6 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
-use super::frame::FramePlan;
 use super::gpu_scene::{Draw, GpuScene, VertexAttributes};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
@@ -392,7 +391,7 @@ pub struct CameraCull {
     pub clip_from_world: Mat4,
     /// Eye position and the distance from it to the near plane's farthest corner.
     pub eye: (Vec3, f32),
-    /// The frame's shader variant bits (`frame_variant_bits`).
+    /// The frame's shader variant bits (`FramePlan::shader_variant`).
     pub frame_bits: usize,
     /// The shadow-visibility or normals view (the debug entry point).
     pub debug_view: bool,
@@ -418,25 +417,6 @@ impl Entry {
             (false, false) => Entry::Opaque,
         }
     }
-}
-
-/// The shader variant bits a frame sets: one light (a constant loop), shadows sampled, the
-/// comparison path and the PCF kernel (constant loops instead of per-frame uniforms).
-pub fn frame_variant_bits(plan: &FramePlan) -> usize {
-    let [_, taps, hardware, _] = plan.uniform.modes;
-    let mut bits = 0;
-    for (on, bit) in [
-        (plan.lights.len() == 1, sh::BIT_SINGLE_LIGHT),
-        (plan.shadows_on, sh::BIT_SHADOWS),
-        (hardware == 1, sh::BIT_HW_COMPARE),
-        (taps == 1 || taps == 5, sh::BIT_PCF_BIT0),
-        (taps >= 3, sh::BIT_PCF_BIT1),
-    ] {
-        if on {
-            bits |= bit;
-        }
-    }
-    bits
 }
 
 impl Drop for CameraPass {

@@ -2,7 +2,7 @@
 //! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
 //! record exactly the same commands, so the window and the capture give the same pixels.
 
-use super::camera_pass::{frame_variant_bits, CameraCull, CameraPass};
+use super::camera_pass::{CameraCull, CameraPass};
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
 use super::settings::{SceneOptions, View, ViewMode};
@@ -10,6 +10,7 @@ use super::shadow_pass::ShadowPass;
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::Image;
+use crate::math::shadow_fit::spot_near;
 use crate::scene::{Light, LightKind, Scene};
 use ash::vk;
 use std::sync::Arc;
@@ -124,11 +125,8 @@ impl FrameCore {
             hw,
         );
         self.camera.write_frame(slot, &plan.uniform)?;
-        self.camera.ensure_pipelines(
-            &self.gpu,
-            frame_variant_bits(&plan),
-            is_debug_view(view.mode),
-        )?;
+        self.camera
+            .ensure_pipelines(&self.gpu, plan.shader_variant, is_debug_view(view.mode))?;
         Ok(plan)
     }
 
@@ -167,7 +165,7 @@ impl FrameCore {
             .shadow_light
             .map(|i| &plan.lights[i])
             .filter(|l| l.kind != LightKind::Directional)
-            .map(|l| (l.position, (self.gpu.bounds.diagonal() * 1e-3).max(1e-3)));
+            .map(|l| (l.position, spot_near(&self.gpu.bounds)));
         let casters = self.shadow.record(
             cmd,
             &self.gpu,
@@ -196,7 +194,7 @@ impl FrameCore {
                 plan.camera_position,
                 view.camera.near * (1.0 + t * t * (1.0 + aspect * aspect)).sqrt(),
             ),
-            frame_bits: frame_variant_bits(plan),
+            frame_bits: plan.shader_variant,
             debug_view: is_debug_view(view.mode),
         };
         let camera_draws = self.camera.record(

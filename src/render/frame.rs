@@ -1,7 +1,7 @@
 //! Per-frame planning on the CPU: which lights shade, which one gets the shadow map, the fitted
 //! light projection, the camera projection, and the frame uniform block.
 
-use super::settings::{ShadowFit, View};
+use super::settings::{Pcf, ShadowFit, View};
 use super::uniforms::{FrameUniform, LightUniform, MAX_LIGHTS};
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
 use crate::math::shadow_fit::{fit_directional, fit_spot, CameraFrustum, DirectionalFitInput};
@@ -85,6 +85,9 @@ pub struct FramePlan {
     pub shadow_map_size: u32,
     /// The camera's world position.
     pub camera_position: Vec3,
+    /// The scene shader's variant bits this frame sets (one light, shadows sampled, comparison
+    /// path, PCF kernel); each draw adds its material's bits.
+    pub(crate) shader_variant: usize,
     /// Lights shading this frame.
     pub lights: Vec<Light>,
     /// Index of the light with the shadow map, if any.
@@ -189,12 +192,36 @@ pub fn plan_frame(
         shadows_on,
         shadow_map_size: size,
         camera_position: view.camera.position(),
+        shader_variant: frame_variant_bits(lights.len(), shadows_on, hw_compare, view.shadow.pcf),
         lights,
         shadow_light,
         light_clip_from_world,
         texel_world,
         clip_from_world,
     }
+}
+
+/// The scene shader's frame variant bits: one light (a constant loop), shadows sampled, hardware
+/// comparison, and the PCF kernel (constant loops instead of per-frame uniforms).
+fn frame_variant_bits(lights: usize, shadows_on: bool, hw_compare: bool, pcf: Pcf) -> usize {
+    use crate::gpu::shaders::scene as sh;
+    let kernel_bits = match pcf {
+        Pcf::None => 0,
+        Pcf::P2x2 => sh::BIT_PCF_BIT0,
+        Pcf::P3x3 => sh::BIT_PCF_BIT1,
+        Pcf::P5x5 => sh::BIT_PCF_BIT0 | sh::BIT_PCF_BIT1,
+    };
+    let mut bits = kernel_bits;
+    for (on, bit) in [
+        (lights == 1, sh::BIT_SINGLE_LIGHT),
+        (shadows_on, sh::BIT_SHADOWS),
+        (hw_compare, sh::BIT_HW_COMPARE),
+    ] {
+        if on {
+            bits |= bit;
+        }
+    }
+    bits
 }
 
 #[cfg(test)]
@@ -215,5 +242,12 @@ mod tests {
         let p = plan_frame(&s.lights, &s.bounds(), &v, 1.5, false);
         assert_eq!(p.lights[0].direction, Vec3::NEG_Y);
         assert_eq!(p.uniform.modes[3], 1);
+        // One light, shadows on, PCF 2×2 by hand (hw_compare false).
+        use crate::gpu::shaders::scene as sh;
+        let want = sh::BIT_SINGLE_LIGHT | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0;
+        assert_eq!(p.shader_variant, want);
+        v.shadow.enabled = false;
+        let p = plan_frame(&s.lights, &s.bounds(), &v, 1.5, false);
+        assert_eq!(p.shader_variant, want & !sh::BIT_SHADOWS);
     }
 }

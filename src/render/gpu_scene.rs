@@ -63,12 +63,11 @@ pub struct Draw {
 }
 
 impl Draw {
-    /// Cull mode for a pass seen from `eye` = (position, near-plane reach) (None: a directional
-    /// light, outside everything); the reach keeps the near plane from cutting into a closed
-    /// mesh that is then treated as seen from outside. Single-sided materials cull back faces; double-sided ones draw (and cast
-    /// from) both faces, unless the primitive is closed and the eye is outside its bounds, where
-    /// back faces are hidden behind front faces anyway and culling them saves half the
-    /// rasterisation.
+    /// Cull mode for a pass seen from `eye` = (position, near-plane reach), None for a
+    /// directional light (outside everything). Single-sided materials cull back faces;
+    /// double-sided ones draw (and cast from) both faces, unless the primitive is closed and the
+    /// eye, with its near plane, is outside its bounds: there back faces are hidden behind front
+    /// faces anyway, and culling them saves half the rasterisation.
     pub fn cull_mode(&self, eye: Option<(Vec3, f32)>) -> vk::CullModeFlags {
         let outside = eye.is_none_or(|(e, reach)| !self.world_bounds.contains(e, reach));
         if !self.double_sided || (self.closed && outside) {
@@ -203,6 +202,7 @@ impl GpuScene {
                 if index_count == 0 {
                     continue;
                 }
+                let mat = scene.materials.get(material);
                 triangles += index_count as usize / 3;
                 draws.push(Draw {
                     first_index,
@@ -212,20 +212,11 @@ impl GpuScene {
                     world_from_model: inst.world_from_model,
                     immediates: SceneImmediates::new(inst.world_from_model),
                     world_bounds: b.transformed(&inst.world_from_model),
-                    double_sided: scene
-                        .materials
-                        .get(material)
-                        .is_some_and(|m| m.double_sided),
+                    double_sided: mat.is_some_and(|m| m.double_sided),
                     mirrored: glam::Mat3::from_mat4(inst.world_from_model).determinant() < 0.0,
                     closed,
-                    masked: scene
-                        .materials
-                        .get(material)
-                        .is_some_and(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
-                    material_bits: scene
-                        .materials
-                        .get(material)
-                        .map_or(0, material_variant_bits),
+                    masked: mat.is_some_and(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
+                    material_bits: mat.map_or(0, material_variant_bits),
                 });
             }
         }
