@@ -65,6 +65,9 @@ struct Frame {
     shadow_light: vec4<f32>,
     // x: constant bias in shadow texels, applied towards the light
     bias: vec4<f32>,
+    // Texel rectangle (x0, y0, x1, y1) of the map outside which a lookup's footprint meets no
+    // caster: lit there, without reading the map (the shadow pass clears only what it draws).
+    shadow_rect: vec4<f32>,
     // x: view mode, y: PCF kernel width in bilinear taps (0 = single nearest compare),
     // z: 1 if hardware linear comparison filtering is used, w: number of lights
     modes: vec4<u32>,
@@ -173,13 +176,14 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) ->
     }
     let ndc = lc.xyz / lc.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
-    if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+    let p_texel = uv * frame.shadow.x;
+    // Outside the casters' rectangle (which lies inside the map) nothing is in shadow.
+    if any(p_texel < frame.shadow_rect.xy) || any(p_texel > frame.shadow_rect.zw) {
         return 1.0;
     }
     // Depth clamp is on in the shadow pass, so receivers are clamped the same way.
     let depth = clamp(ndc.z, 0.0, 1.0);
     let size = i32(frame.shadow.x);
-    let p_texel = uv * frame.shadow.x;
     let kernel = pcf_taps();
     if kernel == 0 {
         return compare_texel(vec2<i32>(floor(p_texel)), depth, size);
@@ -197,18 +201,24 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) ->
     }
     // By hand: the kernel x kernel bilinear taps at one-texel spacing cover (kernel+1)^2 texels;
     // each texel's weight is separable, wx[i] = (1-fx)[i < kernel] + fx[i > 0], so every texel is
-    // compared once (16 loads for 3x3 taps instead of 36).
+    // compared once. kernel + 1 is even, so the texels come in 2x2 blocks, one gathered comparison
+    // each (the nearest comparison sampler clamps to the edge like the texel clamp above).
     let t = p_texel - vec2<f32>(0.5);
-    let base = vec2<i32>(floor(t)) - vec2<i32>(half);
+    let base = floor(t) - vec2<f32>(f32(half));
     let f = t - floor(t);
-    for (var j = 0; j <= kernel; j++) {
-        let wy = select(0.0, 1.0 - f.y, j < kernel) + select(0.0, f.y, j > 0);
-        var row = 0.0;
-        for (var i = 0; i <= kernel; i++) {
-            let wx = select(0.0, 1.0 - f.x, i < kernel) + select(0.0, f.x, i > 0);
-            row += wx * compare_texel(base + vec2<i32>(i, j), depth, size);
+    let inv = 1.0 / frame.shadow.x;
+    for (var bj = 0; bj <= kernel; bj += 2) {
+        let wy0 = select(0.0, 1.0 - f.y, bj < kernel) + select(0.0, f.y, bj > 0);
+        let wy1 = select(0.0, 1.0 - f.y, bj + 1 < kernel) + f.y;
+        for (var bi = 0; bi <= kernel; bi += 2) {
+            let wx0 = select(0.0, 1.0 - f.x, bi < kernel) + select(0.0, f.x, bi > 0);
+            let wx1 = select(0.0, 1.0 - f.x, bi + 1 < kernel) + f.x;
+            // Sampling at the corner shared by the block's four texels gathers exactly them:
+            // x = (i0, j1), y = (i1, j1), z = (i1, j0), w = (i0, j0).
+            let corner = (base + vec2<f32>(f32(bi) + 1.0, f32(bj) + 1.0)) * inv;
+            let g = textureGatherCompare(shadow_map, shadow_sampler, corner, depth);
+            sum += wy0 * (wx0 * g.w + wx1 * g.z) + wy1 * (wx0 * g.x + wx1 * g.y);
         }
-        sum += wy * row;
     }
     return sum / f32(kernel * kernel);
 }

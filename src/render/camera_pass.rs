@@ -1,7 +1,7 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
-use super::gpu_scene::{Draw, GpuScene, VertexAttributes};
+use super::gpu_scene::{Draw, GpuScene, VertexAttributes, Viewpoint};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
@@ -345,7 +345,8 @@ impl CameraPass {
                         );
                         bound_material = dr.material;
                     }
-                    d.cmd_set_cull_mode(cmd, dr.cull_mode(Some(cull.eye)));
+                    let cull_mode = dr.cull_mode(Some(cull.eye));
+                    d.cmd_set_cull_mode(cmd, cull_mode);
                     d.cmd_set_front_face(cmd, dr.front_face());
                     d.cmd_push_constants(
                         cmd,
@@ -354,7 +355,7 @@ impl CameraPass {
                         0,
                         bytemuck::bytes_of(&dr.immediates),
                     );
-                    d.cmd_draw_indexed(cmd, dr.index_count, 1, dr.first_index, dr.vertex_offset, 0);
+                    scene.draw_indexed(d, cmd, dr, cull_mode, Viewpoint::Eye(cull.eye.0));
                 }
             }
             d.cmd_end_rendering(cmd);

@@ -6,7 +6,7 @@ use super::camera_pass::{CameraCull, CameraPass};
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
 use super::settings::{SceneOptions, View, ViewMode};
-use super::shadow_pass::ShadowPass;
+use super::shadow_pass::{plan_casters, LightSource, ShadowPass};
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::Image;
@@ -117,13 +117,29 @@ impl FrameCore {
         self.camera.bind_shadow_map(slot, map_view, hw);
         let mut v = view.clone();
         v.shadow.map_size = map_size;
-        let plan = plan_frame(
+        let mut plan = plan_frame(
             &self.lights,
             &self.gpu.bounds,
             &v,
             width as f32 / height.max(1) as f32,
             hw,
         );
+        if plan.shadows_on {
+            let source = match plan.shadow_light.map(|i| &plan.lights[i]) {
+                Some(l) if l.kind != LightKind::Directional => LightSource::Position(l.position),
+                Some(l) => LightSource::Direction(l.direction),
+                None => LightSource::Direction(glam::Vec3::NEG_Y),
+            };
+            plan.casters = plan_casters(
+                &self.gpu,
+                &plan.light_clip_from_world,
+                source,
+                map_size,
+                view.shadow.pcf.lookup_reach(),
+                view.mode == ViewMode::ShadowMap,
+            );
+        }
+        plan.uniform.shadow_rect = plan.casters.lookup;
         self.camera.write_frame(slot, &plan.uniform)?;
         self.camera
             .ensure_pipelines(&self.gpu, plan.shader_variant, is_debug_view(view.mode))?;
@@ -158,7 +174,6 @@ impl FrameCore {
                 );
             }
         }
-        let shadows_on = plan.shadows_on;
         // The shadowed light's eye: none for a directional light (outside everything); a spot
         // light's position with its projection's near distance.
         let light_eye = plan
@@ -171,8 +186,9 @@ impl FrameCore {
             &self.gpu,
             &plan.light_clip_from_world,
             &view.shadow,
-            shadows_on,
+            &plan.casters,
             light_eye,
+            plan.casters.light,
         );
         unsafe {
             if timestamps {

@@ -1,6 +1,7 @@
 //! Per-frame planning on the CPU: which lights shade, which one gets the shadow map, the fitted
 //! light projection, the camera projection, and the frame uniform block.
 
+use super::shadow_pass::CasterPlan;
 use super::settings::{Pcf, ShadowFit, View};
 use super::uniforms::{FrameUniform, LightUniform, MAX_LIGHTS};
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
@@ -98,6 +99,8 @@ pub struct FramePlan {
     pub texel_world: f32,
     /// The camera's world → clip.
     pub clip_from_world: Mat4,
+    /// The shadow pass's casters and area (set by `FrameCore::prepare`; none before).
+    pub casters: CasterPlan,
 }
 
 /// Plans a frame for `view` of a scene with `scene_lights` and `bounds`, rendered at `aspect`.
@@ -164,6 +167,8 @@ pub fn plan_frame(
             shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32),
         ),
         bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
+        // Set with the casters (`shadow_pass::plan_casters`); until then every lookup is lit.
+        shadow_rect: Vec4::new(1.0, 1.0, -1.0, -1.0),
         modes: [
             view.mode.shader_value(),
             view.shadow.pcf.taps(),
@@ -198,6 +203,7 @@ pub fn plan_frame(
         light_clip_from_world,
         texel_world,
         clip_from_world,
+        casters: CasterPlan::default(),
     }
 }
 

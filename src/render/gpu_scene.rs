@@ -7,7 +7,8 @@ use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
 use crate::gpu::{Buffer, Image};
 use crate::math::Aabb;
-use crate::scene::topology::is_closed;
+use crate::scene::clusters::{self, Cluster};
+use crate::scene::topology::{is_closed, plane_of};
 use crate::scene::{AlphaMode, Scene};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -28,9 +29,20 @@ pub struct VertexAttributes {
     pub tangent: [f32; 4],
 }
 
-/// (first index, index count, vertex offset, material, object bounds) of one uploaded primitive.
-/// First index, index count, vertex offset, material, bounds, closed (see `Draw::closed`).
-type PrimitiveRange = (u32, u32, i32, usize, Aabb, bool);
+/// One uploaded primitive: its index range, material, model-space bounds and shape facts.
+struct PrimitiveRange {
+    first_index: u32,
+    index_count: u32,
+    vertex_offset: i32,
+    material: usize,
+    bounds: Aabb,
+    /// See `Draw::closed`.
+    closed: bool,
+    /// Model-space plane of a flat primitive (`scene::topology::plane_of`).
+    plane: Option<Vec4>,
+    /// (first, count) in `GpuScene::clusters` (count 0: one draw).
+    clusters: (u32, u32),
+}
 
 /// One indexed draw (a primitive of an instance).
 #[derive(Clone, Copy, Debug)]
@@ -45,10 +57,16 @@ pub struct Draw {
     pub material: usize,
     /// Model → world.
     pub world_from_model: Mat4,
+    /// World → model (for cluster culling in model space).
+    pub model_from_world: Mat4,
+    /// (first, count) of the primitive's clusters in `GpuScene::clusters` (count 0: none).
+    pub clusters: (u32, u32),
     /// Camera-pass immediates (transform and normal matrix), computed once at upload.
     pub immediates: SceneImmediates,
     /// World-space bounds (for culling).
     pub world_bounds: Aabb,
+    /// World-space plane `(n, w)` of a flat primitive (`scene::topology::plane_of`), unit `n`.
+    pub world_plane: Option<Vec4>,
     /// Draw both faces.
     pub double_sided: bool,
     /// The transform mirrors (negative determinant): its triangles wind clockwise on screen.
@@ -60,6 +78,15 @@ pub struct Draw {
     /// The primitive is closed and consistently wound (`scene::topology::is_closed`): seen from
     /// outside its bounds, culling back faces changes no pixel even if it is double-sided.
     pub closed: bool,
+}
+
+/// A model-space plane `(n, w)` carried into world space by `m` (None for a singular `m`).
+fn world_plane(plane: Vec4, m: &Mat4) -> Option<Vec4> {
+    let n = plane.truncate();
+    let point = m.transform_point3(n * -plane.w);
+    let normal_matrix = glam::Mat3::from_mat4(*m).inverse().transpose();
+    let wn = (normal_matrix * n).try_normalize()?;
+    wn.is_finite().then(|| wn.extend(-wn.dot(point)))
 }
 
 impl Draw {
@@ -109,6 +136,15 @@ pub fn material_variant_bits(m: &crate::scene::Material) -> usize {
     bits
 }
 
+/// What a draw's faces are tested against when clusters are skipped.
+#[derive(Clone, Copy, Debug)]
+pub enum Viewpoint {
+    /// A perspective eye (camera, spot light) at this world position.
+    Eye(Vec3),
+    /// An orthographic view (directional light) looking along this world direction.
+    Along(Vec3),
+}
+
 /// The GPU copy of a scene.
 pub struct GpuScene {
     ctx: Arc<Context>,
@@ -126,6 +162,8 @@ pub struct GpuScene {
     pub material_sets: Vec<vk::DescriptorSet>,
     /// World bounds.
     pub bounds: Aabb,
+    /// Clusters of the large primitives (`scene::clusters`), indexed by `Draw::clusters`.
+    pub clusters: Vec<Cluster>,
     /// Triangles drawn per frame.
     pub triangles: usize,
     /// Whether draws outside the camera's view are skipped (`SceneOptions::culling`).
@@ -140,6 +178,40 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
+    /// Records `dr` drawn with `cull`: with back faces culled, clusters whose faces all point away
+    /// from `from` are left out (tested in model space, where a mirroring transform's flipped
+    /// winding is undone by `Draw::front_face`), and runs of the rest are drawn.
+    pub fn draw_indexed(
+        &self,
+        device: &ash::Device,
+        cmd: vk::CommandBuffer,
+        dr: &Draw,
+        cull: vk::CullModeFlags,
+        from: Viewpoint,
+    ) {
+        let (start, count) = dr.clusters;
+        let draw = |first: u32, n: u32| unsafe {
+            device.cmd_draw_indexed(cmd, n, 1, dr.first_index + first, dr.vertex_offset, 0)
+        };
+        if count == 0 || cull != vk::CullModeFlags::BACK {
+            return draw(0, dr.index_count);
+        }
+        let cl = &self.clusters[start as usize..(start + count) as usize];
+        let runs = match from {
+            Viewpoint::Eye(e) => {
+                let e = dr.model_from_world.transform_point3(e);
+                clusters::visible_runs(cl, |c| c.back_facing_from(e))
+            }
+            Viewpoint::Along(d) => {
+                let d = dr.model_from_world.transform_vector3(d);
+                clusters::visible_runs(cl, |c| c.back_facing_along(d))
+            }
+        };
+        for (first, n) in runs {
+            draw(first, n);
+        }
+    }
+
     /// Uploads `scene`.
     pub fn new(
         ctx: &Arc<Context>,
@@ -152,6 +224,7 @@ impl GpuScene {
         let mut attrs: Vec<VertexAttributes> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
         let mut ranges: Vec<Vec<PrimitiveRange>> = Vec::new();
+        let mut all_clusters: Vec<Cluster> = Vec::new();
         for mesh in &scene.meshes {
             let mut r = Vec::new();
             for p in &mesh.primitives {
@@ -175,46 +248,67 @@ impl GpuScene {
                             .to_array(),
                     });
                 }
-                indices.extend_from_slice(&p.indices);
-                r.push((
-                    first,
-                    p.indices.len() as u32,
-                    base,
-                    p.material.min(scene.materials.len().saturating_sub(1)),
-                    p.bounds(),
+                // Large primitives are split into clusters (their indices reordered cluster by
+                // cluster) so that clusters facing away can be skipped.
+                let built = options
+                    .culling
+                    .then(|| clusters::build(&p.positions, &p.indices))
+                    .flatten();
+                let cluster_start = all_clusters.len() as u32;
+                match built {
+                    Some((reordered, cl)) => {
+                        indices.extend_from_slice(&reordered);
+                        all_clusters.extend(cl);
+                    }
+                    None => indices.extend_from_slice(&p.indices),
+                }
+                let cluster_range = (cluster_start, all_clusters.len() as u32 - cluster_start);
+                r.push(PrimitiveRange {
+                    clusters: cluster_range,
+                    first_index: first,
+                    index_count: indices.len() as u32 - first,
+                    vertex_offset: base,
+                    material: p.material.min(scene.materials.len().saturating_sub(1)),
+                    bounds: p.bounds(),
                     // Only double-sided materials can use it; skip the check for the others.
-                    options.culling
+                    closed: options.culling
                         && scene
                             .materials
                             .get(p.material)
                             .is_some_and(|m| m.double_sided)
                         && is_closed(&p.positions, &p.indices),
-                ));
+                    plane: options
+                        .culling
+                        .then(|| plane_of(&p.positions, &p.indices))
+                        .flatten(),
+                });
             }
             ranges.push(r);
         }
         let mut draws = Vec::new();
         let mut triangles = 0;
         for inst in &scene.instances {
-            for &(first_index, index_count, vertex_offset, material, b, closed) in
-                &ranges[inst.mesh]
-            {
+            for r in &ranges[inst.mesh] {
+                let (index_count, material) = (r.index_count, r.material);
                 if index_count == 0 {
                     continue;
                 }
                 let mat = scene.materials.get(material);
                 triangles += index_count as usize / 3;
                 draws.push(Draw {
-                    first_index,
+                    first_index: r.first_index,
                     index_count,
-                    vertex_offset,
+                    vertex_offset: r.vertex_offset,
                     material,
                     world_from_model: inst.world_from_model,
+                    model_from_world: inst.world_from_model.inverse(),
+                    clusters: r.clusters,
                     immediates: SceneImmediates::new(inst.world_from_model),
-                    world_bounds: b.transformed(&inst.world_from_model),
+                    world_bounds: r.bounds.transformed(&inst.world_from_model),
+                    world_plane: r.plane.and_then(|pl| world_plane(pl, &inst.world_from_model)),
                     double_sided: mat.is_some_and(|m| m.double_sided),
                     mirrored: glam::Mat3::from_mat4(inst.world_from_model).determinant() < 0.0,
-                    closed,
+                    closed: r.closed,
                     masked: mat.is_some_and(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
                     material_bits: mat.map_or(0, material_variant_bits),
                 });
@@ -359,6 +453,7 @@ impl GpuScene {
             material_layout,
             material_sets: sets,
             bounds: scene.bounds(),
+            clusters: all_clusters,
             triangles,
             frustum_culling: options.culling,
             pipeline_keys,

@@ -52,6 +52,12 @@ impl Pcf {
             Pcf::P5x5 => 5,
         }
     }
+
+    /// How many texels from its centre a lookup reads: half the kernel's bilinear taps, plus the
+    /// 2×2 texels of each tap (1 for the single nearest comparison).
+    pub fn lookup_reach(self) -> u32 {
+        self.taps().saturating_sub(1) / 2 + 1
+    }
 }
 
 /// Depth format of the shadow map.

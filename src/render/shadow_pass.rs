@@ -2,7 +2,7 @@
 //! depth bias pushing casters away from the light (negative factors under reversed-z).
 
 use super::core::Attachment;
-use super::gpu_scene::GpuScene;
+use super::gpu_scene::{GpuScene, Viewpoint};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
@@ -14,7 +14,7 @@ use crate::gpu::shaders::{create_module, shadow as sh};
 use crate::gpu::Image;
 use crate::math::Aabb;
 use ash::vk;
-use glam::{Mat4, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 use std::sync::Arc;
 
 /// Vulkan format of a shadow format.
@@ -25,21 +25,156 @@ pub fn vk_format(f: ShadowFormat) -> vk::Format {
     }
 }
 
-/// True when a caster with world bounds `b` may land inside the light's view (x, y in [−1, 1],
-/// not entirely beyond the far plane). Near-plane overshoot is kept: depth clamp pancakes it.
-pub fn caster_visible(light_clip_from_world: &Mat4, b: &Aabb) -> bool {
-    let mut lo = glam::Vec3::splat(f32::INFINITY);
-    let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
+/// The light-clip x, y extent `[x0, y0, x1, y1]` of a caster with world bounds `b`, or None when
+/// it cannot land inside the light's view (outside x, y in [−1, 1] or entirely beyond the far
+/// plane). Near-plane overshoot is kept: depth clamp pancakes it. A box reaching behind a
+/// perspective light's eye gets the whole view.
+pub fn caster_extent(light_clip_from_world: &Mat4, b: &Aabb) -> Option<[f32; 4]> {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
     for c in b.corners() {
         let p = *light_clip_from_world * Vec4::new(c.x, c.y, c.z, 1.0);
         if p.w <= 1e-12 {
-            return true; // behind a perspective light's eye: be conservative.
+            return Some([-1.0, -1.0, 1.0, 1.0]);
         }
         let q = p.truncate() / p.w;
         lo = lo.min(q);
         hi = hi.max(q);
     }
-    hi.x >= -1.0 && lo.x <= 1.0 && hi.y >= -1.0 && lo.y <= 1.0 && hi.z >= 0.0
+    let visible = hi.x >= -1.0 && lo.x <= 1.0 && hi.y >= -1.0 && lo.y <= 1.0 && hi.z >= 0.0;
+    visible.then_some([lo.x, lo.y, hi.x, hi.y])
+}
+
+/// The casters one frame draws into the shadow map, and the texels they can touch.
+#[derive(Clone, Debug)]
+pub struct CasterPlan {
+    /// Indices into `GpuScene::draws`.
+    pub draws: Vec<usize>,
+    /// The texels the pass clears and draws (the casters' rectangle grown by twice the lookup
+    /// reach, so every texel a lookup inside `lookup` reads is written this frame).
+    pub area: vk::Rect2D,
+    /// Texel rectangle `(x0, y0, x1, y1)` outside which a lookup's footprint meets no caster
+    /// texel (the casters' rectangle grown by the reach): such lookups are lit without a read.
+    pub lookup: Vec4,
+    /// The shadowed light (clusters facing away from it are not drawn).
+    pub light: LightSource,
+}
+
+impl Default for CasterPlan {
+    /// No casters: one texel cleared, every lookup lit.
+    fn default() -> Self {
+        Self {
+            draws: Vec::new(),
+            area: vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: vk::Extent2D {
+                    width: 1,
+                    height: 1,
+                },
+            },
+            lookup: Vec4::new(1.0, 1.0, -1.0, -1.0),
+            light: LightSource::Direction(Vec3::NEG_Y),
+        }
+    }
+}
+
+/// Chooses the casters of a frame: those whose bounds reach the light's view, less flat casters
+/// with nothing behind them (`flat_caster_casts_nothing`). `reach` is how many texels from its
+/// centre a lookup reads (PCF half-width + 1); `full` clears the whole map (the map debug view).
+pub fn plan_casters(
+    scene: &GpuScene,
+    light_clip_from_world: &Mat4,
+    light: LightSource,
+    size: u32,
+    reach: u32,
+    full: bool,
+) -> CasterPlan {
+    let mut plan = CasterPlan {
+        light,
+        ..CasterPlan::default()
+    };
+    let mut ndc = [f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY];
+    for (i, dr) in scene.draws.iter().enumerate() {
+        let Some(e) = caster_extent(light_clip_from_world, &dr.world_bounds) else {
+            continue;
+        };
+        if dr
+            .world_plane
+            .is_some_and(|pl| flat_caster_casts_nothing(pl, light, &scene.bounds))
+        {
+            continue;
+        }
+        plan.draws.push(i);
+        ndc = [ndc[0].min(e[0]), ndc[1].min(e[1]), ndc[2].max(e[2]), ndc[3].max(e[3])];
+    }
+    let s = size as f32;
+    let (x0, x1) = ((ndc[0] * 0.5 + 0.5) * s, (ndc[2] * 0.5 + 0.5) * s);
+    // Texel rows grow downwards: v = 0.5 − 0.5·y.
+    let (y0, y1) = ((0.5 - ndc[3] * 0.5) * s, (0.5 - ndc[1] * 0.5) * s);
+    // One texel of slack for rasterisation rules, then the reach.
+    let grow = |a: f32, b: f32, by: f32| ((a - 1.0 - by).max(0.0), (b + 1.0 + by).min(s));
+    let empty = plan.draws.is_empty() || !(x0 <= x1 && y0 <= y1);
+    let r = reach as f32;
+    plan.lookup = if empty {
+        Vec4::new(1.0, 1.0, -1.0, -1.0) // empty: every lookup is lit
+    } else {
+        let ((lx0, lx1), (ly0, ly1)) = (grow(x0, x1, r), grow(y0, y1, r));
+        Vec4::new(lx0, ly0, lx1, ly1)
+    };
+    let ((ax0, ax1), (ay0, ay1)) = if full {
+        ((0.0, s), (0.0, s))
+    } else if empty {
+        ((0.0, 1.0), (0.0, 1.0))
+    } else {
+        (grow(x0, x1, 2.0 * r + 1.0), grow(y0, y1, 2.0 * r + 1.0))
+    };
+    let (ax0, ay0) = (ax0.floor() as u32, ay0.floor() as u32);
+    let (ax1, ay1) = ((ax1.ceil() as u32).max(ax0 + 1), (ay1.ceil() as u32).max(ay0 + 1));
+    plan.area = vk::Rect2D {
+        offset: vk::Offset2D {
+            x: ax0 as i32,
+            y: ay0 as i32,
+        },
+        extent: vk::Extent2D {
+            width: ax1 - ax0,
+            height: ay1 - ay0,
+        },
+    };
+    plan
+}
+
+/// Where the shadowed light is, for the flat-caster rule.
+#[derive(Clone, Copy, Debug)]
+pub enum LightSource {
+    /// A directional light: the direction its light travels.
+    Direction(Vec3),
+    /// A spot (or point) light's position.
+    Position(Vec3),
+}
+
+/// True when a flat caster on `plane` (`(n, w)`, unit `n`) cannot shadow anything: the light and
+/// the whole scene (bounds `scene`, which hold every receiver) lie on one closed side of the plane,
+/// and a segment from a point to the light never leaves that side (a half-space is convex), so it
+/// never meets the caster except at its own end. This skips a ground plane with nothing under it,
+/// the largest caster of most scenes, from the depth pass. Scene parts within 1e-5 of the scene's
+/// diagonal behind the plane still count as in front (a model resting on the ground), a choice
+/// that can only matter for geometry sunk that little and seen from beneath the plane.
+pub fn flat_caster_casts_nothing(plane: Vec4, light: LightSource, scene: &Aabb) -> bool {
+    let n = plane.truncate();
+    let light_side = match light {
+        LightSource::Direction(d) => -n.dot(d.normalize_or_zero()),
+        LightSource::Position(p) => n.dot(p) + plane.w,
+    };
+    // Edge-on to the light, or the light on the plane: keep it (cheap, and no sign to trust).
+    if light_side.abs() <= 1e-6 || !light_side.is_finite() {
+        return false;
+    }
+    let s = light_side.signum();
+    let tolerance = 1e-5 * scene.diagonal();
+    scene
+        .corners()
+        .iter()
+        .all(|c| s * (n.dot(*c) + plane.w) >= -tolerance)
 }
 
 /// The shadow depth pass and its map.
@@ -152,9 +287,14 @@ impl ShadowPass {
         scene: &GpuScene,
         light_clip_from_world: &Mat4,
         s: &ShadowSettings,
-        draw: bool,
+        casters: &CasterPlan,
         eye: Option<(glam::Vec3, f32)>,
+        light: LightSource,
     ) -> usize {
+        let from = match light {
+            LightSource::Direction(d) => Viewpoint::Along(d),
+            LightSource::Position(p) => Viewpoint::Eye(p),
+        };
         let (Some(map), Some(at)) = (&self.map, self.map_at.as_mut()) else {
             return 0;
         };
@@ -162,33 +302,31 @@ impl ShadowPass {
         self.ctx.begin_label(cmd, "shadow depth pass");
         at.transition(d, cmd, Access::DepthAttachment);
         let depth_attachment = depth_clear_attachment(map.view);
+        // Only the casters' area is cleared and drawn: lookups elsewhere never read the map.
+        let area = casters.area;
         let rendering = vk::RenderingInfo::default()
-            .render_area(vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent: map.extent,
-            })
+            .render_area(area)
             .layer_count(1)
             .depth_attachment(&depth_attachment);
         let mut drawn = 0;
         unsafe {
             d.cmd_begin_rendering(cmd, &rendering);
-            if draw && !scene.draws.is_empty() {
+            if !casters.draws.is_empty() {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
                 set_viewport(&self.ctx, cmd, map.extent);
+                d.cmd_set_scissor(cmd, 0, &[area]);
                 // Reversed-z: "away from the light" is towards smaller depth, so the factor is negated.
                 // The constant bias is applied on the receiver side, in texels (camera pass).
                 d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
                 d.cmd_bind_vertex_buffers(cmd, 0, &[scene.positions.raw], &[0]);
                 d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-                for dr in &scene.draws {
-                    if !caster_visible(light_clip_from_world, &dr.world_bounds) {
-                        continue;
-                    }
+                for dr in casters.draws.iter().map(|&i| &scene.draws[i]) {
                     let pc = ShadowImmediates {
                         light_clip_from_world: *light_clip_from_world,
                         world_from_model: dr.world_from_model,
                     };
-                    d.cmd_set_cull_mode(cmd, dr.cull_mode(eye));
+                    let cull_mode = dr.cull_mode(eye);
+                    d.cmd_set_cull_mode(cmd, cull_mode);
                     d.cmd_set_front_face(cmd, dr.front_face());
                     d.cmd_push_constants(
                         cmd,
@@ -197,7 +335,7 @@ impl ShadowPass {
                         0,
                         bytemuck::bytes_of(&pc),
                     );
-                    d.cmd_draw_indexed(cmd, dr.index_count, 1, dr.first_index, dr.vertex_offset, 0);
+                    scene.draw_indexed(d, cmd, dr, cull_mode, from);
                     drawn += 1;
                 }
             }
@@ -224,29 +362,59 @@ impl Drop for ShadowPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
 
     #[test]
     fn caster_culling() {
         let m = crate::math::projection::orthographic_reversed(-1.0, 1.0, -1.0, 1.0, 0.0, 10.0);
-        assert!(caster_visible(
+        let e = caster_extent(
             &m,
-            &Aabb::new(Vec3::new(-0.5, -0.5, -5.0), Vec3::new(0.5, 0.5, -4.0))
-        ));
+            &Aabb::new(Vec3::new(-0.5, -0.5, -5.0), Vec3::new(0.5, 0.5, -4.0)),
+        );
+        assert_eq!(e, Some([-0.5, -0.5, 0.5, 0.5]));
         // Outside in x.
-        assert!(!caster_visible(
+        assert!(caster_extent(
             &m,
             &Aabb::new(Vec3::new(2.0, -0.5, -5.0), Vec3::new(3.0, 0.5, -4.0))
-        ));
+        )
+        .is_none());
         // Nearer than the near plane (depth > 1): kept, depth clamp flattens it.
-        assert!(caster_visible(
+        assert!(caster_extent(
             &m,
             &Aabb::new(Vec3::new(-0.5, -0.5, 1.0), Vec3::new(0.5, 0.5, 2.0))
-        ));
+        )
+        .is_some());
         // Beyond the far plane: culled.
-        assert!(!caster_visible(
+        assert!(caster_extent(
             &m,
             &Aabb::new(Vec3::new(-0.5, -0.5, -20.0), Vec3::new(0.5, 0.5, -15.0))
-        ));
+        )
+        .is_none());
+    }
+
+    #[test]
+    fn flat_casters_with_nothing_behind_them() {
+        let ground = Vec4::new(0.0, 1.0, 0.0, 0.0); // y = 0, facing +y
+        let above = Aabb::new(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 5.0, 10.0));
+        let sun = LightSource::Direction(Vec3::new(0.3, -1.0, 0.2));
+        assert!(flat_caster_casts_nothing(ground, sun, &above));
+        // The plane's normal may point either way: the light's side decides.
+        assert!(flat_caster_casts_nothing(-ground, sun, &above));
+        // Something below the ground: it may be shadowed by the ground.
+        let below = Aabb::new(Vec3::new(-10.0, -1.0, -10.0), Vec3::new(10.0, 5.0, 10.0));
+        assert!(!flat_caster_casts_nothing(ground, sun, &below));
+        // A sun from below: the scene is on the dark side, the plane shadows it.
+        let under = LightSource::Direction(Vec3::new(0.0, 1.0, 0.0));
+        assert!(!flat_caster_casts_nothing(ground, under, &above));
+        // A grazing sun exactly in the plane: kept.
+        let grazing = LightSource::Direction(Vec3::X);
+        assert!(!flat_caster_casts_nothing(ground, grazing, &above));
+        // A spot above the ground, and one below it.
+        let lamp = LightSource::Position(Vec3::new(0.0, 4.0, 0.0));
+        assert!(flat_caster_casts_nothing(ground, lamp, &above));
+        let cellar = LightSource::Position(Vec3::new(0.0, -4.0, 0.0));
+        assert!(!flat_caster_casts_nothing(ground, cellar, &above));
+        // A wall at x = 2 with the scene on both sides casts.
+        let wall = Vec4::new(1.0, 0.0, 0.0, -2.0);
+        assert!(!flat_caster_casts_nothing(wall, sun, &above));
     }
 }

@@ -40,6 +40,9 @@ pub struct FrameUniform {
     pub shadow_light: Vec4,
     /// x constant bias in shadow texels (towards the light).
     pub bias: Vec4,
+    /// Texel rectangle (x0, y0, x1, y1) of the shadow map outside which a lookup's footprint
+    /// meets no caster (lit without reading the map; the texels there are not cleared).
+    pub shadow_rect: Vec4,
     /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
     pub modes: [u32; 4],
     /// Lights.
