@@ -188,7 +188,6 @@ impl FrameCore {
             &view.shadow,
             &plan.casters,
             light_eye,
-            plan.casters.light,
         );
         unsafe {
             if timestamps {

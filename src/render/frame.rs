@@ -1,8 +1,8 @@
 //! Per-frame planning on the CPU: which lights shade, which one gets the shadow map, the fitted
 //! light projection, the camera projection, and the frame uniform block.
 
-use super::shadow_pass::CasterPlan;
 use super::settings::{Pcf, ShadowFit, View};
+use super::shadow_pass::CasterPlan;
 use super::uniforms::{FrameUniform, LightUniform, MAX_LIGHTS};
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
 use crate::math::shadow_fit::{fit_directional, fit_spot, CameraFrustum, DirectionalFitInput};

@@ -305,7 +305,9 @@ impl GpuScene {
                     clusters: r.clusters,
                     immediates: SceneImmediates::new(inst.world_from_model),
                     world_bounds: r.bounds.transformed(&inst.world_from_model),
-                    world_plane: r.plane.and_then(|pl| world_plane(pl, &inst.world_from_model)),
+                    world_plane: r
+                        .plane
+                        .and_then(|pl| world_plane(pl, &inst.world_from_model)),
                     double_sided: mat.is_some_and(|m| m.double_sided),
                     mirrored: glam::Mat3::from_mat4(inst.world_from_model).determinant() < 0.0,
                     closed: r.closed,

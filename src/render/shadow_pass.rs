@@ -93,7 +93,12 @@ pub fn plan_casters(
         light,
         ..CasterPlan::default()
     };
-    let mut ndc = [f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY];
+    let mut ndc = [
+        f32::INFINITY,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NEG_INFINITY,
+    ];
     for (i, dr) in scene.draws.iter().enumerate() {
         let Some(e) = caster_extent(light_clip_from_world, &dr.world_bounds) else {
             continue;
@@ -105,7 +110,12 @@ pub fn plan_casters(
             continue;
         }
         plan.draws.push(i);
-        ndc = [ndc[0].min(e[0]), ndc[1].min(e[1]), ndc[2].max(e[2]), ndc[3].max(e[3])];
+        ndc = [
+            ndc[0].min(e[0]),
+            ndc[1].min(e[1]),
+            ndc[2].max(e[2]),
+            ndc[3].max(e[3]),
+        ];
     }
     let s = size as f32;
     let (x0, x1) = ((ndc[0] * 0.5 + 0.5) * s, (ndc[2] * 0.5 + 0.5) * s);
@@ -129,7 +139,10 @@ pub fn plan_casters(
         (grow(x0, x1, 2.0 * r + 1.0), grow(y0, y1, 2.0 * r + 1.0))
     };
     let (ax0, ay0) = (ax0.floor() as u32, ay0.floor() as u32);
-    let (ax1, ay1) = ((ax1.ceil() as u32).max(ax0 + 1), (ay1.ceil() as u32).max(ay0 + 1));
+    let (ax1, ay1) = (
+        (ax1.ceil() as u32).max(ax0 + 1),
+        (ay1.ceil() as u32).max(ay0 + 1),
+    );
     plan.area = vk::Rect2D {
         offset: vk::Offset2D {
             x: ax0 as i32,
@@ -289,9 +302,8 @@ impl ShadowPass {
         s: &ShadowSettings,
         casters: &CasterPlan,
         eye: Option<(glam::Vec3, f32)>,
-        light: LightSource,
     ) -> usize {
-        let from = match light {
+        let from = match casters.light {
             LightSource::Direction(d) => Viewpoint::Along(d),
             LightSource::Position(p) => Viewpoint::Eye(p),
         };

@@ -44,15 +44,14 @@ impl Cluster {
 /// Splits a primitive into clusters: returns its index list reordered cluster by cluster, and the
 /// clusters; None for a primitive under `MIN_TRIANGLES` triangles or with an index out of range.
 pub fn build(positions: &[Vec3], indices: &[u32]) -> Option<(Vec<u32>, Vec<Cluster>)> {
-    if indices.len() / 3 < MIN_TRIANGLES
-        || indices.iter().any(|&i| i as usize >= positions.len())
-    {
+    if indices.len() / 3 < MIN_TRIANGLES || indices.iter().any(|&i| i as usize >= positions.len()) {
         return None;
     }
     let data: &[u8] = bytemuck::cast_slice(positions);
     let adapter = meshopt::VertexDataAdapter::new(data, std::mem::size_of::<Vec3>(), 0).ok()?;
     let tris = &indices[..indices.len() / 3 * 3];
-    let meshlets = meshopt::build_meshlets(tris, &adapter, MAX_VERTICES, MAX_TRIANGLES, CONE_WEIGHT);
+    let meshlets =
+        meshopt::build_meshlets(tris, &adapter, MAX_VERTICES, MAX_TRIANGLES, CONE_WEIGHT);
     let mut out = Vec::with_capacity(tris.len());
     let mut clusters = Vec::with_capacity(meshlets.len());
     for m in meshlets.iter() {
@@ -72,7 +71,10 @@ pub fn build(positions: &[Vec3], indices: &[u32]) -> Option<(Vec<u32>, Vec<Clust
 
 /// The runs of consecutive clusters that are not `hidden`, as (first index, index count) relative
 /// to the primitive, merged so that each run is one draw.
-pub fn visible_runs(clusters: &[Cluster], mut hidden: impl FnMut(&Cluster) -> bool) -> Vec<(u32, u32)> {
+pub fn visible_runs(
+    clusters: &[Cluster],
+    mut hidden: impl FnMut(&Cluster) -> bool,
+) -> Vec<(u32, u32)> {
     let mut runs: Vec<(u32, u32)> = Vec::new();
     for c in clusters {
         if hidden(c) {
@@ -111,12 +113,19 @@ mod tests {
         a.sort_unstable();
         b.sort_unstable();
         assert_eq!(a, b);
-        for eye in [Vec3::new(0.0, 0.0, 3.0), Vec3::new(2.0, 1.5, -1.2), Vec3::new(0.0, 1.05, 0.0)] {
+        for eye in [
+            Vec3::new(0.0, 0.0, 3.0),
+            Vec3::new(2.0, 1.5, -1.2),
+            Vec3::new(0.0, 1.05, 0.0),
+        ] {
             let mut culled_tris = 0;
             for c in clusters.iter().filter(|c| c.back_facing_from(eye)) {
                 let tris = &idx[c.first as usize..(c.first + c.count) as usize];
                 for t in tris.chunks(3) {
-                    assert!(!faces(&s.positions, t, eye), "a culled cluster held a front face");
+                    assert!(
+                        !faces(&s.positions, t, eye),
+                        "a culled cluster held a front face"
+                    );
                 }
                 culled_tris += tris.len() / 3;
             }

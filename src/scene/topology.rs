@@ -53,7 +53,11 @@ pub fn is_closed(positions: &[Vec3], indices: &[u32]) -> bool {
 /// A flat caster can only shadow what lies on the far side of its plane from the light, which lets
 /// the shadow pass skip a ground plane that has nothing beneath it.
 pub fn plane_of(positions: &[Vec3], indices: &[u32]) -> Option<Vec4> {
-    let used = || indices.iter().filter_map(|&i| positions.get(i as usize).copied());
+    let used = || {
+        indices
+            .iter()
+            .filter_map(|&i| positions.get(i as usize).copied())
+    };
     let b = crate::math::Aabb::from_points(used());
     // Newell's normal: the sum of the triangles' area vectors (robust to slivers).
     let mut sum = glam::DVec3::ZERO;
@@ -114,7 +118,10 @@ mod tests {
         // The shapes' plane lies at y = 0 facing +y.
         let p = plane(2.0, 1.0);
         let pl = plane_of(&p.positions, &p.indices).expect("a plane is flat");
-        assert!((pl - Vec4::new(0.0, 1.0, 0.0, 0.0)).abs().max_element() < 1e-6, "{pl}");
+        assert!(
+            (pl - Vec4::new(0.0, 1.0, 0.0, 0.0)).abs().max_element() < 1e-6,
+            "{pl}"
+        );
         // Moved and tilted: the plane follows.
         let m = glam::Mat4::from_rotation_x(0.3) * glam::Mat4::from_translation(Vec3::Y * 2.0);
         let moved: Vec<Vec3> = p.positions.iter().map(|&v| m.transform_point3(v)).collect();
