@@ -42,6 +42,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
             Validation::Off
         },
         device: a.device.clone(),
+        pipeline_cache: app::pipeline_cache_path(),
         ..Default::default()
     })?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
@@ -99,6 +100,7 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
     let mut view = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
         device: a.device.clone(),
+        pipeline_cache: app::pipeline_cache_path(),
         ..Default::default()
     })?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
@@ -173,6 +175,7 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
     let base = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
         device: a.device.clone(),
+        pipeline_cache: app::pipeline_cache_path(),
         ..Default::default()
     })?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;

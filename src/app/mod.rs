@@ -8,3 +8,13 @@ pub mod cli;
 pub mod controller;
 #[cfg(feature = "viewer")]
 pub mod viewer;
+
+/// The binary's pipeline cache file: `UMBRA_PIPELINE_CACHE` (a path, or `off`), else the user's
+/// cache directory (`umbra::gpu::pipeline_cache::default_path`).
+pub fn pipeline_cache_path() -> Option<std::path::PathBuf> {
+    match std::env::var_os("UMBRA_PIPELINE_CACHE") {
+        Some(v) if v == "off" || v == "0" => None,
+        Some(v) if !v.is_empty() => Some(v.into()),
+        _ => umbra::gpu::pipeline_cache::default_path(),
+    }
+}

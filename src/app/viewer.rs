@@ -161,6 +161,7 @@ impl App {
             device: self.opts.device.clone(),
             instance_extensions,
             swapchain: true,
+            pipeline_cache: super::pipeline_cache_path(),
         })?;
         let handle = window
             .window_handle()

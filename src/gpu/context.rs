@@ -77,6 +77,10 @@ pub struct ContextDesc {
     pub instance_extensions: Vec<CString>,
     /// Enable VK_KHR_swapchain on the device.
     pub swapchain: bool,
+    /// A file that keeps the Vulkan pipeline cache between processes (read at creation when it
+    /// belongs to this device, written back when the context is dropped); None keeps it in
+    /// memory only. See `gpu::pipeline_cache::default_path`.
+    pub pipeline_cache: Option<std::path::PathBuf>,
 }
 
 impl Default for ContextDesc {
@@ -86,6 +90,7 @@ impl Default for ContextDesc {
             device: None,
             instance_extensions: Vec::new(),
             swapchain: false,
+            pipeline_cache: None,
         }
     }
 }
@@ -230,6 +235,9 @@ pub struct Context {
     pub validation_log: Arc<ValidationLog>,
     /// Whether the validation layer is on.
     pub validation_enabled: bool,
+    /// The pipeline cache every pipeline is created with.
+    pub(crate) pipeline_cache: vk::PipelineCache,
+    pipeline_cache_path: Option<std::path::PathBuf>,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     command_pool: Mutex<vk::CommandPool>,
     debug_device: Option<ash::ext::debug_utils::Device>,
@@ -292,6 +300,22 @@ impl Context {
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         let command_pool =
             unsafe { device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
+        let initial = desc
+            .pipeline_cache
+            .as_deref()
+            .map(|p| super::pipeline_cache::load(p, &properties))
+            .unwrap_or_default();
+        let cache_info = vk::PipelineCacheCreateInfo::default().initial_data(&initial);
+        let pipeline_cache = match unsafe { device.create_pipeline_cache(&cache_info, None) } {
+            Ok(c) => c,
+            Err(e) => {
+                unsafe { device.destroy_command_pool(command_pool, None) };
+                return Err(GpuError::Vk {
+                    call: "vkCreatePipelineCache",
+                    result: e,
+                });
+            }
+        };
         let debug_device = instance
             .debug_utils
             .as_ref()
@@ -310,6 +334,8 @@ impl Context {
             timestamp_valid_bits,
             validation_log: log,
             validation_enabled: enable_validation,
+            pipeline_cache,
+            pipeline_cache_path: desc.pipeline_cache.clone(),
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             command_pool: Mutex::new(command_pool),
             debug_device,
@@ -466,6 +492,18 @@ impl Drop for Context {
             ManuallyDrop::drop(&mut self.allocator);
             let pool = *self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
             self.device.destroy_command_pool(pool, None);
+            if let Some(path) = &self.pipeline_cache_path {
+                match self.device.get_pipeline_cache_data(self.pipeline_cache) {
+                    Ok(data) => {
+                        if let Err(e) = super::pipeline_cache::store(path, &data) {
+                            log::warn!("pipeline cache not saved to {}: {e}", path.display());
+                        }
+                    }
+                    Err(e) => log::warn!("pipeline cache not read back: {e}"),
+                }
+            }
+            self.device
+                .destroy_pipeline_cache(self.pipeline_cache, None);
         }
         // Then the fields: `device` (DeviceOwner), then `instance` (messenger, instance, loader).
     }

@@ -102,7 +102,7 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .push_next(&mut rendering);
     let p = unsafe {
         ctx.device
-            .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+            .create_graphics_pipelines(ctx.pipeline_cache, &[info], None)
     }
     .map_err(|(_, e)| GpuError::Vk {
         call: "vkCreateGraphicsPipelines",
