@@ -129,10 +129,9 @@ mod tests {
                 }
                 culled_tris += tris.len() / 3;
             }
-            // Measured: 36–40 % of the triangles from 3 radii away, 8 % from just above the pole
-            // (where only a small cap faces the eye... and everything else is hidden).
-            let share = culled_tris as f32 / (idx.len() / 3) as f32;
-            assert!(share > 0.05, "{eye}: culled {share}");
+            // Measured: 50.6 % (3 radii away on the axis), 47.8 % (off axis), 65.0 % (just above
+            // the pole, where the eye sees only a small cap).
+            assert!(share > 0.45, "{eye}: culled {share}");
         }
         // A light along −z: clusters facing +z are lit, never culled.
         let dir = Vec3::NEG_Z;
