@@ -26,6 +26,10 @@ have_any() {
 }
 
 missing=()
+# meshoptimizer (the `meshopt` crate) is C++, compiled by cargo's build.
+if ! command -v c++ >/dev/null 2>&1; then
+  missing+=(g++)
+fi
 if ! ldconfig -p 2>/dev/null | grep 'libvulkan\.so\.1' >/dev/null; then
   missing+=(libvulkan1)
 fi
