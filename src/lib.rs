@@ -28,6 +28,7 @@
 //! ```
 
 pub mod gpu;
+pub(crate) mod parallel;
 pub mod math;
 #[cfg(feature = "reference")]
 pub mod reference;

@@ -1,7 +1,7 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
-use super::gpu_scene::{Draw, GpuScene, VertexAttributes, Viewpoint};
+use super::gpu_scene::{flat_hides_nothing, Draw, GpuScene, VertexAttributes, Viewpoint};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
@@ -166,10 +166,15 @@ impl CameraPass {
         frame_bits: usize,
         debug_view: bool,
     ) -> Result<(), GpuError> {
+        // Modules first (cheap), then the missing pipelines compiled in parallel: on lavapipe
+        // each is an LLVM compile of its shaders, the largest part of a cold first frame.
+        let mut missing: Vec<(usize, Entry, vk::ShaderModule)> = Vec::new();
         for &(material_bits, masked) in &scene.pipeline_keys {
             let variant = material_bits | frame_bits;
             let entry = Entry::of(masked, debug_view);
-            if self.pipelines.contains_key(&(variant, entry)) {
+            if self.pipelines.contains_key(&(variant, entry))
+                || missing.iter().any(|m| (m.0, m.1) == (variant, entry))
+            {
                 continue;
             }
             let module = match self.variant_modules.get(&variant) {
@@ -184,34 +189,36 @@ impl CameraPass {
                     m
                 }
             };
-            let (bindings, attributes) = vertex_layout();
-            let name = format!("camera pipeline variant {variant} {entry:?}");
-            let pipeline = create_pipeline(
-                &self.ctx,
-                &PipelineDesc {
-                    name: &name,
-                    layout: self.layout,
-                    vertex: (module, sh::ENTRY_VS_MAIN),
-                    fragment: Some((
-                        module,
-                        match entry {
-                            Entry::Opaque => sh::ENTRY_FS_MAIN,
-                            Entry::Masked => sh::ENTRY_FS_MASKED,
-                            Entry::Debug => sh::ENTRY_FS_DEBUG,
-                        },
-                    )),
-                    bindings: &bindings,
-                    attributes: &attributes,
-                    color_format: Some(self.color_format),
-                    depth_format: DEPTH_FORMAT,
-                    depth_clamp: false,
-                    depth_bias: false,
-                    depth_test: true,
-                },
-            )?;
-            self.pipelines.insert((variant, entry), pipeline);
+            missing.push((variant, entry, module));
         }
-        Ok(())
+        let (ctx, layout, color_format) = (&self.ctx, self.layout, self.color_format);
+        let built: Vec<Result<vk::Pipeline, GpuError>> = std::thread::scope(|s| {
+            let threads: Vec<_> = missing
+                .iter()
+                .map(|&(variant, entry, module)| {
+                    s.spawn(move || scene_pipeline(ctx, layout, color_format, variant, entry, module))
+                })
+                .collect();
+            threads
+                .into_iter()
+                .map(|t| {
+                    t.join().unwrap_or(Err(GpuError::Vk {
+                        call: "vkCreateGraphicsPipelines (thread panicked)",
+                        result: vk::Result::ERROR_UNKNOWN,
+                    }))
+                })
+                .collect()
+        });
+        let mut first_error = None;
+        for (&(variant, entry, _), result) in missing.iter().zip(built) {
+            match result {
+                Ok(p) => {
+                    self.pipelines.insert((variant, entry), p);
+                }
+                Err(e) => first_error = first_error.or(Some(e)),
+            }
+        }
+        first_error.map_or(Ok(()), Err)
     }
 
     /// Points slot `slot`'s set at the shadow map. Every binding is written (lavapipe crashes on
@@ -367,9 +374,10 @@ impl CameraPass {
 
 /// The draws the camera can see (unless culling is off), opaque ones first and front to back
 /// (nearest bounds first, so llvmpipe's early depth test rejects more hidden fragments before
-/// shading), then the alpha-masked ones.
+/// shading; flat draws that hide nothing from the eye, such as the ground, after the others),
+/// then the alpha-masked ones.
 fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
-    let mut v: Vec<(bool, f32, &Draw)> = scene
+    let mut v: Vec<((bool, bool), f32, &Draw)> = scene
         .draws
         .iter()
         .filter(|dr| {
@@ -377,7 +385,13 @@ fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
         })
         .map(|dr| {
             let nearest = cull.eye.0.clamp(dr.world_bounds.min, dr.world_bounds.max);
-            (dr.masked, nearest.distance_squared(cull.eye.0), dr)
+            // A ground plane's nearest point is right under the eye, but it hides nothing: drawn
+            // last, its fragments behind everything else fail the early depth test.
+            let hides_nothing = dr.world_plane.is_some_and(|pl| {
+                flat_hides_nothing(pl, Viewpoint::Eye(cull.eye.0), &scene.bounds)
+            });
+            let key = (dr.masked, hides_nothing);
+            (key, nearest.distance_squared(cull.eye.0), dr)
         })
         .collect();
     v.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
@@ -396,6 +410,42 @@ pub struct CameraCull {
     pub frame_bits: usize,
     /// The shadow-visibility or normals view (the debug entry point).
     pub debug_view: bool,
+}
+
+/// Creates the scene pipeline of shader `variant` (in `module`) with fragment entry `entry`.
+fn scene_pipeline(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    color_format: vk::Format,
+    variant: usize,
+    entry: Entry,
+    module: vk::ShaderModule,
+) -> Result<vk::Pipeline, GpuError> {
+    let (bindings, attributes) = vertex_layout();
+    let name = format!("camera pipeline variant {variant} {entry:?}");
+    create_pipeline(
+        ctx,
+        &PipelineDesc {
+            name: &name,
+            layout,
+            vertex: (module, sh::ENTRY_VS_MAIN),
+            fragment: Some((
+                module,
+                match entry {
+                    Entry::Opaque => sh::ENTRY_FS_MAIN,
+                    Entry::Masked => sh::ENTRY_FS_MASKED,
+                    Entry::Debug => sh::ENTRY_FS_DEBUG,
+                },
+            )),
+            bindings: &bindings,
+            attributes: &attributes,
+            color_format: Some(color_format),
+            depth_format: DEPTH_FORMAT,
+            depth_clamp: false,
+            depth_bias: false,
+            depth_test: true,
+        },
+    )
 }
 
 /// The fragment entry point of a scene pipeline.

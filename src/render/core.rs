@@ -6,7 +6,8 @@ use super::camera_pass::{CameraCull, CameraPass};
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
 use super::settings::{SceneOptions, View, ViewMode};
-use super::shadow_pass::{plan_casters, LightSource, ShadowPass};
+use super::gpu_scene::Viewpoint;
+use super::shadow_pass::{plan_casters, ShadowPass};
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::Image;
@@ -126,9 +127,9 @@ impl FrameCore {
         );
         if plan.shadows_on {
             let source = match plan.shadow_light.map(|i| &plan.lights[i]) {
-                Some(l) if l.kind != LightKind::Directional => LightSource::Position(l.position),
-                Some(l) => LightSource::Direction(l.direction),
-                None => LightSource::Direction(glam::Vec3::NEG_Y),
+                Some(l) if l.kind != LightKind::Directional => Viewpoint::Eye(l.position),
+                Some(l) => Viewpoint::Along(l.direction),
+                None => Viewpoint::Along(glam::Vec3::NEG_Y),
             };
             plan.casters = plan_casters(
                 &self.gpu,

@@ -29,6 +29,13 @@ pub struct VertexAttributes {
     pub tangent: [f32; 4],
 }
 
+/// What the load-time analysis found about a primitive's shape.
+struct PrimitiveShape {
+    closed: bool,
+    plane: Option<Vec4>,
+    clusters: Option<(Vec<u32>, Vec<Cluster>)>,
+}
+
 /// One uploaded primitive: its index range, material, model-space bounds and shape facts.
 struct PrimitiveRange {
     first_index: u32,
@@ -145,6 +152,33 @@ pub enum Viewpoint {
     Along(Vec3),
 }
 
+/// True when a flat primitive on `plane` (`(n, w)`, unit `n`) hides nothing from `from`: the
+/// viewpoint and the whole scene (bounds `scene`) lie on one closed side of the plane, and a
+/// segment from a point to the viewpoint never leaves that side (a half-space is convex), so it
+/// never meets the primitive except at its own end. Seen from a light, such a caster shadows
+/// nothing (the shadow pass skips a ground plane with nothing under it, the largest caster of most
+/// scenes); seen from the camera, it occludes nothing (the camera pass draws it after the rest, so
+/// the early depth test rejects its hidden fragments). Scene parts within 1e-5 of the scene's
+/// diagonal behind the plane still count as in front (a model resting on the ground), a choice
+/// that can only matter for geometry sunk that little and seen from beneath the plane.
+pub fn flat_hides_nothing(plane: Vec4, from: Viewpoint, scene: &Aabb) -> bool {
+    let n = plane.truncate();
+    let light_side = match from {
+        Viewpoint::Along(d) => -n.dot(d.normalize_or_zero()),
+        Viewpoint::Eye(p) => n.dot(p) + plane.w,
+    };
+    // Edge-on to the light, or the light on the plane: keep it (cheap, and no sign to trust).
+    if light_side.abs() <= 1e-6 || !light_side.is_finite() {
+        return false;
+    }
+    let s = light_side.signum();
+    let tolerance = 1e-5 * scene.diagonal();
+    scene
+        .corners()
+        .iter()
+        .all(|c| s * (n.dot(*c) + plane.w) >= -tolerance)
+}
+
 /// The GPU copy of a scene.
 pub struct GpuScene {
     ctx: Arc<Context>,
@@ -225,9 +259,32 @@ impl GpuScene {
         let mut indices: Vec<u32> = Vec::new();
         let mut ranges: Vec<Vec<PrimitiveRange>> = Vec::new();
         let mut all_clusters: Vec<Cluster> = Vec::new();
+        // Shape analysis per primitive (closed? flat? clusters), on all cores.
+        let prims: Vec<&crate::scene::Primitive> =
+            scene.meshes.iter().flat_map(|m| &m.primitives).collect();
+        let mut analyses = crate::parallel::map(&prims, |p| {
+            let double_sided = scene
+                .materials
+                .get(p.material)
+                .is_some_and(|m| m.double_sided);
+            PrimitiveShape {
+                // Only double-sided materials can use it; skip the check for the others.
+                closed: options.culling && double_sided && is_closed(&p.positions, &p.indices),
+                plane: options
+                    .culling
+                    .then(|| plane_of(&p.positions, &p.indices))
+                    .flatten(),
+                clusters: options
+                    .culling
+                    .then(|| clusters::build(&p.positions, &p.indices))
+                    .flatten(),
+            }
+        })
+        .into_iter();
         for mesh in &scene.meshes {
             let mut r = Vec::new();
             for p in &mesh.primitives {
+                let shape = analyses.next().expect("one analysis per primitive");
                 let first = indices.len() as u32;
                 let base = positions.len() as i32;
                 positions.extend(p.positions.iter().map(|v| v.to_array()));
@@ -250,12 +307,8 @@ impl GpuScene {
                 }
                 // Large primitives are split into clusters (their indices reordered cluster by
                 // cluster) so that clusters facing away can be skipped.
-                let built = options
-                    .culling
-                    .then(|| clusters::build(&p.positions, &p.indices))
-                    .flatten();
                 let cluster_start = all_clusters.len() as u32;
-                match built {
+                match shape.clusters {
                     Some((reordered, cl)) => {
                         indices.extend_from_slice(&reordered);
                         all_clusters.extend(cl);
@@ -270,17 +323,8 @@ impl GpuScene {
                     vertex_offset: base,
                     material: p.material.min(scene.materials.len().saturating_sub(1)),
                     bounds: p.bounds(),
-                    // Only double-sided materials can use it; skip the check for the others.
-                    closed: options.culling
-                        && scene
-                            .materials
-                            .get(p.material)
-                            .is_some_and(|m| m.double_sided)
-                        && is_closed(&p.positions, &p.indices),
-                    plane: options
-                        .culling
-                        .then(|| plane_of(&p.positions, &p.indices))
-                        .flatten(),
+                    closed: shape.closed,
+                    plane: shape.plane,
                 });
             }
             ranges.push(r);

@@ -2,7 +2,7 @@
 //! depth bias pushing casters away from the light (negative factors under reversed-z).
 
 use super::core::Attachment;
-use super::gpu_scene::{GpuScene, Viewpoint};
+use super::gpu_scene::{flat_hides_nothing, GpuScene, Viewpoint};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
@@ -57,7 +57,7 @@ pub struct CasterPlan {
     /// texel (the casters' rectangle grown by the reach): such lookups are lit without a read.
     pub lookup: Vec4,
     /// The shadowed light (clusters facing away from it are not drawn).
-    pub light: LightSource,
+    pub light: Viewpoint,
 }
 
 impl Default for CasterPlan {
@@ -73,18 +73,18 @@ impl Default for CasterPlan {
                 },
             },
             lookup: Vec4::new(1.0, 1.0, -1.0, -1.0),
-            light: LightSource::Direction(Vec3::NEG_Y),
+            light: Viewpoint::Along(Vec3::NEG_Y),
         }
     }
 }
 
 /// Chooses the casters of a frame: those whose bounds reach the light's view, less flat casters
-/// with nothing behind them (`flat_caster_casts_nothing`). `reach` is how many texels from its
+/// with nothing behind them (`flat_hides_nothing`). `reach` is how many texels from its
 /// centre a lookup reads (PCF half-width + 1); `full` clears the whole map (the map debug view).
 pub fn plan_casters(
     scene: &GpuScene,
     light_clip_from_world: &Mat4,
-    light: LightSource,
+    light: Viewpoint,
     size: u32,
     reach: u32,
     full: bool,
@@ -105,7 +105,7 @@ pub fn plan_casters(
         };
         if dr
             .world_plane
-            .is_some_and(|pl| flat_caster_casts_nothing(pl, light, &scene.bounds))
+            .is_some_and(|pl| flat_hides_nothing(pl, light, &scene.bounds))
         {
             continue;
         }
@@ -154,40 +154,6 @@ pub fn plan_casters(
         },
     };
     plan
-}
-
-/// Where the shadowed light is, for the flat-caster rule.
-#[derive(Clone, Copy, Debug)]
-pub enum LightSource {
-    /// A directional light: the direction its light travels.
-    Direction(Vec3),
-    /// A spot (or point) light's position.
-    Position(Vec3),
-}
-
-/// True when a flat caster on `plane` (`(n, w)`, unit `n`) cannot shadow anything: the light and
-/// the whole scene (bounds `scene`, which hold every receiver) lie on one closed side of the plane,
-/// and a segment from a point to the light never leaves that side (a half-space is convex), so it
-/// never meets the caster except at its own end. This skips a ground plane with nothing under it,
-/// the largest caster of most scenes, from the depth pass. Scene parts within 1e-5 of the scene's
-/// diagonal behind the plane still count as in front (a model resting on the ground), a choice
-/// that can only matter for geometry sunk that little and seen from beneath the plane.
-pub fn flat_caster_casts_nothing(plane: Vec4, light: LightSource, scene: &Aabb) -> bool {
-    let n = plane.truncate();
-    let light_side = match light {
-        LightSource::Direction(d) => -n.dot(d.normalize_or_zero()),
-        LightSource::Position(p) => n.dot(p) + plane.w,
-    };
-    // Edge-on to the light, or the light on the plane: keep it (cheap, and no sign to trust).
-    if light_side.abs() <= 1e-6 || !light_side.is_finite() {
-        return false;
-    }
-    let s = light_side.signum();
-    let tolerance = 1e-5 * scene.diagonal();
-    scene
-        .corners()
-        .iter()
-        .all(|c| s * (n.dot(*c) + plane.w) >= -tolerance)
 }
 
 /// The shadow depth pass and its map.
@@ -303,10 +269,7 @@ impl ShadowPass {
         casters: &CasterPlan,
         eye: Option<(glam::Vec3, f32)>,
     ) -> usize {
-        let from = match casters.light {
-            LightSource::Direction(d) => Viewpoint::Along(d),
-            LightSource::Position(p) => Viewpoint::Eye(p),
-        };
+        let from = casters.light;
         let (Some(map), Some(at)) = (&self.map, self.map_at.as_mut()) else {
             return 0;
         };
@@ -407,26 +370,26 @@ mod tests {
     fn flat_casters_with_nothing_behind_them() {
         let ground = Vec4::new(0.0, 1.0, 0.0, 0.0); // y = 0, facing +y
         let above = Aabb::new(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 5.0, 10.0));
-        let sun = LightSource::Direction(Vec3::new(0.3, -1.0, 0.2));
-        assert!(flat_caster_casts_nothing(ground, sun, &above));
+        let sun = Viewpoint::Along(Vec3::new(0.3, -1.0, 0.2));
+        assert!(flat_hides_nothing(ground, sun, &above));
         // The plane's normal may point either way: the light's side decides.
-        assert!(flat_caster_casts_nothing(-ground, sun, &above));
+        assert!(flat_hides_nothing(-ground, sun, &above));
         // Something below the ground: it may be shadowed by the ground.
         let below = Aabb::new(Vec3::new(-10.0, -1.0, -10.0), Vec3::new(10.0, 5.0, 10.0));
-        assert!(!flat_caster_casts_nothing(ground, sun, &below));
+        assert!(!flat_hides_nothing(ground, sun, &below));
         // A sun from below: the scene is on the dark side, the plane shadows it.
-        let under = LightSource::Direction(Vec3::new(0.0, 1.0, 0.0));
-        assert!(!flat_caster_casts_nothing(ground, under, &above));
+        let under = Viewpoint::Along(Vec3::new(0.0, 1.0, 0.0));
+        assert!(!flat_hides_nothing(ground, under, &above));
         // A grazing sun exactly in the plane: kept.
-        let grazing = LightSource::Direction(Vec3::X);
-        assert!(!flat_caster_casts_nothing(ground, grazing, &above));
+        let grazing = Viewpoint::Along(Vec3::X);
+        assert!(!flat_hides_nothing(ground, grazing, &above));
         // A spot above the ground, and one below it.
-        let lamp = LightSource::Position(Vec3::new(0.0, 4.0, 0.0));
-        assert!(flat_caster_casts_nothing(ground, lamp, &above));
-        let cellar = LightSource::Position(Vec3::new(0.0, -4.0, 0.0));
-        assert!(!flat_caster_casts_nothing(ground, cellar, &above));
+        let lamp = Viewpoint::Eye(Vec3::new(0.0, 4.0, 0.0));
+        assert!(flat_hides_nothing(ground, lamp, &above));
+        let cellar = Viewpoint::Eye(Vec3::new(0.0, -4.0, 0.0));
+        assert!(!flat_hides_nothing(ground, cellar, &above));
         // A wall at x = 2 with the scene on both sides casts.
         let wall = Vec4::new(1.0, 0.0, 0.0, -2.0);
-        assert!(!flat_caster_casts_nothing(wall, sun, &above));
+        assert!(!flat_hides_nothing(wall, sun, &above));
     }
 }

@@ -416,30 +416,9 @@ type Decoded = Result<(u32, u32, Vec<u8>), String>;
 
 /// Decodes every readable image, on as many threads as the machine has (in order).
 fn decode_all(sources: &[ImageSource]) -> Vec<Decoded> {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(sources.len())
-        .max(1);
-    let decode = |(_, _, data): &ImageSource| match data {
+    crate::parallel::map(sources, |(_, _, data)| match data {
         Ok(d) => decode_image(d),
         Err(_) => Err(String::new()),
-    };
-    if threads == 1 {
-        return sources.iter().map(decode).collect();
-    }
-    let chunk = sources.len().div_ceil(threads);
-    std::thread::scope(|s| {
-        let handles: Vec<_> = sources
-            .chunks(chunk)
-            .map(|part| s.spawn(move || part.iter().map(decode).collect::<Vec<_>>()))
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| {
-                h.join()
-                    .unwrap_or_else(|_| vec![Err("decoder panicked".into()); chunk])
-            })
-            .collect()
     })
 }
 
