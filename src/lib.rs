@@ -28,8 +28,8 @@
 //! ```
 
 pub mod gpu;
-pub(crate) mod parallel;
 pub mod math;
+pub(crate) mod parallel;
 #[cfg(feature = "reference")]
 pub mod reference;
 pub mod render;

@@ -196,7 +196,9 @@ impl CameraPass {
             let threads: Vec<_> = missing
                 .iter()
                 .map(|&(variant, entry, module)| {
-                    s.spawn(move || scene_pipeline(ctx, layout, color_format, variant, entry, module))
+                    s.spawn(move || {
+                        scene_pipeline(ctx, layout, color_format, variant, entry, module)
+                    })
                 })
                 .collect();
             threads

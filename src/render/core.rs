@@ -5,8 +5,8 @@
 use super::camera_pass::{CameraCull, CameraPass};
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
-use super::settings::{SceneOptions, View, ViewMode};
 use super::gpu_scene::Viewpoint;
+use super::settings::{SceneOptions, View, ViewMode};
 use super::shadow_pass::{plan_casters, ShadowPass};
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
