@@ -89,14 +89,48 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
         .iter()
         .map(|(_, o)| o.name.clone().unwrap_or_default())
         .collect();
-    if overrides.len() > 8 {
+    if overrides.len() > 10 {
         return Err(format!(
-            "{}:1:1: error: at most 8 boolean overrides (one SPIR-V per combination)",
+            "{}:1:1: error: at most 10 boolean overrides (one SPIR-V per combination)",
             path.display()
         ));
     }
+    // An override declared with a trailing `// requires OTHER` means nothing while OTHER is off:
+    // such combinations share the SPIR-V of the one with the override off too.
+    let mut requires: Vec<Option<usize>> = vec![None; overrides.len()];
+    for line in source.lines() {
+        let l = line.trim_start();
+        let (Some(rest), Some((_, req))) =
+            (l.strip_prefix("override "), l.split_once("// requires "))
+        else {
+            continue;
+        };
+        let name = rest.split(':').next().unwrap_or("").trim();
+        let req = req.split_whitespace().next().unwrap_or("");
+        let (Some(i), Some(r)) = (
+            overrides.iter().position(|o| o == name),
+            overrides.iter().position(|o| o == req),
+        ) else {
+            return Err(format!(
+                "{}:1:1: error: `{l}`: unknown override in a requires clause",
+                path.display()
+            ));
+        };
+        requires[i] = Some(r);
+    }
+    let canonical = |mask: usize| {
+        let mut m = mask;
+        for (i, r) in requires.iter().enumerate() {
+            if let Some(r) = r {
+                if (mask >> r) & 1 == 0 {
+                    m &= !(1 << i);
+                }
+            }
+        }
+        m
+    };
     let variants = 1usize << overrides.len();
-    for mask in 0..variants {
+    for mask in (0..variants).filter(|&m| canonical(m) == m) {
         let mut constants = naga::back::PipelineConstants::default();
         for (i, name) in overrides.iter().enumerate() {
             constants.insert(name.clone(), ((mask >> i) & 1) as f64);
@@ -126,7 +160,10 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
     )
     .unwrap();
     let list: Vec<String> = (0..variants)
-        .map(|m| format!("include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{stem}_{m}.spv\"))"))
+        .map(|m| {
+            let m = canonical(m);
+            format!("include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{stem}_{m}.spv\"))")
+        })
         .collect();
     writeln!(
         code,

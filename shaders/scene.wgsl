@@ -24,9 +24,12 @@ override HAS_NORMAL_MAP: bool = true;
 override HAS_OTHER_TEX: bool = true; // metallic-roughness or emissive
 override SINGLE_LIGHT: bool = false;
 override SHADOWS: bool = true;
-override HW_COMPARE: bool = false;
-override PCF_BIT0: bool = true;
-override PCF_BIT1: bool = false;
+override HW_COMPARE: bool = false; // requires SHADOWS
+override PCF_BIT0: bool = true; // requires SHADOWS
+override PCF_BIT1: bool = false; // requires SHADOWS
+// More than one shadow view (cascades): the view is chosen per pixel; without, view 0 is read
+// with constant indices.
+override CASCADED: bool = true; // requires SHADOWS
 
 // Bilinear taps per side of the PCF kernel (0 = one nearest comparison).
 fn pcf_taps() -> i32 {
@@ -39,6 +42,7 @@ fn pcf_taps() -> i32 {
 const VIEW_LIT: u32 = 0u;
 const VIEW_SHADOW: u32 = 1u;
 const VIEW_NORMALS: u32 = 2u;
+const VIEW_CASCADES: u32 = 3u;
 
 struct Light {
     // xyz: position (point, spot); w: kind (0 directional, 1 point, 2 spot)
@@ -53,7 +57,9 @@ struct Light {
 
 struct Frame {
     clip_from_world: mat4x4<f32>,
-    light_clip_from_world: mat4x4<f32>,
+    // World -> light clip of each shadow view (cascades near to far; one for a single map or a
+    // spot light); layer i of the shadow map belongs to view i.
+    shadow_clip: array<mat4x4<f32>, 4>,
     // xyz: camera position in world
     camera_position: vec4<f32>,
     // rgb: ambient intensity Ia
@@ -65,9 +71,17 @@ struct Frame {
     shadow_light: vec4<f32>,
     // x: constant bias in shadow texels, applied towards the light
     bias: vec4<f32>,
-    // Texel rectangle (x0, y0, x1, y1) of the map outside which a lookup's footprint meets no
-    // caster: lit there, without reading the map (the shadow pass clears only what it draws).
-    shadow_rect: vec4<f32>,
+    // Per view: texel rectangle (x0, y0, x1, y1) of its layer outside which a lookup's footprint
+    // meets no caster: lit there, without reading the map (the shadow pass clears only what it
+    // draws).
+    shadow_rect: array<vec4<f32>, 4>,
+    // Per cascade: view depth where it ends, and where blending into the next one starts.
+    cascade_far: vec4<f32>,
+    cascade_blend: vec4<f32>,
+    // Per cascade: world size of one texel (directional) or per unit distance (spot).
+    cascade_texel: vec4<f32>,
+    // xyz: camera forward (view depth = dot(p - eye, forward)); w: number of shadow views.
+    camera_forward: vec4<f32>,
     // x: view mode, y: PCF kernel width in bilinear taps (0 = single nearest compare),
     // z: 1 if hardware linear comparison filtering is used, w: number of lights
     modes: vec4<u32>,
@@ -93,7 +107,7 @@ struct Immediates {
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var shadow_map: texture_depth_2d;
+@group(0) @binding(1) var shadow_map: texture_depth_2d_array;
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
 
 @group(1) @binding(0) var<uniform> material: Material;
@@ -136,33 +150,50 @@ fn vs_main(v: VsIn) -> VsOut {
 }
 
 // One depth comparison against texel `c` (clamped to the map): 1 = lit.
-fn compare_texel(c: vec2<i32>, depth: f32, size: i32) -> f32 {
+fn compare_texel(c: vec2<i32>, layer: i32, depth: f32, size: i32) -> f32 {
     let cc = clamp(c, vec2<i32>(0), vec2<i32>(size - 1));
-    let stored = textureLoad(shadow_map, cc, 0);
+    let stored = textureLoad(shadow_map, cc, layer, 0);
     return select(0.0, 1.0, depth >= stored);
 }
 
 // Bilinearly weighted 2x2 comparison at a position given in texel units (texel centres at +0.5).
-fn bilinear_compare(p: vec2<f32>, depth: f32, size: i32) -> f32 {
+fn bilinear_compare(p: vec2<f32>, layer: i32, depth: f32, size: i32) -> f32 {
     if HW_COMPARE {
-        return textureSampleCompareLevel(shadow_map, shadow_sampler, p / f32(size), depth);
+        return textureSampleCompareLevel(shadow_map, shadow_sampler, p / f32(size), layer, depth);
     }
     let t = p - vec2<f32>(0.5);
     let i = vec2<i32>(floor(t));
     let f = t - floor(t);
-    let c00 = compare_texel(i, depth, size);
-    let c10 = compare_texel(i + vec2<i32>(1, 0), depth, size);
-    let c01 = compare_texel(i + vec2<i32>(0, 1), depth, size);
-    let c11 = compare_texel(i + vec2<i32>(1, 1), depth, size);
+    let c00 = compare_texel(i, layer, depth, size);
+    let c10 = compare_texel(i + vec2<i32>(1, 0), layer, depth, size);
+    let c01 = compare_texel(i + vec2<i32>(0, 1), layer, depth, size);
+    let c11 = compare_texel(i + vec2<i32>(1, 1), layer, depth, size);
     return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
 }
 
 // Filtered shadow-map visibility of world point `p` with geometric normal `ng`, for the shadowed
 // light `light` whose direction at `p` is `l` (call only when shadows are on).
-fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) -> f32 {
-    var texel_world = frame.shadow.z;
+// The shadow view (cascade) for world point `p` seen at pixel `pixel`: the cascade holding its
+// view depth; within the blend band at a cascade's end, the next cascade for a share of pixels
+// growing from 0 to 1 across the band (interleaved-gradient dither: no seam line, and every
+// lookup stays a single exact one, which llvmpipe, running both sides of every branch, pays once).
+fn shadow_view_index(p: vec3<f32>, pixel: vec2<f32>) -> i32 {
+    let d = dot(p - frame.camera_position.xyz, frame.camera_forward.xyz);
+    let n = i32(frame.camera_forward.w);
+    var c = 0;
+    for (var k = 0; k < 3; k++) {
+        c += select(0, 1, k + 1 < n && d > frame.cascade_far[k]);
+    }
+    let start = frame.cascade_blend[c];
+    let t = clamp((d - start) / max(frame.cascade_far[c] - start, 1e-20), 0.0, 1.0);
+    let noise = fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
+    return select(c, c + 1, c + 1 < n && noise < t);
+}
+
+fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, layer: i32) -> f32 {
+    var texel_world = frame.cascade_texel[layer];
     if light.position.w == LIGHT_SPOT {
-        texel_world = frame.shadow.z * distance(light.position.xyz, p);
+        texel_world = texel_world * distance(light.position.xyz, p);
     }
     // Normal offset: move the lookup point off the surface by a number of shadow texels, more at
     // grazing angles where acne appears.
@@ -170,7 +201,7 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) ->
     let sin_theta = sqrt(1.0 - cos_theta * cos_theta);
     // Constant bias: towards the light by a number of texels (so it scales with texel size).
     let offset = ng * (frame.shadow.y * texel_world * sin_theta) + l * (frame.bias.x * texel_world);
-    let lc = frame.light_clip_from_world * vec4<f32>(p + offset, 1.0);
+    let lc = frame.shadow_clip[layer] * vec4<f32>(p + offset, 1.0);
     if lc.w <= 0.0 {
         return 1.0;
     }
@@ -178,7 +209,8 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) ->
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     let p_texel = uv * frame.shadow.x;
     // Outside the casters' rectangle (which lies inside the map) nothing is in shadow.
-    if any(p_texel < frame.shadow_rect.xy) || any(p_texel > frame.shadow_rect.zw) {
+    let rect = frame.shadow_rect[layer];
+    if any(p_texel < rect.xy) || any(p_texel > rect.zw) {
         return 1.0;
     }
     // Depth clamp is on in the shadow pass, so receivers are clamped the same way.
@@ -186,7 +218,7 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) ->
     let size = i32(frame.shadow.x);
     let kernel = pcf_taps();
     if kernel == 0 {
-        return compare_texel(vec2<i32>(floor(p_texel)), depth, size);
+        return compare_texel(vec2<i32>(floor(p_texel)), layer, depth, size);
     }
     let half = (kernel - 1) / 2;
     var sum = 0.0;
@@ -194,7 +226,7 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) ->
         // Hardware bilinear comparisons, one per tap.
         for (var y = -half; y <= half; y++) {
             for (var x = -half; x <= half; x++) {
-                sum += bilinear_compare(p_texel + vec2<f32>(f32(x), f32(y)), depth, size);
+                sum += bilinear_compare(p_texel + vec2<f32>(f32(x), f32(y)), layer, depth, size);
             }
         }
         return sum / f32(kernel * kernel);
@@ -216,7 +248,7 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light) ->
             // Sampling at the corner shared by the block's four texels gathers exactly them:
             // x = (i0, j1), y = (i1, j1), z = (i1, j0), w = (i0, j0).
             let corner = (base + vec2<f32>(f32(bi) + 1.0, f32(bj) + 1.0)) * inv;
-            let g = textureGatherCompare(shadow_map, shadow_sampler, corner, depth);
+            let g = textureGatherCompare(shadow_map, shadow_sampler, corner, layer, depth);
             sum += wy0 * (wx0 * g.w + wx1 * g.z) + wy1 * (wx0 * g.x + wx1 * g.y);
         }
     }
@@ -269,6 +301,17 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
     if frame.modes.x == VIEW_SHADOW {
         return vec4<f32>(srgb_to_linear(vec3<f32>(s.shadow_term)), 1.0);
     }
+    if frame.modes.x == VIEW_CASCADES {
+        var tint = vec3<f32>(0.5);
+        switch s.cascade {
+            case 0: { tint = vec3<f32>(1.0, 0.25, 0.2); }
+            case 1: { tint = vec3<f32>(0.25, 0.9, 0.25); }
+            case 2: { tint = vec3<f32>(0.25, 0.4, 1.0); }
+            case 3: { tint = vec3<f32>(1.0, 0.9, 0.2); }
+            default: {}
+        }
+        return vec4<f32>(srgb_to_linear(tint * (0.35 + 0.65 * s.shadow_term)), 1.0);
+    }
     return vec4<f32>(srgb_to_linear(s.normal * 0.5 + vec3<f32>(0.5)), 1.0);
 }
 
@@ -278,6 +321,8 @@ struct Shaded {
     normal: vec3<f32>,
     // The shadowed light's visibility (1 without one).
     shadow_term: f32,
+    // The shadow view (cascade) read, -1 for none.
+    cascade: i32,
 }
 
 // Blinn-Phong with normal mapping and shadows for the fragment `in` of base colour `base`.
@@ -320,6 +365,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     let v = normalize(frame.camera_position.xyz - p);
     var color = ka * frame.ambient.rgb + emissive;
     var shadow_term = 1.0;
+    var cascade = -1;
     // One light: a constant trip count the driver unrolls (a uniform count costs a real loop).
     let count = select(min(frame.modes.w, MAX_LIGHTS), 1u, SINGLE_LIGHT);
     for (var i = 0u; i < count; i++) {
@@ -341,7 +387,11 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
         var vis = select(0.0, 1.0, dot(n_geo, l) > 0.0);
         if u32(frame.shadow_light.w) == i {
             if SHADOWS && frame.shadow.w > 0.5 {
-                vis *= shadow_visibility(p, n_geo, l, light);
+                cascade = 0;
+                if CASCADED {
+                    cascade = shadow_view_index(p, in.clip.xy);
+                }
+                vis *= shadow_visibility(p, n_geo, l, light, cascade);
             }
             shadow_term = vis;
         }
@@ -353,7 +403,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     if material.params.w > 0.5 {
         color = base.rgb;
     }
-    return Shaded(color, n, shadow_term);
+    return Shaded(color, n, shadow_term, cascade);
 }
 
 // Full-screen triangle for the shadow-map debug view.
@@ -377,6 +427,6 @@ fn vs_fullscreen(@builtin(vertex_index) index: u32) -> FullscreenOut {
 fn fs_shadow_map(in: FullscreenOut) -> @location(0) vec4<f32> {
     let size = i32(frame.shadow.x);
     let c = clamp(vec2<i32>(in.uv * f32(size)), vec2<i32>(0), vec2<i32>(size - 1));
-    let d = textureLoad(shadow_map, c, 0);
+    let d = textureLoad(shadow_map, c, 0, 0);
     return vec4<f32>(srgb_to_linear(vec3<f32>(d)), 1.0);
 }

@@ -106,7 +106,8 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 ViewMode::Lit => ViewMode::Shadow,
                 ViewMode::Shadow => ViewMode::Normals,
                 ViewMode::Normals => ViewMode::ShadowMap,
-                ViewMode::ShadowMap => ViewMode::Lit,
+                ViewMode::ShadowMap => ViewMode::Cascades,
+                ViewMode::Cascades => ViewMode::Lit,
             };
             format!("view: {:?}", view.mode)
         }
@@ -185,7 +186,8 @@ mod tests {
                 ViewMode::Lit,
                 ViewMode::Shadow,
                 ViewMode::Normals,
-                ViewMode::ShadowMap
+                ViewMode::ShadowMap,
+                ViewMode::Cascades
             ]
         );
         assert!(apply(Action::ToggleShadows, &mut v, &mut sun).contains("off"));

@@ -151,6 +151,8 @@ pub enum ViewArg {
     Normals,
     /// The shadow map.
     ShadowMap,
+    /// Which cascade shades each pixel (red, green, blue, yellow), darker in shadow.
+    Cascades,
 }
 
 /// PCF kernels.
@@ -226,6 +228,10 @@ pub struct ViewArgs {
     /// Do not snap the light frustum to whole texels.
     #[arg(long)]
     pub no_snap: bool,
+    /// Cascades of the sun's shadow map (1–4; with `--fit camera`): each covers a slice of the
+    /// view depth with its own map, so near shadows keep their detail in large scenes.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
+    pub cascades: u32,
     /// Disable shadows.
     #[arg(long)]
     pub no_shadows: bool,
@@ -356,6 +362,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         ViewArg::Shadow => ViewMode::Shadow,
         ViewArg::Normals => ViewMode::Normals,
         ViewArg::ShadowMap => ViewMode::ShadowMap,
+        ViewArg::Cascades => ViewMode::Cascades,
     };
     if !(16..=16384).contains(&a.shadow_map) {
         bail!("--shadow-map {} must be within 16..16384", a.shadow_map);
@@ -378,6 +385,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
             ShadowFit::Camera
         },
         snap: !a.no_snap,
+        cascades: a.cascades,
     };
     Ok(v)
 }

@@ -106,7 +106,7 @@ pub fn image_barrier(
             base_mip_level: mips.start,
             level_count: mips.end - mips.start,
             base_array_layer: 0,
-            layer_count: 1,
+            layer_count: vk::REMAINING_ARRAY_LAYERS,
         });
     let barriers = [barrier];
     let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);

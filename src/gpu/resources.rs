@@ -156,6 +156,8 @@ pub struct Image {
     pub extent: vk::Extent2D,
     /// Aspect (colour or depth).
     pub aspect: vk::ImageAspectFlags,
+    /// One 2-D view per layer of an array image (`new_array`, to render into); empty otherwise.
+    pub layer_views: Vec<vk::ImageView>,
     allocation: Option<Allocation>,
 }
 
@@ -169,6 +171,33 @@ impl Image {
         mip_levels: u32,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, GpuError> {
+        Self::create(ctx, name, format, extent, mip_levels, None, usage)
+    }
+
+    /// Creates a named device-local 2-D array image of `layers` layers (at least 1), one mip
+    /// level: `view` is a 2-D array view of every layer, `layer_views` a 2-D view per layer.
+    pub fn new_array(
+        ctx: &Arc<Context>,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        layers: u32,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self, GpuError> {
+        Self::create(ctx, name, format, extent, 1, Some(layers.max(1)), usage)
+    }
+
+    /// `new` (`array` None) or `new_array` (`array` = its layer count).
+    fn create(
+        ctx: &Arc<Context>,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        mip_levels: u32,
+        array: Option<u32>,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self, GpuError> {
+        let layers = array.unwrap_or(1);
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
@@ -178,7 +207,7 @@ impl Image {
                 depth: 1,
             })
             .mip_levels(mip_levels.max(1))
-            .array_layers(1)
+            .array_layers(layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
@@ -199,6 +228,7 @@ impl Image {
             format,
             extent,
             aspect,
+            layer_views: Vec::new(),
             allocation: None,
         };
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
@@ -214,19 +244,30 @@ impl Image {
                 .bind_image_memory(raw, allocation.memory(), allocation.offset())
         }
         .vk("vkBindImageMemory")?;
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(format)
-            .subresource_range(vk::ImageSubresourceRange {
-                aspect_mask: aspect,
-                base_mip_level: 0,
-                level_count: mip_levels.max(1),
-                base_array_layer: 0,
-                layer_count: 1,
-            });
-        image.view =
-            unsafe { ctx.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
+        let view_of = |view_type, base_array_layer, layer_count| {
+            let view_info = vk::ImageViewCreateInfo::default()
+                .image(raw)
+                .view_type(view_type)
+                .format(format)
+                .subresource_range(vk::ImageSubresourceRange {
+                    aspect_mask: aspect,
+                    base_mip_level: 0,
+                    level_count: mip_levels.max(1),
+                    base_array_layer,
+                    layer_count,
+                });
+            unsafe { ctx.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")
+        };
+        if array.is_none() {
+            image.view = view_of(vk::ImageViewType::TYPE_2D, 0, 1)?;
+        } else {
+            image.view = view_of(vk::ImageViewType::TYPE_2D_ARRAY, 0, layers)?;
+            for layer in 0..layers {
+                let v = view_of(vk::ImageViewType::TYPE_2D, layer, 1)?;
+                image.layer_views.push(v);
+                ctx.set_name(v, &format!("{name} layer {layer}"));
+            }
+        }
         ctx.set_name(raw, name);
         ctx.set_name(image.view, name);
         Ok(image)
@@ -371,6 +412,10 @@ impl Image {
 
 impl Drop for Image {
     fn drop(&mut self) {
+        for v in self.layer_views.drain(..) {
+            self.ctx.clear_name(v);
+            unsafe { self.ctx.device.destroy_image_view(v, None) };
+        }
         if self.view != vk::ImageView::null() {
             self.ctx.clear_name(self.view);
             unsafe { self.ctx.device.destroy_image_view(self.view, None) };

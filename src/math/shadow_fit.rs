@@ -196,6 +196,29 @@ pub struct DirectionalFit {
     pub texel_world: f32,
 }
 
+/// The `n` + 1 view depths bounding `n` cascades between `near` and `far`: the practical split
+/// scheme (Zhang et al. 2006), a blend of logarithmic and uniform splits weighted by `lambda` (1 =
+/// logarithmic: equal texel density ratio per cascade; 0 = uniform).
+pub fn cascade_splits(near: f32, far: f32, n: usize, lambda: f32) -> Vec<f32> {
+    let n = n.max(1);
+    let near = near.max(1e-6);
+    let far = far.max(near * 1.0001);
+    (0..=n)
+        .map(|i| {
+            let t = i as f32 / n as f32;
+            let log = near * (far / near).powf(t);
+            let uniform = near + (far - near) * t;
+            if i == 0 {
+                near
+            } else if i == n {
+                far
+            } else {
+                lambda * log + (1.0 - lambda) * uniform
+            }
+        })
+        .collect()
+}
+
 /// World → light view rotation for a light travelling along `direction`.
 pub fn light_view_rotation(direction: Vec3) -> Mat4 {
     let d = direction.try_normalize().unwrap_or(-Vec3::Y);

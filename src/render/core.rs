@@ -112,10 +112,7 @@ impl FrameCore {
         } else {
             1
         };
-        self.shadow.ensure_map(map_size, view.shadow.format)?;
-        let hw = self.shadow.hardware_filtering();
-        let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
-        self.camera.bind_shadow_map(slot, map_view, hw);
+        let hw = self.shadow.hardware_filtering(view.shadow.format);
         let mut v = view.clone();
         v.shadow.map_size = map_size;
         let mut plan = plan_frame(
@@ -125,22 +122,35 @@ impl FrameCore {
             width as f32 / height.max(1) as f32,
             hw,
         );
+        let layers = plan.shadow_views.len().max(1) as u32;
+        self.shadow
+            .ensure_map(map_size, view.shadow.format, layers)?;
+        let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
+        self.camera.bind_shadow_map(slot, map_view, hw);
         if plan.shadows_on {
             let source = match plan.shadow_light.map(|i| &plan.lights[i]) {
                 Some(l) if l.kind != LightKind::Directional => Viewpoint::Eye(l.position),
                 Some(l) => Viewpoint::Along(l.direction),
                 None => Viewpoint::Along(glam::Vec3::NEG_Y),
             };
-            plan.casters = plan_casters(
-                &self.gpu,
-                &plan.light_clip_from_world,
-                source,
-                map_size,
-                view.shadow.pcf.lookup_reach(),
-                view.mode == ViewMode::ShadowMap,
-            );
+            plan.casters = plan
+                .shadow_views
+                .iter()
+                .map(|sv| {
+                    plan_casters(
+                        &self.gpu,
+                        &sv.light_clip_from_world,
+                        source,
+                        map_size,
+                        view.shadow.pcf.lookup_reach(),
+                        view.mode == ViewMode::ShadowMap,
+                    )
+                })
+                .collect();
         }
-        plan.uniform.shadow_rect = plan.casters.lookup;
+        for (c, cp) in plan.casters.iter().enumerate() {
+            plan.uniform.shadow_rect[c] = cp.lookup;
+        }
         self.camera.write_frame(slot, &plan.uniform)?;
         self.camera
             .ensure_pipelines(&self.gpu, plan.shader_variant, is_debug_view(view.mode))?;
@@ -182,14 +192,15 @@ impl FrameCore {
             .map(|i| &plan.lights[i])
             .filter(|l| l.kind != LightKind::Directional)
             .map(|l| (l.position, spot_near(&self.gpu.bounds)));
-        let casters = self.shadow.record(
-            cmd,
-            &self.gpu,
-            &plan.light_clip_from_world,
-            &view.shadow,
-            &plan.casters,
-            light_eye,
-        );
+        let views: Vec<_> = plan
+            .shadow_views
+            .iter()
+            .map(|v| v.light_clip_from_world)
+            .zip(&plan.casters)
+            .collect();
+        let casters = self
+            .shadow
+            .record(cmd, &self.gpu, &view.shadow, &views, light_eye);
         unsafe {
             if timestamps {
                 d.cmd_write_timestamp2(
@@ -269,7 +280,10 @@ impl FrameCore {
 
 /// Whether `mode` draws the scene with the debug entry point (shadow visibility, normals).
 fn is_debug_view(mode: ViewMode) -> bool {
-    matches!(mode, ViewMode::Shadow | ViewMode::Normals)
+    matches!(
+        mode,
+        ViewMode::Shadow | ViewMode::Normals | ViewMode::Cascades
+    )
 }
 
 /// Draws recorded in one frame, after culling.

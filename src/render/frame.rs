@@ -1,11 +1,13 @@
 //! Per-frame planning on the CPU: which lights shade, which one gets the shadow map, the fitted
 //! light projection, the camera projection, and the frame uniform block.
 
-use super::settings::{Pcf, ShadowFit, View};
+use super::settings::{Pcf, ShadowFit, View, MAX_CASCADES};
 use super::shadow_pass::CasterPlan;
 use super::uniforms::{FrameUniform, LightUniform, MAX_LIGHTS};
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
-use crate::math::shadow_fit::{fit_directional, fit_spot, CameraFrustum, DirectionalFitInput};
+use crate::math::shadow_fit::{
+    cascade_splits, fit_directional, fit_spot, CameraFrustum, DirectionalFitInput,
+};
 use crate::math::Aabb;
 use crate::scene::{Camera, Light, LightKind};
 use glam::{Mat4, Vec3, Vec4};
@@ -75,6 +77,24 @@ pub fn fitting_frustum(camera: &Camera, aspect: f32, bounds: &Aabb) -> CameraFru
     }
 }
 
+/// Weight of logarithmic against uniform cascade splits (`cascade_splits`).
+pub const CASCADE_SPLIT_LAMBDA: f32 = 0.9;
+/// The last fraction of each cascade (but the last) over which lookups move to the next one.
+pub const CASCADE_BLEND: f32 = 0.1;
+
+/// One view of the shadowed light: a cascade, the single map, or a spot light's.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowView {
+    /// World → light clip.
+    pub light_clip_from_world: Mat4,
+    /// World size of a texel (directional) or per unit distance (spot).
+    pub texel_world: f32,
+    /// View depth where this view stops being used (+inf for the last).
+    pub far: f32,
+    /// View depth where lookups start moving to the next view (= `far` for the last).
+    pub blend: f32,
+}
+
 /// The result of planning a frame.
 #[derive(Clone, Debug)]
 pub struct FramePlan {
@@ -93,14 +113,16 @@ pub struct FramePlan {
     pub lights: Vec<Light>,
     /// Index of the light with the shadow map, if any.
     pub shadow_light: Option<usize>,
-    /// World → light clip of the shadow map.
+    /// World → light clip of the shadow map (its first view).
     pub light_clip_from_world: Mat4,
+    /// Every view of the shadowed light (cascades near to far; one for a single map or a spot).
+    pub shadow_views: Vec<ShadowView>,
     /// World size of a shadow texel (directional) or per unit distance (spot).
     pub texel_world: f32,
     /// The camera's world → clip.
     pub clip_from_world: Mat4,
-    /// The shadow pass's casters and area (set by `FrameCore::prepare`; none before).
-    pub casters: CasterPlan,
+    /// The shadow pass's casters and area per shadow view (set by `FrameCore::prepare`).
+    pub casters: Vec<CasterPlan>,
 }
 
 /// Plans a frame for `view` of a scene with `scene_lights` and `bounds`, rendered at `aspect`.
@@ -117,40 +139,83 @@ pub fn plan_frame(
     let shadow_light = lights
         .iter()
         .position(|l| l.casts_shadows && l.kind != LightKind::Point && l.intensity > 0.0);
-    let mut light_clip_from_world = Mat4::IDENTITY;
-    let mut texel_world = 0.0;
+    let mut views: Vec<ShadowView> = Vec::new();
     let size = view.shadow.map_size.max(1);
     if let Some(i) = shadow_light {
         let l = &lights[i];
         match l.kind {
             LightKind::Directional => {
                 let fit_cam = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
-                let camera = match view.shadow.fit {
-                    ShadowFit::Camera => Some(fitting_frustum(fit_cam, aspect, bounds)),
-                    ShadowFit::Scene => None,
+                let fit = |camera| {
+                    fit_directional(&DirectionalFitInput {
+                        direction: l.direction,
+                        scene_bounds: *bounds,
+                        camera,
+                        map_size: size,
+                        snap: view.shadow.snap,
+                    })
                 };
-                let fit = fit_directional(&DirectionalFitInput {
-                    direction: l.direction,
-                    scene_bounds: *bounds,
-                    camera,
-                    map_size: size,
-                    snap: view.shadow.snap,
-                });
-                light_clip_from_world = fit.light_clip_from_world;
-                texel_world = fit.texel_world;
+                match view.shadow.fit {
+                    ShadowFit::Camera => {
+                        let frustum = fitting_frustum(fit_cam, aspect, bounds);
+                        let n = view.shadow.cascades.clamp(1, MAX_CASCADES) as usize;
+                        let splits =
+                            cascade_splits(frustum.near, frustum.far, n, CASCADE_SPLIT_LAMBDA);
+                        for c in 0..n {
+                            // Each cascade also covers the blend band at the end of the previous.
+                            let near = match c {
+                                0 => splits[0],
+                                _ => splits[c] - CASCADE_BLEND * (splits[c] - splits[c - 1]),
+                            };
+                            let f = fit(Some(CameraFrustum {
+                                near,
+                                far: splits[c + 1],
+                                ..frustum
+                            }));
+                            let last = c + 1 == n;
+                            views.push(ShadowView {
+                                light_clip_from_world: f.light_clip_from_world,
+                                texel_world: f.texel_world,
+                                far: if last { f32::INFINITY } else { splits[c + 1] },
+                                blend: if last {
+                                    f32::INFINITY
+                                } else {
+                                    splits[c + 1] - CASCADE_BLEND * (splits[c + 1] - splits[c])
+                                },
+                            });
+                        }
+                    }
+                    ShadowFit::Scene => {
+                        let f = fit(None);
+                        views.push(ShadowView {
+                            light_clip_from_world: f.light_clip_from_world,
+                            texel_world: f.texel_world,
+                            far: f32::INFINITY,
+                            blend: f32::INFINITY,
+                        });
+                    }
+                }
             }
             LightKind::Spot { outer, .. } => {
                 let (m, tan_half) = fit_spot(l.position, l.direction, outer, bounds);
-                light_clip_from_world = m;
-                texel_world = 2.0 * tan_half / size as f32;
+                views.push(ShadowView {
+                    light_clip_from_world: m,
+                    texel_world: 2.0 * tan_half / size as f32,
+                    far: f32::INFINITY,
+                    blend: f32::INFINITY,
+                });
             }
             LightKind::Point => {}
         }
     }
+    let light_clip_from_world = views
+        .first()
+        .map_or(Mat4::IDENTITY, |v| v.light_clip_from_world);
+    let texel_world = views.first().map_or(0.0, |v| v.texel_world);
     let shadows_on = view.shadow.enabled && shadow_light.is_some();
     let mut u = FrameUniform {
         clip_from_world,
-        light_clip_from_world,
+        shadow_clip: [light_clip_from_world; 4],
         camera_position: view.camera.position().extend(1.0),
         ambient: view.ambient.extend(0.0),
         shadow: Vec4::new(
@@ -168,7 +233,17 @@ pub fn plan_frame(
         ),
         bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
         // Set with the casters (`shadow_pass::plan_casters`); until then every lookup is lit.
-        shadow_rect: Vec4::new(1.0, 1.0, -1.0, -1.0),
+        shadow_rect: [Vec4::new(1.0, 1.0, -1.0, -1.0); 4],
+        cascade_far: Vec4::splat(f32::MAX),
+        cascade_blend: Vec4::splat(f32::MAX),
+        cascade_texel: Vec4::splat(texel_world),
+        camera_forward: (view
+            .camera
+            .view_from_world()
+            .inverse()
+            .transform_vector3(Vec3::NEG_Z))
+        .normalize_or(Vec3::NEG_Z)
+        .extend(views.len().max(1) as f32),
         modes: [
             view.mode.shader_value(),
             view.shadow.pcf.taps(),
@@ -177,6 +252,13 @@ pub fn plan_frame(
         ],
         lights: [LightUniform::default(); MAX_LIGHTS],
     };
+    for (c, v) in views.iter().enumerate() {
+        u.shadow_clip[c] = v.light_clip_from_world;
+        u.cascade_texel[c] = v.texel_world;
+        // f32::MAX rather than infinity: the shader compares and subtracts these.
+        u.cascade_far[c] = v.far.min(f32::MAX);
+        u.cascade_blend[c] = v.blend.min(f32::MAX);
+    }
     for (i, l) in lights.iter().enumerate() {
         let (kind, cone) = match l.kind {
             LightKind::Directional => (0.0, Vec4::ZERO),
@@ -197,31 +279,51 @@ pub fn plan_frame(
         shadows_on,
         shadow_map_size: size,
         camera_position: view.camera.position(),
-        shader_variant: frame_variant_bits(lights.len(), shadows_on, hw_compare, view.shadow.pcf),
+        shader_variant: frame_variant_bits(
+            lights.len(),
+            shadows_on,
+            hw_compare,
+            view.shadow.pcf,
+            views.len(),
+        ),
         lights,
         shadow_light,
         light_clip_from_world,
+        shadow_views: views,
         texel_world,
         clip_from_world,
-        casters: CasterPlan::default(),
+        casters: Vec::new(),
     }
 }
 
 /// The scene shader's frame variant bits: one light (a constant loop), shadows sampled, hardware
 /// comparison, and the PCF kernel (constant loops instead of per-frame uniforms).
-fn frame_variant_bits(lights: usize, shadows_on: bool, hw_compare: bool, pcf: Pcf) -> usize {
+fn frame_variant_bits(
+    lights: usize,
+    shadows_on: bool,
+    hw_compare: bool,
+    pcf: Pcf,
+    views: usize,
+) -> usize {
     use crate::gpu::shaders::scene as sh;
-    let kernel_bits = match pcf {
-        Pcf::None => 0,
-        Pcf::P2x2 => sh::BIT_PCF_BIT0,
-        Pcf::P3x3 => sh::BIT_PCF_BIT1,
-        Pcf::P5x5 => sh::BIT_PCF_BIT0 | sh::BIT_PCF_BIT1,
-    };
-    let mut bits = kernel_bits;
+    let mut bits = 0;
+    if lights == 1 {
+        bits |= sh::BIT_SINGLE_LIGHT;
+    }
+    // The filter, comparison path and cascades mean nothing without a map (one shader for all).
+    if !shadows_on {
+        return bits;
+    }
+    bits |= sh::BIT_SHADOWS
+        | match pcf {
+            Pcf::None => 0,
+            Pcf::P2x2 => sh::BIT_PCF_BIT0,
+            Pcf::P3x3 => sh::BIT_PCF_BIT1,
+            Pcf::P5x5 => sh::BIT_PCF_BIT0 | sh::BIT_PCF_BIT1,
+        };
     for (on, bit) in [
-        (lights == 1, sh::BIT_SINGLE_LIGHT),
-        (shadows_on, sh::BIT_SHADOWS),
         (hw_compare, sh::BIT_HW_COMPARE),
+        (views > 1, sh::BIT_CASCADED),
     ] {
         if on {
             bits |= bit;

@@ -286,7 +286,7 @@ impl Renderer {
             draws: counts.camera_draws,
             draws_total: self.core.gpu.draws.len(),
             triangles: self.core.gpu.triangles,
-            hardware_compare: self.core.shadow.hardware_filtering(),
+            hardware_compare: self.core.shadow.hardware_filtering(view.shadow.format),
         };
         let t = self.target.as_mut().expect("target");
         let bytes = t

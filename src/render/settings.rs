@@ -16,6 +16,9 @@ pub enum ViewMode {
     Normals,
     /// The shadow map itself (grey = depth, reversed-z: white is near the light).
     ShadowMap,
+    /// Which shadow view (cascade) shades each pixel: red, green, blue, yellow for cascades 0–3,
+    /// darkened where in shadow; grey where no map is read.
+    Cascades,
 }
 
 impl ViewMode {
@@ -25,6 +28,7 @@ impl ViewMode {
             ViewMode::Lit | ViewMode::ShadowMap => 0,
             ViewMode::Shadow => 1,
             ViewMode::Normals => 2,
+            ViewMode::Cascades => 3,
         }
     }
 }
@@ -102,7 +106,13 @@ pub struct ShadowSettings {
     pub fit: ShadowFit,
     /// Snap the fitted frustum to whole texels (stable under camera motion).
     pub snap: bool,
+    /// Cascades of a directional light's map fitted to the camera (1–4; `MAX_CASCADES`): each
+    /// covers a slice of the view depth with its own `map_size`² layer. 1 is the single map.
+    pub cascades: u32,
 }
+
+/// Most cascades a directional light can have.
+pub const MAX_CASCADES: u32 = 4;
 
 impl Default for ShadowSettings {
     fn default() -> Self {
@@ -116,6 +126,7 @@ impl Default for ShadowSettings {
             normal_offset: 1.5,
             fit: ShadowFit::Camera,
             snap: true,
+            cascades: 1,
         }
     }
 }

@@ -163,7 +163,6 @@ pub struct ShadowPass {
     module: vk::ShaderModule,
     pipeline: vk::Pipeline,
     pipeline_format: vk::Format,
-    hardware_filtering: bool,
     /// The shadow map (None before the first `ensure_map`).
     pub map: Option<Image>,
     /// The map's attachment state (set with the map).
@@ -181,14 +180,19 @@ impl ShadowPass {
             module,
             pipeline: vk::Pipeline::null(),
             pipeline_format: vk::Format::UNDEFINED,
-            hardware_filtering: false,
             map: None,
             map_at: None,
         })
     }
 
-    /// Makes sure the map has this size and format; returns true if it was (re)created.
-    pub fn ensure_map(&mut self, size: u32, format: ShadowFormat) -> Result<bool, GpuError> {
+    /// Makes sure the map has this size, format and layer count (one per shadow view); returns
+    /// true if it was (re)created.
+    pub fn ensure_map(
+        &mut self,
+        size: u32,
+        format: ShadowFormat,
+        layers: u32,
+    ) -> Result<bool, GpuError> {
         let fmt = vk_format(format);
         if self.pipeline_format != fmt {
             unsafe { self.ctx.device.destroy_pipeline(self.pipeline, None) };
@@ -221,17 +225,11 @@ impl ShadowPass {
                 },
             )?;
             self.pipeline_format = fmt;
-            self.hardware_filtering = self
-                .ctx
-                .format_features(fmt)
-                .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
         }
         let size = size.clamp(1, 16384);
-        if self
-            .map
-            .as_ref()
-            .is_some_and(|m| m.extent.width == size && m.format == fmt)
-        {
+        if self.map.as_ref().is_some_and(|m| {
+            m.extent.width == size && m.format == fmt && m.layer_views.len() == layers as usize
+        }) {
             return Ok(false);
         }
         if self.map.is_some() {
@@ -239,7 +237,7 @@ impl ShadowPass {
                 let _ = self.ctx.device.device_wait_idle();
             }
         }
-        self.map = Some(Image::new(
+        self.map = Some(Image::new_array(
             &self.ctx,
             "shadow map",
             fmt,
@@ -247,16 +245,18 @@ impl ShadowPass {
                 width: size,
                 height: size,
             },
-            1,
+            layers,
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
         )?);
         self.map_at = self.map.as_ref().map(Attachment::of);
         Ok(true)
     }
 
-    /// Whether the map's format supports hardware linear filtering of comparisons.
-    pub fn hardware_filtering(&self) -> bool {
-        self.hardware_filtering
+    /// Whether `format` supports hardware linear filtering of comparisons.
+    pub fn hardware_filtering(&self, format: ShadowFormat) -> bool {
+        self.ctx
+            .format_features(vk_format(format))
+            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
     }
 
     /// Records the pass; leaves the map ready for fragment-shader sampling. Returns casters drawn.
@@ -264,57 +264,70 @@ impl ShadowPass {
         &mut self,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-        light_clip_from_world: &Mat4,
         s: &ShadowSettings,
-        casters: &CasterPlan,
+        views: &[(Mat4, &CasterPlan)],
         eye: Option<(glam::Vec3, f32)>,
     ) -> usize {
-        let from = casters.light;
         let (Some(map), Some(at)) = (&self.map, self.map_at.as_mut()) else {
             return 0;
+        };
+        // Without shadow views (shadows off) one texel of layer 0 is still cleared, so that the
+        // map debug view reads defined values.
+        let none = CasterPlan::default();
+        let fallback = [(Mat4::IDENTITY, &none)];
+        let views = if views.is_empty() {
+            &fallback[..]
+        } else {
+            views
         };
         let d = &self.ctx.device;
         self.ctx.begin_label(cmd, "shadow depth pass");
         at.transition(d, cmd, Access::DepthAttachment);
-        let depth_attachment = depth_clear_attachment(map.view);
-        // Only the casters' area is cleared and drawn: lookups elsewhere never read the map.
-        let area = casters.area;
-        let rendering = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .depth_attachment(&depth_attachment);
         let mut drawn = 0;
-        unsafe {
-            d.cmd_begin_rendering(cmd, &rendering);
-            if !casters.draws.is_empty() {
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-                set_viewport(&self.ctx, cmd, map.extent);
-                d.cmd_set_scissor(cmd, 0, &[area]);
-                // Reversed-z: "away from the light" is towards smaller depth, so the factor is negated.
-                // The constant bias is applied on the receiver side, in texels (camera pass).
-                d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
-                d.cmd_bind_vertex_buffers(cmd, 0, &[scene.positions.raw], &[0]);
-                d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-                for dr in casters.draws.iter().map(|&i| &scene.draws[i]) {
-                    let pc = ShadowImmediates {
-                        light_clip_from_world: *light_clip_from_world,
-                        world_from_model: dr.world_from_model,
-                    };
-                    let cull_mode = dr.cull_mode(eye);
-                    d.cmd_set_cull_mode(cmd, cull_mode);
-                    d.cmd_set_front_face(cmd, dr.front_face());
-                    d.cmd_push_constants(
-                        cmd,
-                        self.layout,
-                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                        0,
-                        bytemuck::bytes_of(&pc),
-                    );
-                    scene.draw_indexed(d, cmd, dr, cull_mode, from);
-                    drawn += 1;
+        for (layer, (light_clip_from_world, casters)) in views.iter().enumerate() {
+            let Some(&layer_view) = map.layer_views.get(layer) else {
+                break;
+            };
+            let from = casters.light;
+            let depth_attachment = depth_clear_attachment(layer_view);
+            // Only the casters' area is cleared and drawn: lookups elsewhere never read the map.
+            let area = casters.area;
+            let rendering = vk::RenderingInfo::default()
+                .render_area(area)
+                .layer_count(1)
+                .depth_attachment(&depth_attachment);
+            unsafe {
+                d.cmd_begin_rendering(cmd, &rendering);
+                if !casters.draws.is_empty() {
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+                    set_viewport(&self.ctx, cmd, map.extent);
+                    d.cmd_set_scissor(cmd, 0, &[area]);
+                    // Reversed-z: "away from the light" is towards smaller depth, so the factor
+                    // is negated. The constant bias is applied on the receiver side, in texels.
+                    d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
+                    d.cmd_bind_vertex_buffers(cmd, 0, &[scene.positions.raw], &[0]);
+                    d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
+                    for dr in casters.draws.iter().map(|&i| &scene.draws[i]) {
+                        let pc = ShadowImmediates {
+                            light_clip_from_world: *light_clip_from_world,
+                            world_from_model: dr.world_from_model,
+                        };
+                        let cull_mode = dr.cull_mode(eye);
+                        d.cmd_set_cull_mode(cmd, cull_mode);
+                        d.cmd_set_front_face(cmd, dr.front_face());
+                        d.cmd_push_constants(
+                            cmd,
+                            self.layout,
+                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                            0,
+                            bytemuck::bytes_of(&pc),
+                        );
+                        scene.draw_indexed(d, cmd, dr, cull_mode, from);
+                        drawn += 1;
+                    }
                 }
+                d.cmd_end_rendering(cmd);
             }
-            d.cmd_end_rendering(cmd);
         }
         at.transition(d, cmd, Access::DepthFragmentSampled);
         self.ctx.end_label(cmd);

@@ -28,8 +28,8 @@ pub struct LightUniform {
 pub struct FrameUniform {
     /// World → clip (camera).
     pub clip_from_world: Mat4,
-    /// World → clip (shadowed light).
-    pub light_clip_from_world: Mat4,
+    /// World → clip of each shadow view (cascade; one for a spot light or a single map).
+    pub shadow_clip: [Mat4; 4],
     /// Camera position.
     pub camera_position: Vec4,
     /// Ambient intensity Ia.
@@ -40,9 +40,17 @@ pub struct FrameUniform {
     pub shadow_light: Vec4,
     /// x constant bias in shadow texels (towards the light).
     pub bias: Vec4,
-    /// Texel rectangle (x0, y0, x1, y1) of the shadow map outside which a lookup's footprint
-    /// meets no caster (lit without reading the map; the texels there are not cleared).
-    pub shadow_rect: Vec4,
+    /// Per shadow view: texel rectangle (x0, y0, x1, y1) of its layer outside which a lookup's
+    /// footprint meets no caster (lit without reading the map; the texels there are not cleared).
+    pub shadow_rect: [Vec4; 4],
+    /// Per cascade: the view depth where it ends (the last: +inf).
+    pub cascade_far: Vec4,
+    /// Per cascade: the view depth where blending into the next one starts.
+    pub cascade_blend: Vec4,
+    /// Per cascade: world size of one texel (directional), or per unit distance (spot).
+    pub cascade_texel: Vec4,
+    /// xyz: the camera's forward direction (view depth = dot(p − eye, forward)); w: cascade count.
+    pub camera_forward: Vec4,
     /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
     pub modes: [u32; 4],
     /// Lights.
