@@ -329,6 +329,21 @@ pub fn project(m: &Mat4, p: Vec3) -> Vec3 {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn practical_splits() {
+        // λ = 1: logarithmic (each cascade 10× deeper); λ = 0: uniform.
+        let log = cascade_splits(0.1, 1000.0, 4, 1.0);
+        for (a, b) in log.iter().zip([0.1, 1.0, 10.0, 100.0, 1000.0]) {
+            assert!((a / b - 1.0).abs() < 1e-4, "{log:?}");
+        }
+        let uni = cascade_splits(0.1, 1000.0, 4, 0.0);
+        assert!((uni[2] - 500.05).abs() < 1e-2, "{uni:?}");
+        let mixed = cascade_splits(0.1, 1000.0, 4, 0.9);
+        assert!(mixed.windows(2).all(|w| w[0] < w[1]), "{mixed:?}");
+        assert_eq!(cascade_splits(0.5, 9.0, 1, 0.9), vec![0.5, 9.0]);
+    }
+
     use super::*;
 
     fn camera(eye: Vec3, target: Vec3) -> CameraFrustum {

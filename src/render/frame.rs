@@ -354,8 +354,19 @@ mod tests {
         use crate::gpu::shaders::scene as sh;
         let want = sh::BIT_SINGLE_LIGHT | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0;
         assert_eq!(p.shader_variant, want);
+        // Cascades: four views, nearest first, each ending where the next blends in.
+        v.shadow.cascades = 4;
+        let p = plan_frame(&s.lights, &s.bounds(), &v, 1.5, false);
+        assert_eq!(p.shader_variant, want | sh::BIT_CASCADED);
+        assert_eq!(p.shadow_views.len(), 4);
+        for w in p.shadow_views.windows(2) {
+            assert!(w[0].blend < w[0].far && w[0].far < w[1].far, "{w:?}");
+            assert!(w[0].texel_world > 0.0 && w[1].texel_world > 0.0, "{w:?}");
+        }
+        assert!(p.shadow_views[3].far.is_infinite());
+        // Without shadows the filter, comparison and cascade bits mean nothing: one shader.
         v.shadow.enabled = false;
         let p = plan_frame(&s.lights, &s.bounds(), &v, 1.5, false);
-        assert_eq!(p.shader_variant, want & !sh::BIT_SHADOWS);
+        assert_eq!(p.shader_variant, sh::BIT_SINGLE_LIGHT);
     }
 }
