@@ -176,7 +176,7 @@ mod tests {
         apply(Action::BiasUp, &mut v, &mut sun);
         assert!((v.shadow.normal_offset - b * 1.25).abs() < 1e-6);
         let mut seen = vec![v.mode];
-        for _ in 0..3 {
+        for _ in 0..5 {
             apply(Action::CycleView, &mut v, &mut sun);
             seen.push(v.mode);
         }
@@ -187,7 +187,8 @@ mod tests {
                 ViewMode::Shadow,
                 ViewMode::Normals,
                 ViewMode::ShadowMap,
-                ViewMode::Cascades
+                ViewMode::Cascades,
+                ViewMode::Lit
             ]
         );
         assert!(apply(Action::ToggleShadows, &mut v, &mut sun).contains("off"));
