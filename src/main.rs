@@ -76,8 +76,8 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         String::new()
     };
     println!(
-        "rendered {} ({} triangles, {} casters drawn) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
-        scene.name, s.triangles, s.casters_drawn, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
+        "rendered {} ({} triangles, {} casters drawn, {} shadow view(s)) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
+        scene.name, s.triangles, s.casters_drawn, frame.plan.shadow_views.len(), frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
     );
     // Count after the renderer and the context are gone, so destroy-time and leak messages count.
     let log = ctx.validation_log.clone();

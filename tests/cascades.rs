@@ -1,6 +1,6 @@
 //! Cascaded shadow maps on a scene as large as a town, seen from eye height (lavapipe,
-//! validation on): a 2 km ground with buildings up to a kilometre away and a bench-sized box eight
-//! metres in front of the camera. One map fitted to the view spends its texels over a kilometre of
+//! validation on; `scene::synthetic::town_scene`): a 2 km ground with buildings up to a kilometre
+//! away and a bench-sized box six metres in front of the camera. One map fitted to the view spends its texels over a kilometre of
 //! depth and loses the near shadow; four cascades keep it. Judged against exact visibility: every
 //! ground pixel's ray towards the sun against the boxes, away from shadow edges (EDGE_TEXELS
 //! texels of the cascade that shades the pixel, or one pixel).
@@ -12,8 +12,8 @@ use glam::{Mat4, Vec3};
 use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
 use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
-use umbra::scene::shapes::{add_object, colored, cuboid, plane};
-use umbra::scene::{Camera, Light, Scene};
+use umbra::scene::synthetic::{town_boxes, town_scene, town_sun};
+use umbra::scene::Camera;
 
 const EDGE_TEXELS: f32 = 3.0;
 const W: u32 = 320;
@@ -22,25 +22,11 @@ const H: u32 = 180;
 const NEAR: f32 = 30.0;
 
 fn sun() -> Vec3 {
-    Vec3::new(0.7, -0.6, 0.35).normalize()
-}
-
-/// Boxes as (centre of the base, half extents).
-fn boxes() -> Vec<(Vec3, Vec3)> {
-    let mut b = vec![(Vec3::new(-0.5, 0.0, -6.0), Vec3::new(1.0, 0.5, 0.4))];
-    for i in 0..12 {
-        let a = i as f32 * 0.52;
-        let r = 60.0 + 80.0 * i as f32;
-        b.push((
-            Vec3::new(r * a.sin(), 0.0, -r * a.cos()),
-            Vec3::new(8.0, 6.0 + i as f32, 8.0),
-        ));
-    }
-    b
+    town_sun()
 }
 
 fn aabbs() -> Vec<Aabb> {
-    boxes()
+    town_boxes()
         .iter()
         .map(|&(c, h)| {
             Aabb::new(
@@ -49,40 +35,6 @@ fn aabbs() -> Vec<Aabb> {
             )
         })
         .collect()
-}
-
-fn town() -> Scene {
-    let mut s = Scene {
-        name: "town".into(),
-        ..Default::default()
-    };
-    add_object(
-        &mut s,
-        "ground",
-        plane(2000.0, 1.0),
-        colored(Vec3::splat(0.8), 1.0),
-        Mat4::IDENTITY,
-    );
-    for (i, (c, h)) in boxes().into_iter().enumerate() {
-        add_object(
-            &mut s,
-            &format!("box {i}"),
-            cuboid(h),
-            colored(Vec3::new(0.7, 0.3, 0.2), 1.0),
-            Mat4::from_translation(c + Vec3::Y * h.y),
-        );
-    }
-    s.lights.push(Light::sun(sun(), 2.0));
-    s
-}
-
-fn camera() -> Camera {
-    Camera::look_at(
-        Vec3::new(0.0, 1.7, 0.0),
-        Vec3::new(0.0, 0.0, -9.0),
-        60f32.to_radians(),
-        0.1,
-    )
 }
 
 fn exact_visible(boxes: &[Aabb], g: Vec3) -> bool {
@@ -208,10 +160,10 @@ fn one_and_four(r: &mut Renderer, cam: Camera, name: &str) -> Vec<Errors> {
 #[test]
 fn cascades_keep_near_shadows_in_a_town() {
     let ctx = context();
-    let scene = town();
+    let scene = town_scene();
     let mut r = Renderer::new(&ctx, &scene).unwrap();
     // From eye height: the bench's shadow 5–7 m away.
-    let street = one_and_four(&mut r, camera(), "street");
+    let street = one_and_four(&mut r, scene.cameras[0], "street");
     let (one, four) = (&street[0], &street[1]);
     assert!(four.near_shadowed > 250, "{four:?}");
     // Measured: one map 295 of 295 near shadow pixels lit (its texel is 0.71 m); four cascades 0.
@@ -221,18 +173,18 @@ fn cascades_keep_near_shadows_in_a_town() {
     );
     assert!(four.near_wrong <= 3, "four cascades: {four:?}");
     // From a roof, looking 150 m down the street: the buildings' shadows fall in every cascade.
-    let roof = Camera::look_at(
-        Vec3::new(-20.0, 30.0, 40.0),
-        Vec3::new(60.0, 0.0, -200.0),
-        60f32.to_radians(),
-        0.1,
-    );
-    let over = one_and_four(&mut r, roof, "roof");
+    let over = one_and_four(&mut r, scene.cameras[1], "roof");
     // Measured: 139 judged shadow pixels (the rest lie in the coarser cascades' edge bands),
     // 0 wrong with four cascades, 1 with one map.
     let four = &over[1];
     assert!(four.far_shadowed > 110, "{four:?}");
     assert!(four.far_wrong <= 3, "four cascades: {four:?}");
+    // The automatic count (the default): four from the street (one map's texel is ~180 pixel
+    // footprints at the nearest ground), two from the roof (~15).
+    for (cam, want) in [(scene.cameras[0], 4), (scene.cameras[1], 2)] {
+        let f = r.render(&View::new(cam), W, H).unwrap();
+        assert_eq!(f.plan.shadow_views.len(), want);
+    }
     drop(r);
     assert_validation_clean(&ctx);
 }

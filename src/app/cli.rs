@@ -179,7 +179,8 @@ pub struct ViewArgs {
     #[arg(long)]
     pub no_culling: bool,
     /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided
-    /// primitives) or `spheres:N` (an N×N grid of 1,200-triangle spheres).
+    /// primitives), `town` (2 km across, cameras at eye height and on a roof) or `spheres:N` (an
+    /// N×N grid of 1,200-triangle spheres).
     #[arg(long)]
     pub synthetic: Option<String>,
     /// Image size WxH.
@@ -229,8 +230,10 @@ pub struct ViewArgs {
     #[arg(long)]
     pub no_snap: bool,
     /// Cascades of the sun's shadow map (1–4; with `--fit camera`): each covers a slice of the
-    /// view depth with its own map, so near shadows keep their detail in large scenes.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
+    /// view depth with its own map, so near shadows keep their detail in large scenes. 0 (the
+    /// default) chooses 1, 2 or 4 per frame from how much coarser than a pixel one map's texels
+    /// would be at the nearest surface in view.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub cascades: u32,
     /// Disable shadows.
     #[arg(long)]
@@ -288,15 +291,18 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
 /// Loads SCENE or builds the demo, prints its warnings (`warning: NAME: …` on stderr, one per
 /// line), and adds a ground plane when asked.
 pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene> {
-    use umbra::scene::synthetic::{double_sided_scene, sphere_grid};
+    use umbra::scene::synthetic::{double_sided_scene, sphere_grid, town_scene};
     let mut s = match (path, a.synthetic.as_deref()) {
         (Some(_), Some(_)) => bail!("give either SCENE or --synthetic, not both"),
         (Some(p), None) => load_gltf(p)?,
         (None, None) => demo_scene(),
         (None, Some("double-sided")) => double_sided_scene(),
+        (None, Some("town")) => town_scene(),
         (None, Some(name)) => match name.strip_prefix("spheres:").map(str::parse::<u32>) {
             Some(Ok(n)) if (1..=256).contains(&n) => sphere_grid(n),
-            _ => bail!("--synthetic {name}: expected double-sided or spheres:N with N in 1..=256"),
+            _ => bail!(
+                "--synthetic {name}: expected double-sided, town or spheres:N with N in 1..=256"
+            ),
         },
     };
     let ground = a.ground;

@@ -64,6 +64,8 @@ pub struct FrameCore {
     pub camera: CameraPass,
     query_pool: vk::QueryPool,
     timestamps_written: Vec<bool>,
+    /// World bounds of every draw (the receivers cascades are split over).
+    receiver_bounds: Vec<crate::math::Aabb>,
 }
 
 impl FrameCore {
@@ -76,6 +78,7 @@ impl FrameCore {
         slots: usize,
     ) -> Result<Self, GpuError> {
         let gpu = GpuScene::new(ctx, scene, options)?;
+        let receiver_bounds = gpu.draws.iter().map(|d| d.world_bounds).collect();
         let shadow = ShadowPass::new(ctx)?;
         let camera = CameraPass::new(ctx, &gpu, color_format, slots)?;
         let query_pool = unsafe {
@@ -95,6 +98,7 @@ impl FrameCore {
             camera,
             query_pool,
             timestamps_written: vec![false; slots],
+            receiver_bounds,
         })
     }
 
@@ -118,8 +122,10 @@ impl FrameCore {
         let mut plan = plan_frame(
             &self.lights,
             &self.gpu.bounds,
+            &self.receiver_bounds,
             &v,
             width as f32 / height.max(1) as f32,
+            height,
             hw,
         );
         let layers = plan.shadow_views.len().max(1) as u32;

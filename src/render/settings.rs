@@ -107,7 +107,9 @@ pub struct ShadowSettings {
     /// Snap the fitted frustum to whole texels (stable under camera motion).
     pub snap: bool,
     /// Cascades of a directional light's map fitted to the camera (1–4; `MAX_CASCADES`): each
-    /// covers a slice of the view depth with its own `map_size`² layer. 1 is the single map.
+    /// covers a slice of the view depth with its own `map_size`² layer. 1 is the single map; 0
+    /// (the default) chooses per frame from how much coarser than a pixel one map's texels would
+    /// be at the nearest receiver (`render::frame::auto_cascades`).
     pub cascades: u32,
 }
 
@@ -126,7 +128,7 @@ impl Default for ShadowSettings {
             normal_offset: 1.5,
             fit: ShadowFit::Camera,
             snap: true,
-            cascades: 1,
+            cascades: 0,
         }
     }
 }

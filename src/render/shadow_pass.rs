@@ -185,8 +185,8 @@ impl ShadowPass {
         })
     }
 
-    /// Makes sure the map has this size, format and layer count (one per shadow view); returns
-    /// true if it was (re)created.
+    /// Makes sure the map has this size and format and at least `layers` layers (one per shadow
+    /// view); returns true if it was (re)created.
     pub fn ensure_map(
         &mut self,
         size: u32,
@@ -227,8 +227,10 @@ impl ShadowPass {
             self.pipeline_format = fmt;
         }
         let size = size.clamp(1, 16384);
+        // More layers than needed are kept: a frame that needs fewer cascades (the automatic
+        // count changes as the camera moves) reuses the map.
         if self.map.as_ref().is_some_and(|m| {
-            m.extent.width == size && m.format == fmt && m.layer_views.len() == layers as usize
+            m.extent.width == size && m.format == fmt && m.layer_views.len() >= layers as usize
         }) {
             return Ok(false);
         }

@@ -1,8 +1,8 @@
 //! Generated benchmark scenes: a double-sided scene shaped like the C++ Vulkan sample's
-//! (about 52k triangles in 12 primitives, every material double-sided) and grids of spheres for
-//! frame time against triangle count.
+//! (about 52k triangles in 12 primitives, every material double-sided), grids of spheres for
+//! frame time against triangle count, and a town for shadows at every distance.
 
-use super::shapes::{add_object, colored, plane, uv_sphere};
+use super::shapes::{add_object, colored, cuboid, plane, uv_sphere};
 use super::{Camera, Light, Scene};
 use glam::{Mat4, Vec3};
 
@@ -83,6 +83,66 @@ pub fn sphere_grid(n: u32) -> Scene {
         }
     }
     s.lights.push(Light::sun(Vec3::new(0.9, -1.0, -0.25), 2.0));
+    s
+}
+
+/// The town's sun: the direction its light travels.
+pub fn town_sun() -> Vec3 {
+    Vec3::new(0.7, -0.6, 0.35).normalize()
+}
+
+/// The town's boxes as (centre of the base, half extents): a bench-sized box 6 m in front of the
+/// street camera, then twelve buildings from 60 m to 940 m away.
+pub fn town_boxes() -> Vec<(Vec3, Vec3)> {
+    let mut b = vec![(Vec3::new(-0.5, 0.0, -6.0), Vec3::new(1.0, 0.5, 0.4))];
+    for i in 0..12 {
+        let a = i as f32 * 0.52;
+        let r = 60.0 + 80.0 * i as f32;
+        b.push((
+            Vec3::new(r * a.sin(), 0.0, -r * a.cos()),
+            Vec3::new(8.0, 6.0 + i as f32, 8.0),
+        ));
+    }
+    b
+}
+
+/// A town as large as the shadow methods must handle: a 2 km ground, twelve buildings out to a
+/// kilometre and a bench 6 m from the camera, which stands at eye height (1.7 m) looking down the
+/// street (camera 0); camera 1 looks from a roof 150 m down the street.
+pub fn town_scene() -> Scene {
+    let mut s = Scene {
+        name: "town".into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "ground",
+        plane(2000.0, 1.0),
+        colored(Vec3::splat(0.8), 1.0),
+        Mat4::IDENTITY,
+    );
+    for (i, (c, h)) in town_boxes().into_iter().enumerate() {
+        add_object(
+            &mut s,
+            &format!("box {i}"),
+            cuboid(h),
+            colored(Vec3::new(0.7, 0.3, 0.2), 1.0),
+            Mat4::from_translation(c + Vec3::Y * h.y),
+        );
+    }
+    s.lights.push(Light::sun(town_sun(), 2.0));
+    s.cameras.push(Camera::look_at(
+        Vec3::new(0.0, 1.7, 0.0),
+        Vec3::new(0.0, 0.0, -9.0),
+        60f32.to_radians(),
+        0.1,
+    ));
+    s.cameras.push(Camera::look_at(
+        Vec3::new(-20.0, 30.0, 40.0),
+        Vec3::new(60.0, 0.0, -200.0),
+        60f32.to_radians(),
+        0.1,
+    ));
     s
 }
 
