@@ -179,11 +179,16 @@ fn cascades_keep_near_shadows_in_a_town() {
     let four = &over[1];
     assert!(four.far_shadowed > 110, "{four:?}");
     assert!(four.far_wrong <= 3, "four cascades: {four:?}");
-    // The automatic count (the default): four from the street (one map's texel is ~180 pixel
-    // footprints at the nearest ground), two from the roof (~15).
-    for (cam, want) in [(scene.cameras[0], 4), (scene.cameras[1], 2)] {
-        let f = r.render(&View::new(cam), W, H).unwrap();
-        assert_eq!(f.plan.shadow_views.len(), want);
+    // The automatic count (the default) at 1280×720: four from the street (one map's texel is
+    // ~180 pixel footprints at the nearest ground), two from the roof (~15); at 320×180 the
+    // roof's pixels are four times larger and one map does.
+    for (cam, (w, h), want) in [
+        (scene.cameras[0], (1280, 720), 4),
+        (scene.cameras[1], (1280, 720), 2),
+        (scene.cameras[1], (W, H), 1),
+    ] {
+        let f = r.render(&View::new(cam), w, h).unwrap();
+        assert_eq!(f.plan.shadow_views.len(), want, "{w}x{h}");
     }
     drop(r);
     assert_validation_clean(&ctx);
