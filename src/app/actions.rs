@@ -25,7 +25,7 @@ pub enum Action {
     BiasUp,
     /// All biases ÷1.25 (`-`).
     BiasDown,
-    /// Next debug view: lit, shadow, normals, shadow map (`V`).
+    /// Next debug view: lit, shadow, normals, shadow map, cascades (`V`).
     CycleView,
     /// Toggle shadows (`H`).
     ToggleShadows,
