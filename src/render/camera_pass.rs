@@ -354,17 +354,15 @@ impl CameraPass {
                         );
                         bound_material = dr.material;
                     }
-                    let cull_mode = dr.cull_mode(Some(cull.eye));
-                    d.cmd_set_cull_mode(cmd, cull_mode);
-                    d.cmd_set_front_face(cmd, dr.front_face());
-                    d.cmd_push_constants(
+                    scene.record_draw(
+                        d,
                         cmd,
                         self.layout,
-                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                        0,
+                        dr,
+                        Some(cull.eye),
+                        Viewpoint::Eye(cull.eye.0),
                         bytemuck::bytes_of(&dr.immediates),
                     );
-                    scene.draw_indexed(d, cmd, dr, cull_mode, Viewpoint::Eye(cull.eye.0));
                 }
             }
             d.cmd_end_rendering(cmd);

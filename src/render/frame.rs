@@ -116,7 +116,7 @@ pub fn auto_cascades(ratio: f32) -> usize {
 /// (the scene `bounds` when there are none, or too many to clip each), within the frustum's own
 /// range; the frustum's range when nothing is in view.
 pub fn receiver_depths(frustum: &CameraFrustum, bounds: &Aabb, parts: &[Aabb]) -> (f32, f32) {
-    let boxes = if parts.is_empty() || parts.len() > 4096 {
+    let boxes = if parts.is_empty() || parts.len() > 1024 {
         std::slice::from_ref(bounds)
     } else {
         parts
@@ -209,7 +209,11 @@ pub fn plan_frame(
                         let frustum = fitting_frustum(fit_cam, aspect, bounds);
                         // Split the depths where the view meets the scene, not the whole
                         // frustum: a camera high above a compact scene sees nothing near.
-                        let (near, far) = receiver_depths(&frustum, bounds, receivers);
+                        // (Per frame, so only when the count is not fixed at one map.)
+                        let (near, far) = match view.shadow.cascades {
+                            1 => (frustum.near, frustum.far),
+                            _ => receiver_depths(&frustum, bounds, receivers),
+                        };
                         let n = match view.shadow.cascades {
                             0 => {
                                 let single = fit(Some(frustum)).texel_world;

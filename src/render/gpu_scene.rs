@@ -212,10 +212,38 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
+    /// Records draw `dr` of a pass seen from `eye` (`Draw::cull_mode`): its cull mode and front
+    /// face, the pass's `immediates` (pushed to both stages of `layout`), and its triangles.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_draw(
+        &self,
+        device: &ash::Device,
+        cmd: vk::CommandBuffer,
+        layout: vk::PipelineLayout,
+        dr: &Draw,
+        eye: Option<(Vec3, f32)>,
+        from: Viewpoint,
+        immediates: &[u8],
+    ) {
+        let cull = dr.cull_mode(eye);
+        unsafe {
+            device.cmd_set_cull_mode(cmd, cull);
+            device.cmd_set_front_face(cmd, dr.front_face());
+            device.cmd_push_constants(
+                cmd,
+                layout,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                0,
+                immediates,
+            );
+        }
+        self.draw_indexed(device, cmd, dr, cull, from);
+    }
+
     /// Records `dr` drawn with `cull`: with back faces culled, clusters whose faces all point away
     /// from `from` are left out (tested in model space, where a mirroring transform's flipped
     /// winding is undone by `Draw::front_face`), and runs of the rest are drawn.
-    pub fn draw_indexed(
+    fn draw_indexed(
         &self,
         device: &ash::Device,
         cmd: vk::CommandBuffer,

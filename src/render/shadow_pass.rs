@@ -314,17 +314,8 @@ impl ShadowPass {
                             light_clip_from_world: *light_clip_from_world,
                             world_from_model: dr.world_from_model,
                         };
-                        let cull_mode = dr.cull_mode(eye);
-                        d.cmd_set_cull_mode(cmd, cull_mode);
-                        d.cmd_set_front_face(cmd, dr.front_face());
-                        d.cmd_push_constants(
-                            cmd,
-                            self.layout,
-                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                            0,
-                            bytemuck::bytes_of(&pc),
-                        );
-                        scene.draw_indexed(d, cmd, dr, cull_mode, from);
+                        let pc = bytemuck::bytes_of(&pc);
+                        scene.record_draw(d, cmd, self.layout, dr, eye, from, pc);
                         drawn += 1;
                     }
                 }
