@@ -34,7 +34,8 @@ pub struct FrameUniform {
     pub camera_position: Vec4,
     /// Ambient intensity Ia.
     pub ambient: Vec4,
-    /// x map size, y normal offset (texels), z texel world size (or per unit distance), w enabled.
+    /// x map size, y normal offset (texels), z texel world size of view 0 (the shader reads
+    /// `cascade_texel`), w enabled.
     pub shadow: Vec4,
     /// w: index of the shadowed light (`MAX_LIGHTS + 1` when none); xyz unused.
     pub shadow_light: Vec4,
