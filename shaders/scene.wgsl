@@ -65,7 +65,7 @@ struct Frame {
     // rgb: ambient intensity Ia
     ambient: vec4<f32>,
     // x: shadow-map size in texels, y: normal-offset bias in texels,
-    // z: world size of one texel of view 0 (the shader reads `cascade_texel`), w: 1 if shadows on
+    // z: unused (texel sizes are in `cascade_texel`), w: 1 if shadows on
     shadow: vec4<f32>,
     // w: index of the shadowed light (MAX_LIGHTS + 1 when none); xyz unused
     shadow_light: vec4<f32>,

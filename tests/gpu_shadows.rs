@@ -209,7 +209,7 @@ fn box_shadow_matches_geometry_at_80_45_15_degrees() {
         let mut r = Renderer::new(&ctx, &scene).unwrap();
         let view = shadow_view(camera_on_shadow_side(light.direction));
         let f = r.render(&view, W, H).unwrap();
-        let band = EDGE_TEXELS * f.plan.texel_world;
+        let band = EDGE_TEXELS * f.plan.texel_world();
         let (j, diff) = judge(&f, &light, band);
         save(&f.image, &format!("box_shadow_{elevation}.png"));
         save(&diff, &format!("box_shadow_{elevation}_diff.png"));
@@ -255,7 +255,7 @@ fn huge_tiny_and_far_scenes_match_geometry() {
         );
         let cam = Camera::look_at(eye, target, local_cam.fov_y, 0.1 * scale);
         let f = r.render(&shadow_view(cam), W, H).unwrap();
-        let (j, diff) = judge(&f, &light, EDGE_TEXELS * f.plan.texel_world / scale);
+        let (j, diff) = judge(&f, &light, EDGE_TEXELS * f.plan.texel_world() / scale);
         save(&diff, &format!("placed_{scale}_{}_diff.png", offset.x));
         assert!(
             j.judged > (W * H / 3) as usize && j.exact_shadowed > 200,
@@ -283,7 +283,7 @@ fn d16_shadow_map_matches_geometry_too() {
         let mut view = shadow_view(camera_on_shadow_side(light.direction));
         view.shadow.format = ShadowFormat::D16;
         let f = r.render(&view, W, H).unwrap();
-        let (j, diff) = judge(&f, &light, EDGE_TEXELS * f.plan.texel_world);
+        let (j, diff) = judge(&f, &light, EDGE_TEXELS * f.plan.texel_world());
         save(&diff, &format!("box_shadow_d16_{elevation}_diff.png"));
         assert!(j.exact_shadowed > 60);
         assert_eq!(
@@ -357,7 +357,7 @@ fn shadow_touches_the_casters_base_within_two_texels() {
             0.1,
         );
         let f = r.render(&shadow_view(camera), W, H).unwrap();
-        let texel = f.plan.texel_world;
+        let texel = f.plan.texel_world();
         let m = f.plan.clip_from_world;
         let mut checked = 0;
         for k in -12..=12 {
@@ -418,7 +418,7 @@ fn sub_texel_camera_motion_leaves_shadows_unchanged_when_snapped() {
             ..Default::default()
         };
         let base = r.render(&view, W, H).unwrap();
-        let texel = base.plan.texel_world;
+        let texel = base.plan.texel_world();
         for step in 1..=6 {
             // Move the camera that the light frustum is fitted to by a fraction of a texel.
             let offset = Vec3::new(0.13, 0.05, 0.11) * step as f32 * texel;
@@ -470,7 +470,7 @@ fn spot_light_shadow_matches_geometry() {
     ));
     let f = r.render(&view, W, H).unwrap();
     // Texel size grows with distance; judge with the texel at the farthest shadow point (~12 units).
-    let band = EDGE_TEXELS * f.plan.texel_world * 12.0;
+    let band = EDGE_TEXELS * f.plan.texel_world() * 12.0;
     let (j, diff) = judge(&f, &light, band);
     save(&f.image, "spot_shadow.png");
     save(&diff, "spot_shadow_diff.png");

@@ -12,7 +12,7 @@ use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::Image;
 use crate::math::shadow_fit::spot_near;
-use crate::scene::{Light, LightKind, Scene};
+use crate::scene::{Light, Scene};
 use ash::vk;
 use std::sync::Arc;
 
@@ -134,11 +134,9 @@ impl FrameCore {
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         self.camera.bind_shadow_map(slot, map_view, hw);
         if plan.shadows_on {
-            let source = match plan.shadow_light.map(|i| &plan.lights[i]) {
-                Some(l) if l.kind != LightKind::Directional => Viewpoint::Eye(l.position),
-                Some(l) => Viewpoint::Along(l.direction),
-                None => Viewpoint::Along(glam::Vec3::NEG_Y),
-            };
+            let source = plan
+                .shadow_source()
+                .unwrap_or(Viewpoint::Along(glam::Vec3::NEG_Y));
             plan.casters = plan
                 .shadow_views
                 .iter()
@@ -193,11 +191,10 @@ impl FrameCore {
         }
         // The shadowed light's eye: none for a directional light (outside everything); a spot
         // light's position with its projection's near distance.
-        let light_eye = plan
-            .shadow_light
-            .map(|i| &plan.lights[i])
-            .filter(|l| l.kind != LightKind::Directional)
-            .map(|l| (l.position, spot_near(&self.gpu.bounds)));
+        let light_eye = match plan.shadow_source() {
+            Some(Viewpoint::Eye(p)) => Some((p, spot_near(&self.gpu.bounds))),
+            _ => None,
+        };
         let views: Vec<_> = plan
             .shadow_views
             .iter()

@@ -7,7 +7,7 @@ use super::uniforms::{FrameUniform, LightUniform, MAX_LIGHTS};
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
 use crate::math::shadow_fit::{
     cascade_splits, fit_directional, fit_spot, frustum_box_intersection, CameraFrustum,
-    DirectionalFitInput,
+    DirectionalFit, DirectionalFitInput,
 };
 use crate::math::Aabb;
 use crate::scene::{Camera, Light, LightKind};
@@ -96,6 +96,18 @@ pub struct ShadowView {
     pub blend: f32,
 }
 
+impl ShadowView {
+    /// A view used at every depth (the single map, a spot light's, or the last cascade).
+    pub fn whole(light_clip_from_world: Mat4, texel_world: f32) -> Self {
+        Self {
+            light_clip_from_world,
+            texel_world,
+            far: f32::INFINITY,
+            blend: f32::INFINITY,
+        }
+    }
+}
+
 /// How many cascades the automatic setting (`ShadowSettings::cascades` = 0) uses when one map's
 /// texel is `ratio` times the pixel footprint at the nearest receiver: 1 up to 4 (the single map
 /// resolves near shadows to a few pixels), 2 up to 32, else 4. Measured (`umbra compare
@@ -110,6 +122,36 @@ pub fn auto_cascades(ratio: f32) -> usize {
     } else {
         MAX_CASCADES as usize
     }
+}
+
+/// `n` cascades over the view depths `range` of `frustum`, each fitted by `fit` to its slice
+/// (widened to cover the previous cascade's blend band), nearest first.
+fn cascade_views(
+    frustum: &CameraFrustum,
+    range: (f32, f32),
+    n: usize,
+    fit: impl Fn(Option<CameraFrustum>) -> DirectionalFit,
+) -> Vec<ShadowView> {
+    let splits = cascade_splits(range.0, range.1, n, CASCADE_SPLIT_LAMBDA);
+    (0..n)
+        .map(|c| {
+            let near = match c {
+                0 => splits[0],
+                _ => splits[c] - CASCADE_BLEND * (splits[c] - splits[c - 1]),
+            };
+            let f = fit(Some(CameraFrustum {
+                near,
+                far: splits[c + 1],
+                ..*frustum
+            }));
+            let mut v = ShadowView::whole(f.light_clip_from_world, f.texel_world);
+            if c + 1 < n {
+                v.far = splits[c + 1];
+                v.blend = splits[c + 1] - CASCADE_BLEND * (splits[c + 1] - splits[c]);
+            }
+            v
+        })
+        .collect()
 }
 
 /// The view-depth range (near, far) where the camera frustum meets the receivers' boxes `parts`
@@ -156,16 +198,32 @@ pub struct FramePlan {
     pub lights: Vec<Light>,
     /// Index of the light with the shadow map, if any.
     pub shadow_light: Option<usize>,
-    /// World → light clip of the shadow map (its first view).
-    pub light_clip_from_world: Mat4,
-    /// Every view of the shadowed light (cascades near to far; one for a single map or a spot).
+    /// Every view of the shadowed light (cascades near to far; one for a single map or a spot;
+    /// none without a shadowed light).
     pub shadow_views: Vec<ShadowView>,
-    /// World size of a shadow texel (directional) or per unit distance (spot).
-    pub texel_world: f32,
     /// The camera's world → clip.
     pub clip_from_world: Mat4,
     /// The shadow pass's casters and area per shadow view (set by `FrameCore::prepare`).
     pub casters: Vec<CasterPlan>,
+}
+
+impl FramePlan {
+    /// World size of a texel of the first (nearest) shadow view (directional), or per unit
+    /// distance (spot); 0 without a shadow map.
+    pub fn texel_world(&self) -> f32 {
+        self.shadow_views.first().map_or(0.0, |v| v.texel_world)
+    }
+
+    /// The light source the shadow views look from: a spot light's position, or the direction
+    /// a directional light travels; None without a shadowed light.
+    pub fn shadow_source(&self) -> Option<super::gpu_scene::Viewpoint> {
+        use super::gpu_scene::Viewpoint;
+        let l = &self.lights[self.shadow_light?];
+        Some(match l.kind {
+            LightKind::Directional => Viewpoint::Along(l.direction),
+            _ => Viewpoint::Eye(l.position),
+        })
+    }
 }
 
 /// Plans a frame for `view` of a scene with `scene_lights` and `bounds`, rendered at `aspect`;
@@ -214,82 +272,50 @@ pub fn plan_frame(
                             1 => (frustum.near, frustum.far),
                             _ => receiver_depths(&frustum, bounds, receivers),
                         };
+                        // The automatic count fits one map first; when it stays at one, that is
+                        // the frame's map.
+                        let mut single = None;
                         let n = match view.shadow.cascades {
                             0 => {
-                                let single = fit(Some(frustum)).texel_world;
+                                let f = fit(Some(frustum));
                                 let pixel = 2.0 * near * (fit_cam.fov_y * 0.5).tan()
                                     / height_px.max(1) as f32;
-                                auto_cascades(single / pixel.max(f32::MIN_POSITIVE))
+                                single = Some(f);
+                                auto_cascades(f.texel_world / pixel.max(f32::MIN_POSITIVE))
                             }
                             c => c.clamp(1, MAX_CASCADES) as usize,
                         };
-                        let (near, far) = if n > 1 {
-                            (near, far)
+                        if n == 1 {
+                            let f = single.unwrap_or_else(|| fit(Some(frustum)));
+                            views.push(ShadowView::whole(f.light_clip_from_world, f.texel_world));
                         } else {
-                            (frustum.near, frustum.far)
-                        };
-                        let splits = cascade_splits(near, far, n, CASCADE_SPLIT_LAMBDA);
-                        for c in 0..n {
-                            // Each cascade also covers the blend band at the end of the previous.
-                            let near = match c {
-                                0 => splits[0],
-                                _ => splits[c] - CASCADE_BLEND * (splits[c] - splits[c - 1]),
-                            };
-                            let f = fit(Some(CameraFrustum {
-                                near,
-                                far: splits[c + 1],
-                                ..frustum
-                            }));
-                            let last = c + 1 == n;
-                            views.push(ShadowView {
-                                light_clip_from_world: f.light_clip_from_world,
-                                texel_world: f.texel_world,
-                                far: if last { f32::INFINITY } else { splits[c + 1] },
-                                blend: if last {
-                                    f32::INFINITY
-                                } else {
-                                    splits[c + 1] - CASCADE_BLEND * (splits[c + 1] - splits[c])
-                                },
-                            });
+                            views = cascade_views(&frustum, (near, far), n, fit);
                         }
                     }
                     ShadowFit::Scene => {
                         let f = fit(None);
-                        views.push(ShadowView {
-                            light_clip_from_world: f.light_clip_from_world,
-                            texel_world: f.texel_world,
-                            far: f32::INFINITY,
-                            blend: f32::INFINITY,
-                        });
+                        views.push(ShadowView::whole(f.light_clip_from_world, f.texel_world));
                     }
                 }
             }
             LightKind::Spot { outer, .. } => {
                 let (m, tan_half) = fit_spot(l.position, l.direction, outer, bounds);
-                views.push(ShadowView {
-                    light_clip_from_world: m,
-                    texel_world: 2.0 * tan_half / size as f32,
-                    far: f32::INFINITY,
-                    blend: f32::INFINITY,
-                });
+                views.push(ShadowView::whole(m, 2.0 * tan_half / size as f32));
             }
             LightKind::Point => {}
         }
     }
-    let light_clip_from_world = views
-        .first()
-        .map_or(Mat4::IDENTITY, |v| v.light_clip_from_world);
-    let texel_world = views.first().map_or(0.0, |v| v.texel_world);
     let shadows_on = view.shadow.enabled && shadow_light.is_some();
     let mut u = FrameUniform {
         clip_from_world,
-        shadow_clip: [light_clip_from_world; 4],
+        // Set per view below; slots past the views are never read.
+        shadow_clip: [Mat4::IDENTITY; 4],
         camera_position: view.camera.position().extend(1.0),
         ambient: view.ambient.extend(0.0),
         shadow: Vec4::new(
             size as f32,
             view.shadow.normal_offset,
-            texel_world,
+            0.0,
             if shadows_on { 1.0 } else { 0.0 },
         ),
         // No shadowed light: an index the shader's light loop never reaches.
@@ -304,7 +330,7 @@ pub fn plan_frame(
         shadow_rect: [Vec4::new(1.0, 1.0, -1.0, -1.0); 4],
         cascade_far: Vec4::splat(f32::MAX),
         cascade_blend: Vec4::splat(f32::MAX),
-        cascade_texel: Vec4::splat(texel_world),
+        cascade_texel: Vec4::ZERO,
         camera_forward: (view
             .camera
             .view_from_world()
@@ -356,9 +382,7 @@ pub fn plan_frame(
         ),
         lights,
         shadow_light,
-        light_clip_from_world,
         shadow_views: views,
-        texel_world,
         clip_from_world,
         casters: Vec::new(),
     }
@@ -415,7 +439,7 @@ mod tests {
         assert_eq!(p.shadow_views.len(), 1);
         assert_eq!(p.lights.len(), 1);
         assert_eq!(p.shadow_light, Some(0));
-        assert!(p.texel_world > 0.0);
+        assert!(p.texel_world() > 0.0);
         v.sun_direction = Some(Vec3::new(0.0, -1.0, 0.0));
         let p = plan_frame(&s.lights, &s.bounds(), &[], &v, 1.5, 720, false);
         assert_eq!(p.lights[0].direction, Vec3::NEG_Y);

@@ -34,8 +34,7 @@ pub struct FrameUniform {
     pub camera_position: Vec4,
     /// Ambient intensity Ia.
     pub ambient: Vec4,
-    /// x map size, y normal offset (texels), z texel world size of view 0 (the shader reads
-    /// `cascade_texel`), w enabled.
+    /// x map size, y normal offset (texels), z unused (texel sizes: `cascade_texel`), w enabled.
     pub shadow: Vec4,
     /// w: index of the shadowed light (`MAX_LIGHTS + 1` when none); xyz unused.
     pub shadow_light: Vec4,
