@@ -24,6 +24,8 @@ fn main() {
         #[cfg(feature = "viewer")]
         Command::View(a) => view(a),
         Command::Bench(a) => bench(a),
+        #[cfg(feature = "sweep")]
+        Command::Sweep(a) => sweep(a),
     };
     if let Err(e) = result {
         let msg = format!("{e:#}").replace('\n', " ");
@@ -34,7 +36,7 @@ fn main() {
 
 fn render(a: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
-    let view = make_view(&scene, &a.view)?;
+    let mut view = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
         validation: if a.validation {
             Validation::Required
@@ -46,6 +48,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         ..Default::default()
     })?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
+    app::cli::apply_budget(&scene, &mut view, &a.view, &mut renderer)?;
     let (w, h) = a.view.size;
     let n = a.repeat.max(1);
     // Only the last frame's pixels are kept; the others contribute their timings.
@@ -104,6 +107,7 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
         ..Default::default()
     })?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
+    app::cli::apply_budget(&scene, &mut view, &a.view, &mut renderer)?;
     renderer.set_read_depth(true);
     let (w, h) = a.view.size;
     view.mode = ViewMode::Lit;
@@ -160,7 +164,264 @@ fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
         device: a.device,
         validation: a.validation,
         resize_script: a.resize_script,
+        shadow_budget: a.view.shadow_budget,
     })
+}
+
+#[cfg(feature = "sweep")]
+fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
+    use umbra::analysis::{chart, grid, sweep as sw};
+    let grid = if a.quick {
+        grid::Grid::quick()
+    } else {
+        grid::Grid::full()
+    };
+    let configs = grid.configs();
+    let specs = if a.scenes.is_empty() {
+        vec!["demo".to_string()]
+    } else {
+        a.scenes.clone()
+    };
+    let scenes = specs
+        .iter()
+        .map(|s| app::cli::load_named(s, a.ground))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let csv_path = a.out.join("sweep.csv");
+    let done: std::collections::HashSet<(String, String, String)> =
+        sw::read_csv(&csv_path)?.iter().map(sw::Row::key).collect();
+    let (w, h) = a.size;
+    let aspect = w as f32 / h as f32;
+    let views: Vec<Vec<(String, umbra::Camera)>> = scenes
+        .iter()
+        .map(|s| {
+            let mut v = grid::sweep_views(s, aspect);
+            v.truncate(a.views.max(1));
+            v
+        })
+        .collect();
+    let total: usize = views.iter().map(|v| v.len() * configs.len()).sum();
+    let already = scenes
+        .iter()
+        .zip(&views)
+        .flat_map(|(s, vs)| vs.iter().map(move |v| (s, v)))
+        .flat_map(|(s, v)| {
+            configs
+                .iter()
+                .map(move |c| (s.name.clone(), v.0.clone(), c.name()))
+        })
+        .filter(|k| done.contains(k))
+        .count();
+    let ctx = Context::new(&ContextDesc {
+        validation: if a.validation {
+            Validation::Required
+        } else {
+            Validation::Off
+        },
+        device: a.device.clone(),
+        pipeline_cache: app::pipeline_cache_path(),
+        ..Default::default()
+    })?;
+    eprintln!(
+        "sweep: {} scene(s), {} configuration(s) per view, {total} runs ({already} already in {}) on {}",
+        scenes.len(),
+        configs.len(),
+        csv_path.display(),
+        ctx.device_name
+    );
+    let ticks_per_run = a.repeat.max(1) as u64 + 1;
+    let bar = indicatif::ProgressBar::new((total - already) as u64 * ticks_per_run);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {percent}% [{elapsed_precise}, ETA {eta_precise}] {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let started = std::time::Instant::now();
+    let mut out = sw::CsvAppender::open(&csv_path)?;
+    let mut failed: Option<anyhow::Error> = None;
+    for (scene, vs) in scenes.iter().zip(&views) {
+        let pending = |v: &str| {
+            configs
+                .iter()
+                .any(|c| !done.contains(&(scene.name.clone(), v.to_string(), c.name())))
+        };
+        if !vs.iter().any(|v| pending(&v.0)) {
+            continue;
+        }
+        let mut renderer = Renderer::with_options(&ctx, scene, &Default::default())?;
+        let reference = umbra::reference::ReferenceScene::new(scene);
+        for (vname, camera) in vs {
+            bar.set_message(format!("{} / {vname}", scene.name));
+            let skip = |c: &str| done.contains(&(scene.name.clone(), vname.clone(), c.to_string()));
+            let mut on_row = |r: sw::Row| {
+                if failed.is_none() {
+                    if let Err(e) = out.push(&r) {
+                        failed = Some(e.into());
+                    }
+                }
+            };
+            sw::run_view(
+                &mut renderer,
+                &reference,
+                &scene.name,
+                vname,
+                *camera,
+                &configs,
+                &sw::SweepOptions {
+                    width: w,
+                    height: h,
+                    repeat: a.repeat,
+                    ..Default::default()
+                },
+                &skip,
+                &mut on_row,
+                &mut || bar.inc(1),
+            )?;
+            if let Some(e) = failed.take() {
+                return Err(e);
+            }
+        }
+    }
+    bar.finish_and_clear();
+    drop(out);
+    let rows = sw::read_csv(&csv_path)?;
+    sw::write_json(&a.out.join("sweep.json"), &rows)?;
+    let mut names: Vec<String> = Vec::new();
+    for r in &rows {
+        if !names.contains(&r.scene) {
+            names.push(r.scene.clone());
+        }
+    }
+    for n in &names {
+        let of: Vec<sw::Row> = rows.iter().filter(|r| &r.scene == n).cloned().collect();
+        let file = n.replace(|c: char| !c.is_ascii_alphanumeric() && c != '-', "_");
+        chart::write_pareto(
+            &sw::mean_by_config(&of),
+            &format!(
+                "{n}: mean over {} view(s)",
+                of.iter()
+                    .map(|r| &r.view)
+                    .collect::<std::collections::HashSet<_>>()
+                    .len()
+            ),
+            &a.out.join(format!("pareto-{file}.svg")),
+            &a.out.join(format!("pareto-{file}.png")),
+        )?;
+    }
+    chart::write_pareto(
+        &sw::mean_by_config(&rows),
+        &format!("all scenes ({}): mean over every view", names.join(", ")),
+        &a.out.join("pareto.svg"),
+        &a.out.join("pareto.png"),
+    )?;
+    if a.features {
+        let all = grid::Grid::full().configs();
+        let mut feats = Vec::new();
+        for (scene, vs) in scenes.iter().zip(&views) {
+            let reference = umbra::reference::ReferenceScene::new(scene);
+            feats.extend(umbra::analysis::budget::feature_rows(
+                &reference, scene, vs, &all, &rows,
+            ));
+        }
+        let p = a.out.join("budget-features.csv");
+        let mut wr =
+            csv::Writer::from_path(&p).with_context(|| format!("writing {}", p.display()))?;
+        for f in &feats {
+            wr.serialize(f)?;
+        }
+        wr.flush()?;
+        if a.fit_budget {
+            use umbra::analysis::budget;
+            let mut model = Vec::new();
+            for f in ["nearest", "pcf2x2", "pcf3x3", "pcf5x5"] {
+                let of: Vec<&budget::FeatureRow> = feats.iter().filter(|r| r.filter == f).collect();
+                if of.is_empty() {
+                    continue;
+                }
+                model.push(budget::fit_coeffs(f, &of));
+            }
+            let costs = budget::relative_costs(&rows);
+            let provenance = format!(
+                "Fitted to {} rows of {} ({}) at {}x{} on {}.",
+                feats.len(),
+                names.join(", "),
+                a.out.join("sweep.csv").display(),
+                w,
+                h,
+                ctx.device_name
+            );
+            let p = a.out.join("budget-model.rs");
+            std::fs::write(&p, budget::model_source(&model, &costs, &provenance))
+                .with_context(|| format!("writing {}", p.display()))?;
+        }
+    }
+    if !a.check_budget.is_empty() {
+        use umbra::analysis::budget;
+        let p = a.out.join("budget-check.csv");
+        let mut wr =
+            csv::Writer::from_path(&p).with_context(|| format!("writing {}", p.display()))?;
+        for (scene, vs) in scenes.iter().zip(&views) {
+            let mut renderer = Renderer::with_options(&ctx, scene, &Default::default())?;
+            let reference = umbra::reference::ReferenceScene::new(scene);
+            for (vname, camera) in vs {
+                for &b in &a.check_budget {
+                    if let Some(row) = budget::check_view(
+                        &mut renderer,
+                        &reference,
+                        scene,
+                        vname,
+                        *camera,
+                        w,
+                        h,
+                        b,
+                        &rows,
+                    )? {
+                        if row.cheapest.is_empty() {
+                            println!(
+                                "budget {:.3} % on {} / {vname}: no swept configuration meets it; chose {} ({:.4} %, the most accurate tried)",
+                                b * 100.0,
+                                scene.name,
+                                row.chosen,
+                                row.measured * 100.0
+                            );
+                        } else {
+                            println!(
+                            "budget {:.3} % on {} / {vname}: {} measured {:.4} % ({}), {:.2}x the cheapest within budget ({}; {:.2}x by per-pass medians)",
+                            b * 100.0,
+                            scene.name,
+                            row.chosen,
+                            row.measured * 100.0,
+                            if row.within_budget { "within" } else { "OVER" },
+                            row.time_ratio,
+                            row.cheapest,
+                            row.denoised_time_ratio
+                        );
+                        }
+                        wr.serialize(&row)?;
+                    }
+                }
+            }
+        }
+        wr.flush()?;
+    }
+    println!(
+        "swept {} run(s) in {:.1} s; {} rows in {} (+ sweep.json, pareto.svg/.png and {} per-scene chart(s))",
+        total - already,
+        started.elapsed().as_secs_f64(),
+        rows.len(),
+        csv_path.display(),
+        names.len()
+    );
+    let log = ctx.validation_log.clone();
+    drop(ctx);
+    if log.problem_count() > 0 {
+        anyhow::bail!(
+            "{} validation message(s) of warning or error severity",
+            log.problem_count()
+        );
+    }
+    Ok(())
 }
 
 /// The median of `f` over the frames that have a value for it.
@@ -172,13 +433,14 @@ fn median_of(frames: &[FrameStats], f: &dyn Fn(&FrameStats) -> Option<f64>) -> O
 
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
-    let base = make_view(&scene, &a.view)?;
+    let mut base = make_view(&scene, &a.view)?;
     let ctx = Context::new(&ContextDesc {
         device: a.device.clone(),
         pipeline_cache: app::pipeline_cache_path(),
         ..Default::default()
     })?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
+    app::cli::apply_budget(&scene, &mut base, &a.view, &mut renderer)?;
     let (w, h) = a.view.size;
     println!(
         "{} ({} triangles) at {w}x{h} on {}; medians of {} frames after 1 warm-up",
@@ -192,8 +454,15 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
         "| shadow map | PCF | GPU shadow ms | GPU camera ms | GPU total ms | wall ms | casters |"
     );
     println!("|---|---|---|---|---|---|---|");
-    for &map in &a.maps {
-        let kernels = if map == 0 {
+    // With a budget, the one chosen configuration.
+    let budgeted = a.view.shadow_budget.is_some();
+    let maps = if budgeted {
+        vec![base.shadow.map_size]
+    } else {
+        a.maps.clone()
+    };
+    for &map in &maps {
+        let kernels = if map == 0 || budgeted {
             &a.kernels[..a.kernels.len().min(1)]
         } else {
             &a.kernels[..]
@@ -202,7 +471,9 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
             let mut v = base.clone();
             v.shadow.enabled = map > 0;
             v.shadow.map_size = map.max(16);
-            v.shadow.pcf = pcf_of(k);
+            if !budgeted {
+                v.shadow.pcf = pcf_of(k);
+            }
             renderer.render(&v, w, h)?;
             let mut frames = Vec::new();
             for _ in 0..a.repeat.max(1) {

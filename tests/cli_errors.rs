@@ -311,6 +311,9 @@ fn bad_arguments() {
         (vec!["render", "--eye", "1,2,3"], "--target"),
         (vec!["render", "--sun-dir", "0,0,0"], "zero"),
         (vec!["render", "--shadow-map", "3"], "shadow-map"),
+        (vec!["render", "--shadow-budget", "150%"], "below 100%"),
+        (vec!["render", "--shadow-budget", "abc"], "not a fraction"),
+        (vec!["sweep", "no-such-scene.gltf"], "no such file"),
     ] {
         let (ok, stderr) = run(&args, &d);
         assert!(!ok, "{args:?} should fail");

@@ -122,6 +122,32 @@ fn viewer_screenshot_matches_offscreen_render() {
 }
 
 #[test]
+fn viewer_chooses_shadow_settings_for_a_budget() {
+    let x = Xvfb::start();
+    let args = [
+        "view",
+        "--synthetic",
+        "town",
+        "--size",
+        "320x180",
+        "--shadow-budget",
+        "0.2%",
+        "--frames",
+        "10",
+        "--validation",
+    ];
+    let (ok, log) = umbra(&args, Some(&x.display));
+    assert!(ok, "viewer failed:\n{log}");
+    // One map misclassifies 1.15 % of this view: the choice must be a cascaded one.
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("shadow budget 0.200 %:"))
+        .unwrap_or_else(|| panic!("no budget line:\n{log}"));
+    assert!(line.contains("cascades"), "{line}");
+    assert!(!line.contains("not reachable"), "{line}");
+}
+
+#[test]
 fn resizing_through_zero_and_back_is_clean() {
     let x = Xvfb::start();
     let shot = out("viewer_resized.png");

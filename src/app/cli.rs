@@ -31,6 +31,84 @@ pub enum Command {
     /// Time frames offscreen over shadow-map sizes and PCF kernels (medians of N frames) and
     /// print a Markdown table.
     Bench(BenchArgs),
+    /// Speed against accuracy: render every shadow configuration of a grid on a few views of
+    /// each scene, time it and score it against the ray-cast reference; write sweep.csv,
+    /// sweep.json and the Pareto charts (pareto.svg/.png over all scenes, pareto-SCENE.svg/.png).
+    /// Resumes from DIR/sweep.csv when interrupted.
+    #[cfg(feature = "sweep")]
+    Sweep(SweepArgs),
+}
+
+/// `umbra sweep`.
+#[cfg(feature = "sweep")]
+#[derive(Args, Debug)]
+pub struct SweepArgs {
+    /// Scenes: glTF files, `demo`, or generated scenes (`town`, `grazing`, `double-sided`,
+    /// `spheres:N`); the demo when none.
+    pub scenes: Vec<String>,
+    /// Output folder.
+    #[arg(long, default_value = "sweep")]
+    pub out: PathBuf,
+    /// The coarse grid (48 configurations instead of 576).
+    #[arg(long)]
+    pub quick: bool,
+    /// Frames timed per configuration (after one warm-up frame).
+    #[arg(long, default_value_t = 5)]
+    pub repeat: usize,
+    /// Image size WxH.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Add a ground plane under glTF models (as `render --ground`).
+    #[arg(long)]
+    pub ground: bool,
+    /// After sweeping, write budget-features.csv: each row with the error-budget model's
+    /// prediction terms (training data for `analysis::budget`).
+    #[arg(long)]
+    pub features: bool,
+    /// With --features: fit the error-budget model to the rows and write budget-model.rs (the
+    /// source of `analysis::model`).
+    #[arg(long, requires = "features")]
+    pub fit_budget: bool,
+    /// After sweeping, run the budget mode (`--shadow-budget`) on every swept view for each of
+    /// these budgets (e.g. 0.1%,0.05%) and write budget-check.csv: the chosen configuration, its
+    /// full-image misclassification, and its GPU time against the cheapest swept configuration
+    /// within the budget.
+    #[arg(long, value_delimiter = ',', value_parser = parse_budget)]
+    pub check_budget: Vec<f64>,
+    /// Views per scene (its cameras, else default, high and ground), at most this many.
+    #[arg(long, default_value_t = 4)]
+    pub views: usize,
+    /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Enable the Khronos validation layer; exit 1 on any warning or error (also
+    /// UMBRA_VALIDATION=1). Timings then include the layer's overhead.
+    #[arg(long)]
+    pub validation: bool,
+}
+
+#[cfg(feature = "sweep")]
+/// Loads a scene named on the command line: an existing file, `demo`, or a generated scene's
+/// name (`scene::synthetic::by_name`). Prints its warnings; adds a ground plane to files when
+/// `ground`.
+pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
+    let path = std::path::Path::new(spec);
+    let mut s = if path.exists() {
+        load_gltf(path)?
+    } else if spec == "demo" {
+        demo_scene()
+    } else if let Some(s) = umbra::scene::synthetic::by_name(spec) {
+        s
+    } else {
+        bail!("{spec}: no such file, and not demo, town, grazing, double-sided or spheres:N");
+    };
+    for w in &s.warnings {
+        eprintln!("warning: {}: {w}", s.name);
+    }
+    if ground && path.exists() {
+        umbra::scene::shapes::add_ground(&mut s);
+    }
+    Ok(s)
 }
 
 /// `umbra bench`.
@@ -179,7 +257,8 @@ pub struct ViewArgs {
     #[arg(long)]
     pub no_culling: bool,
     /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided
-    /// primitives), `town` (2 km across, cameras at eye height and on a roof) or `spheres:N` (an
+    /// primitives), `town` (2 km across, cameras at eye height and on a roof), `grazing` (a sun 6° above the
+    /// horizon over posts, spheres and crates) or `spheres:N` (an
     /// N×N grid of 1,200-triangle spheres).
     #[arg(long)]
     pub synthetic: Option<String>,
@@ -235,6 +314,11 @@ pub struct ViewArgs {
     /// would be at the nearest surface in view.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub cascades: u32,
+    /// Choose the shadow settings for this scene and view: the cheapest configuration whose
+    /// predicted misclassification is within this budget, e.g. `0.1%` or `0.001` (prints the
+    /// choice and its prediction; overrides --shadow-map, --pcf, --cascades, --fit).
+    #[arg(long, value_parser = parse_budget)]
+    pub shadow_budget: Option<f64>,
     /// Disable shadows.
     #[arg(long)]
     pub no_shadows: bool,
@@ -270,6 +354,77 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+fn parse_budget(s: &str) -> Result<f64, String> {
+    let t = s.trim();
+    let v = match t.strip_suffix('%') {
+        Some(p) => p.trim().parse::<f64>().map(|v| v / 100.0),
+        None => t.parse::<f64>(),
+    }
+    .map_err(|_| format!("'{s}' is not a fraction or a percentage"))?;
+    if !(v.is_finite() && v > 0.0 && v < 1.0) {
+        return Err(format!("budget {s} must be above 0 and below 100%"));
+    }
+    Ok(v)
+}
+
+/// With `--shadow-budget`: chooses this view's shadow settings (`analysis::budget::choose`), sets
+/// them on `view`, and prints the choice on one line.
+#[cfg(feature = "sweep")]
+pub fn apply_budget(
+    scene: &Scene,
+    view: &mut View,
+    a: &ViewArgs,
+    renderer: &mut umbra::Renderer,
+) -> anyhow::Result<()> {
+    use umbra::analysis::{budget, chart::short_label_of};
+    let Some(b) = a.shadow_budget else {
+        return Ok(());
+    };
+    let reference = umbra::reference::ReferenceScene::new(scene);
+    let Some(c) = budget::choose(renderer, &reference, scene, view, a.size.0, a.size.1, b)? else {
+        eprintln!("warning: --shadow-budget: no light casts a shadow; settings unchanged");
+        return Ok(());
+    };
+    view.shadow = c.chosen.config.shadow;
+    println!("{}", budget_line(&c, &short_label_of(&c.chosen.config)));
+    Ok(())
+}
+
+/// The one-line report of a budget choice.
+#[cfg(feature = "sweep")]
+pub fn budget_line(c: &umbra::analysis::budget::BudgetChoice, label: &str) -> String {
+    let measured = c
+        .measured
+        .map(|m| format!(", measured {:.4} % at {} probes", m * 100.0, c.probes))
+        .unwrap_or_default();
+    let met = if c.met {
+        ""
+    } else {
+        " — budget not reachable: the most accurate candidate tried"
+    };
+    format!(
+        "shadow budget {:.3} %: {label} (predicted {:.4} %{measured}; {:.2}x the default's GPU time; {} render(s), {:.0} ms){met}",
+        c.budget * 100.0,
+        c.chosen.predicted * 100.0,
+        c.chosen.relative_cost,
+        c.verified.len(),
+        c.ms
+    )
+}
+
+#[cfg(not(feature = "sweep"))]
+pub fn apply_budget(
+    _: &Scene,
+    _: &mut View,
+    a: &ViewArgs,
+    _: &mut umbra::Renderer,
+) -> anyhow::Result<()> {
+    if a.shadow_budget.is_some() {
+        bail!("--shadow-budget needs umbra built with the `sweep` feature");
+    }
+    Ok(())
+}
+
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
     let parts: Vec<&str> = s.split(',').collect();
     if parts.len() != 3 {
@@ -291,19 +446,15 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
 /// Loads SCENE or builds the demo, prints its warnings (`warning: NAME: …` on stderr, one per
 /// line), and adds a ground plane when asked.
 pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene> {
-    use umbra::scene::synthetic::{double_sided_scene, sphere_grid, town_scene};
     let mut s = match (path, a.synthetic.as_deref()) {
         (Some(_), Some(_)) => bail!("give either SCENE or --synthetic, not both"),
         (Some(p), None) => load_gltf(p)?,
         (None, None) => demo_scene(),
-        (None, Some("double-sided")) => double_sided_scene(),
-        (None, Some("town")) => town_scene(),
-        (None, Some(name)) => match name.strip_prefix("spheres:").map(str::parse::<u32>) {
-            Some(Ok(n)) if (1..=256).contains(&n) => sphere_grid(n),
-            _ => bail!(
-                "--synthetic {name}: expected double-sided, town or spheres:N with N in 1..=256"
-            ),
-        },
+        (None, Some(name)) => umbra::scene::synthetic::by_name(name).ok_or_else(|| {
+            anyhow!(
+                "--synthetic {name}: expected double-sided, town, grazing or spheres:N with N in 1..=256"
+            )
+        })?,
     };
     let ground = a.ground;
     for w in &s.warnings {

@@ -3,6 +3,8 @@
 
 #[cfg(feature = "viewer")]
 pub mod actions;
+#[cfg(all(feature = "viewer", feature = "sweep"))]
+pub mod budget_worker;
 pub mod cli;
 #[cfg(feature = "viewer")]
 pub mod controller;

@@ -47,6 +47,8 @@ pub struct ViewerOptions {
     pub validation: bool,
     /// Window sizes to go through, one every few frames (testing); 0×0 simulates minimising.
     pub resize_script: Vec<(u32, u32)>,
+    /// Re-choose the shadow settings for this misclassification budget as the camera moves.
+    pub shadow_budget: Option<f64>,
 }
 
 /// Frames between two resize-script steps.
@@ -125,6 +127,8 @@ struct State {
     screenshot_count: u32,
     script_pos: usize,
     minimized: bool,
+    #[cfg(feature = "sweep")]
+    budget: Option<super::budget_worker::BudgetWorker>,
 }
 
 struct App {
@@ -142,6 +146,10 @@ impl App {
     }
 
     fn init(&mut self, el: &ActiveEventLoop) -> anyhow::Result<State> {
+        #[cfg(not(feature = "sweep"))]
+        if self.opts.shadow_budget.is_some() {
+            anyhow::bail!("--shadow-budget needs umbra built with the `sweep` feature");
+        }
         let (w, h) = self.opts.size;
         let attrs = Window::default_attributes()
             .with_title(format!("umbra — {}", self.opts.scene.name))
@@ -219,6 +227,15 @@ impl App {
             screenshot_count: 0,
             script_pos: 0,
             minimized: size.width == 0 || size.height == 0,
+            #[cfg(feature = "sweep")]
+            budget: self.opts.shadow_budget.map(|b| {
+                super::budget_worker::BudgetWorker::start(
+                    self.opts.scene.clone(),
+                    b,
+                    self.opts.device.clone(),
+                    self.opts.validation,
+                )
+            }),
         })
     }
 
@@ -251,6 +268,22 @@ impl App {
         s.controller.update(dt);
         if s.camera_index.is_none() {
             s.view.camera = s.controller.camera();
+        }
+        #[cfg(feature = "sweep")]
+        if let Some(b) = s.budget.as_mut() {
+            let size = s.window.inner_size();
+            b.request(&s.view, (size.width, size.height));
+            // A run of a fixed number of frames (automation) waits for each choice, so what it
+            // draws and prints does not depend on the machine's speed.
+            if let Some(out) = b.poll(&mut s.view, opts.frames.is_some())? {
+                let label = umbra::analysis::chart::short_label_of(&out.choice.chosen.config);
+                let line = super::cli::budget_line(&out.choice, &label);
+                if out.kept {
+                    println!("{line}; keeping the running settings (within budget here)");
+                } else {
+                    println!("{line}");
+                }
+            }
         }
         let last_scripted = s.script_pos >= opts.resize_script.len();
         let final_frame = opts.frames.is_some_and(|n| s.drawn + 1 >= n) && last_scripted;
@@ -481,7 +514,8 @@ pub fn run(opts: ViewerOptions) -> anyhow::Result<()> {
     if let Some(e) = app.error.take() {
         return Err(e);
     }
-    if let Some(s) = app.state.take() {
+    #[allow(unused_mut)] // mutated only with the `sweep` feature
+    if let Some(mut s) = app.state.take() {
         if let (Some(t), true) = (s.first_draw, s.drawn > 1) {
             let secs = t.elapsed().as_secs_f64();
             println!(
@@ -502,8 +536,15 @@ pub fn run(opts: ViewerOptions) -> anyhow::Result<()> {
         }
         // Keep the log past the teardown, so messages from destroying objects count too.
         let log = s.ctx.validation_log.clone();
+        #[cfg(feature = "sweep")]
+        let worker_problems = match s.budget.take() {
+            Some(b) => b.finish()?,
+            None => 0,
+        };
+        #[cfg(not(feature = "sweep"))]
+        let worker_problems = 0;
         drop(s);
-        let problems = log.problem_count();
+        let problems = log.problem_count() + worker_problems;
         if problems > 0 {
             anyhow::bail!("{problems} validation message(s) of warning or error severity");
         }

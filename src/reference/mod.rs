@@ -8,4 +8,4 @@ pub mod raycast;
 
 pub use bvh::{Bvh, Hit};
 pub use metrics::{compare, Metrics};
-pub use raycast::{ReferenceFrame, ReferenceScene};
+pub use raycast::{Probe, ReferenceFrame, ReferenceScene};

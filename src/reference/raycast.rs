@@ -46,6 +46,19 @@ pub struct ReferenceFrame {
     pub image: image::RgbaImage,
 }
 
+/// What a probe ray found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Probe {
+    /// World position of the hit.
+    pub position: Vec3,
+    /// Geometric normal, facing the camera.
+    pub normal: Vec3,
+    /// Distance along the ray.
+    pub distance: f32,
+    /// Exact visibility of the shadowed light (facing it and unoccluded).
+    pub visible: bool,
+}
+
 fn srgb_decode(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
@@ -194,6 +207,66 @@ impl<'a> ReferenceScene<'a> {
             .bvh
             .occluded(&Ray::new(origin, dir), self.eps, dist - self.eps);
         (!occluded, dir, radiance)
+    }
+
+    /// Exact visibility at chosen pixel centres of `plan`'s camera (for sparse probes: the error
+    /// budget's prediction). `None` where the ray hits nothing.
+    pub fn probe(
+        &self,
+        plan: &FramePlan,
+        pixels: &[(f32, f32)],
+        width: u32,
+        height: u32,
+    ) -> Vec<Option<Probe>> {
+        let inv = plan.clip_from_world.inverse();
+        let eye = plan.camera_position;
+        pixels
+            .par_iter()
+            .map(|&(x, y)| {
+                let n = pixel_to_ndc(x, y, width, height);
+                let far = inv * Vec4::new(n.x, n.y, 1e-3, 1.0);
+                let dir = (far.truncate() / far.w - eye).normalize_or(Vec3::NEG_Z);
+                let ray = Ray::new(eye, dir);
+                let h = self.bvh.intersect(&ray, 0.0, f32::INFINITY)?;
+                let r = self.refs[h.triangle as usize];
+                let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+                let inst = &self.scene.instances[r.instance as usize];
+                let i0 = r.first as usize;
+                let pw = [0, 1, 2].map(|k| {
+                    inst.world_from_model
+                        .transform_point3(prim.positions[prim.indices[i0 + k] as usize])
+                });
+                // The same normals, flips and facing test as `shade`.
+                let mut ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
+                let idx = [0, 1, 2].map(|k| prim.indices[i0 + k] as usize);
+                let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
+                let mut n_geo = if prim.normals.len() == prim.positions.len() {
+                    let n = prim.normals[idx[0]] * w.x
+                        + prim.normals[idx[1]] * w.y
+                        + prim.normals[idx[2]] * w.z;
+                    (self.normal_mats[r.instance as usize] * n).normalize_or(ng)
+                } else {
+                    ng
+                };
+                if ng.dot(ray.dir) > 0.0 && n_geo.dot(ray.dir) > 0.0 {
+                    n_geo = -n_geo;
+                    ng = -ng;
+                } else if ng.dot(ray.dir) > 0.0 {
+                    ng = -ng;
+                }
+                let p = ray.at(h.t);
+                let visible = match plan.shadow_light {
+                    Some(i) => self.visible(plan, i, p, ng, n_geo).0,
+                    None => true,
+                };
+                Some(Probe {
+                    position: p,
+                    normal: ng,
+                    distance: h.t,
+                    visible,
+                })
+            })
+            .collect()
     }
 
     /// Casts one primary ray per pixel centre of `plan`'s camera and shades the hits.

@@ -146,6 +146,88 @@ pub fn town_scene() -> Scene {
     s
 }
 
+/// Long shadows under a low sun: a 60 m ground, two rows of thin posts, spheres and crates, lit
+/// by a sun 6° above the horizon (shadows 10× longer than their casters, receivers at grazing
+/// incidence: where acne, peter-panning and stretched texels show first). Camera 0 looks along
+/// the shadows from 2 m up, camera 1 across them from 12 m up.
+pub fn grazing_scene() -> Scene {
+    let mut s = Scene {
+        name: "grazing".into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "ground",
+        plane(60.0, 1.0),
+        colored(Vec3::splat(0.75), 1.0),
+        Mat4::IDENTITY,
+    );
+    let post = cuboid(Vec3::new(0.08, 1.2, 0.08));
+    for i in 0..10 {
+        for side in [-1.0f32, 1.0] {
+            add_object(
+                &mut s,
+                &format!("post {i}{}", if side < 0.0 { "l" } else { "r" }),
+                post.clone(),
+                colored(Vec3::new(0.35, 0.3, 0.25), 1.0),
+                Mat4::from_translation(Vec3::new(side * 3.0, 1.2, 8.0 - 3.0 * i as f32)),
+            );
+        }
+    }
+    let ball = uv_sphere(0.6, 32, 20);
+    for i in 0..4 {
+        add_object(
+            &mut s,
+            &format!("sphere {i}"),
+            ball.clone(),
+            colored(Vec3::new(0.3, 0.45, 0.7), 0.4),
+            Mat4::from_translation(Vec3::new(-8.0 + 5.0 * i as f32, 0.6, -4.0 + 2.0 * i as f32)),
+        );
+    }
+    for i in 0..3 {
+        let h = Vec3::new(0.7, 0.5 + 0.4 * i as f32, 0.5);
+        add_object(
+            &mut s,
+            &format!("crate {i}"),
+            cuboid(h),
+            colored(Vec3::new(0.6, 0.45, 0.25), 0.8),
+            Mat4::from_translation(Vec3::new(7.0, h.y, 4.0 - 6.0 * i as f32))
+                * Mat4::from_rotation_y(0.4 * i as f32),
+        );
+    }
+    s.lights.push(Light::sun(
+        Light::sun_direction(6f32.to_radians(), 2.6),
+        2.0,
+    ));
+    s.cameras.push(Camera::look_at(
+        Vec3::new(1.0, 2.0, 16.0),
+        Vec3::new(0.0, 0.0, -10.0),
+        55f32.to_radians(),
+        0.05,
+    ));
+    s.cameras.push(Camera::look_at(
+        Vec3::new(-18.0, 12.0, 6.0),
+        Vec3::new(2.0, 0.0, -4.0),
+        50f32.to_radians(),
+        0.1,
+    ));
+    s
+}
+
+/// The generated scene called `name`: `double-sided`, `town`, `grazing` or `spheres:N`
+/// (1 ≤ N ≤ 256); `None` for any other name.
+pub fn by_name(name: &str) -> Option<Scene> {
+    match name {
+        "double-sided" => Some(double_sided_scene()),
+        "town" => Some(town_scene()),
+        "grazing" => Some(grazing_scene()),
+        _ => match name.strip_prefix("spheres:").map(str::parse::<u32>) {
+            Some(Ok(n)) if (1..=256).contains(&n) => Some(sphere_grid(n)),
+            _ => None,
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
