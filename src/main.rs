@@ -24,6 +24,7 @@ fn main() {
         #[cfg(feature = "viewer")]
         Command::View(a) => view(a),
         Command::Bench(a) => bench(a),
+        Command::Inspect(a) => inspect(a),
         #[cfg(feature = "sweep")]
         Command::Sweep(a) => sweep(a),
     };
@@ -420,6 +421,23 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
             "{} validation message(s) of warning or error severity",
             log.problem_count()
         );
+    }
+    Ok(())
+}
+
+fn inspect(a: app::cli::InspectArgs) -> anyhow::Result<()> {
+    if a.view.synthetic.is_some() {
+        anyhow::bail!("inspect reads a glTF file; --synthetic does not apply");
+    }
+    let scene = umbra::load_gltf(&a.scene)?;
+    let view = make_view(&scene, &a.view)?;
+    let mut report = umbra::scene::inspect::document_report(&a.scene, &scene)?;
+    let (w, h) = a.view.size;
+    report["shadow_plan"] = umbra::render::report::plan_report(&scene, &view, w, h);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", app::inspect_view::format_report(&report, a.md));
     }
     Ok(())
 }

@@ -31,6 +31,11 @@ pub enum Command {
     /// Time frames offscreen over shadow-map sizes and PCF kernels (medians of N frames) and
     /// print a Markdown table.
     Bench(BenchArgs),
+    /// What is in a glTF file and how umbra sees and shadows it: asset, extensions, meshes,
+    /// materials (as Blinn-Phong), textures, totals, scale, the default view's shadow plan and
+    /// findings with codes and JSON pointers. Tables by default; --json (schema umbra-inspect/1)
+    /// or --md.
+    Inspect(InspectArgs),
     /// Speed against accuracy: render every shadow configuration of a grid on a few views of
     /// each scene, time it and score it against the ray-cast reference; write sweep.csv,
     /// sweep.json and the Pareto charts (pareto.svg/.png over all scenes, pareto-SCENE.svg/.png).
@@ -109,6 +114,22 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
         umbra::scene::shapes::add_ground(&mut s);
     }
     Ok(s)
+}
+
+/// `umbra inspect`.
+#[derive(Args, Debug)]
+pub struct InspectArgs {
+    /// glTF 2.0 file (.gltf or .glb).
+    pub scene: PathBuf,
+    /// The report as JSON (schema `umbra-inspect/1`, docs/inspect-schema.json).
+    #[arg(long, conflicts_with = "md")]
+    pub json: bool,
+    /// The report as Markdown tables.
+    #[arg(long)]
+    pub md: bool,
+    /// The view the shadow plan is for (as for render).
+    #[command(flatten)]
+    pub view: ViewArgs,
 }
 
 /// `umbra bench`.

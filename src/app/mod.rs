@@ -8,6 +8,7 @@ pub mod budget_worker;
 pub mod cli;
 #[cfg(feature = "viewer")]
 pub mod controller;
+pub mod inspect_view;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 

@@ -247,6 +247,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             }
         }
     }
+    scene.image_textures = image_slots.clone();
     let tex_ref = |t: gltf::Texture| {
         image_slots
             .get(t.source().index())

@@ -5,6 +5,7 @@ pub mod clusters;
 pub mod demo;
 mod gltf_input;
 pub mod gltf_load;
+pub mod inspect;
 pub mod material;
 pub mod shapes;
 pub mod synthetic;

@@ -253,6 +253,8 @@ pub struct Scene {
     /// Bounds to frame with the default camera when they differ from `bounds()` (set when a
     /// helper such as a ground plane is added).
     pub framing: Option<Aabb>,
+    /// For a loaded glTF: each image's index into `textures` (`None` where it failed to load).
+    pub image_textures: Vec<Option<usize>>,
 }
 
 impl Scene {

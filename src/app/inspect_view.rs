@@ -1,0 +1,406 @@
+//! `umbra inspect`'s text and Markdown views of the JSON report (`scene::inspect`).
+
+use serde_json::Value;
+
+/// A table: header and rows, printed aligned (text) or as Markdown.
+struct Table {
+    head: Vec<String>,
+    rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    fn new(head: &[&str]) -> Self {
+        Self {
+            head: head.iter().map(|s| s.to_string()).collect(),
+            rows: Vec::new(),
+        }
+    }
+
+    fn row(&mut self, r: Vec<String>) {
+        self.rows.push(r);
+    }
+
+    fn render(&self, md: bool) -> String {
+        let mut out = String::new();
+        if md {
+            out += &format!("| {} |\n", self.head.join(" | "));
+            out += &format!("|{}\n", "---|".repeat(self.head.len()));
+            for r in &self.rows {
+                out += &format!("| {} |\n", r.join(" | "));
+            }
+            return out;
+        }
+        let n = self.head.len();
+        let mut w = vec![0usize; n];
+        for r in std::iter::once(&self.head).chain(&self.rows) {
+            for (i, c) in r.iter().enumerate().take(n) {
+                w[i] = w[i].max(c.chars().count());
+            }
+        }
+        let line = |r: &Vec<String>| {
+            r.iter()
+                .enumerate()
+                .map(|(i, c)| format!("{c:<width$}", width = w[i]))
+                .collect::<Vec<_>>()
+                .join("  ")
+                .trim_end()
+                .to_string()
+        };
+        out += &line(&self.head);
+        out.push('\n');
+        out += &w
+            .iter()
+            .map(|k| "-".repeat(*k))
+            .collect::<Vec<_>>()
+            .join("  ");
+        out.push('\n');
+        for r in &self.rows {
+            out += &line(r);
+            out.push('\n');
+        }
+        out
+    }
+}
+
+/// A JSON value as a short cell: strings bare, null as "–", arrays joined, floats to 4 digits.
+fn cell(v: &Value) -> String {
+    match v {
+        Value::Null => "–".into(),
+        Value::String(s) => s.clone(),
+        Value::Number(n) => match n.as_f64() {
+            Some(f) if n.is_f64() => {
+                if f != 0.0 && (f.abs() < 1e-3 || f.abs() >= 1e6) {
+                    format!("{f:.3e}")
+                } else {
+                    format!("{:.4}", f)
+                        .trim_end_matches('0')
+                        .trim_end_matches('.')
+                        .to_string()
+                }
+            }
+            _ => n.to_string(),
+        },
+        Value::Bool(b) => if *b { "yes" } else { "no" }.into(),
+        Value::Array(a) => a.iter().map(cell).collect::<Vec<_>>().join(", "),
+        Value::Object(_) => v.to_string(),
+    }
+}
+
+fn bytes(v: &Value) -> String {
+    let b = v.as_f64().unwrap_or(0.0);
+    if b >= 1024.0 * 1024.0 {
+        format!("{:.1} MiB", b / (1024.0 * 1024.0))
+    } else if b >= 1024.0 {
+        format!("{:.1} KiB", b / 1024.0)
+    } else {
+        format!("{b} B")
+    }
+}
+
+fn arr(v: &Value) -> &[Value] {
+    v.as_array().map(Vec::as_slice).unwrap_or(&[])
+}
+
+/// The report as aligned text tables (`md` = false) or Markdown.
+pub fn format_report(r: &Value, md: bool) -> String {
+    let h = |t: &str| {
+        if md {
+            format!("\n### {t}\n\n")
+        } else {
+            format!("\n{t}\n")
+        }
+    };
+    let mut out = String::new();
+    out += &if md {
+        format!("## {}\n", cell(&r["file"]["path"]))
+    } else {
+        format!("{}\n", cell(&r["file"]["path"]))
+    };
+    let mut t = Table::new(&["field", "value"]);
+    t.row(vec![
+        "file".into(),
+        format!(
+            "{} ({})",
+            bytes(&r["file"]["bytes"]),
+            cell(&r["file"]["container"])
+        ),
+    ]);
+    for k in ["version", "generator", "copyright"] {
+        t.row(vec![k.into(), cell(&r["asset"][k])]);
+    }
+    let ext = &r["extensions"];
+    let sup = |e: &Value| {
+        let n = cell(e);
+        let ok = ext["supported"][&n].as_bool().unwrap_or(false);
+        format!("{n}{}", if ok { "" } else { " (ignored)" })
+    };
+    t.row(vec![
+        "extensions used".into(),
+        arr(&ext["used"])
+            .iter()
+            .map(sup)
+            .collect::<Vec<_>>()
+            .join(", "),
+    ]);
+    t.row(vec!["extensions required".into(), cell(&ext["required"])]);
+    out += &h("Asset");
+    out += &t.render(md);
+
+    let tot = &r["totals"];
+    let mut t = Table::new(&["total", "value"]);
+    for k in ["triangles", "vertices", "draw_calls"] {
+        t.row(vec![
+            format!("{} (rendered)", k.replace('_', " ")),
+            format!("{} ({})", cell(&tot[k]), cell(&tot["rendered"][k])),
+        ]);
+    }
+    for k in ["meshes", "materials", "textures", "images", "nodes"] {
+        t.row(vec![k.into(), cell(&tot[k])]);
+    }
+    let g = &tot["gpu_bytes"];
+    t.row(vec!["GPU geometry".into(), bytes(&g["geometry"])]);
+    t.row(vec![
+        "GPU textures (mip chains)".into(),
+        bytes(&g["textures"]),
+    ]);
+    t.row(vec![
+        "GPU shadow maps".into(),
+        bytes(&r["shadow_plan"]["gpu_bytes"]),
+    ]);
+    out += &h("Totals");
+    out += &t.render(md);
+
+    let s = &r["scale"];
+    if !s.is_null() {
+        let mut t = Table::new(&["measure", "value"]);
+        t.row(vec!["bounds min".into(), cell(&s["bounds"]["min"])]);
+        t.row(vec!["bounds max".into(), cell(&s["bounds"]["max"])]);
+        t.row(vec!["diagonal".into(), cell(&s["diagonal"])]);
+        t.row(vec![
+            "distance from origin".into(),
+            cell(&s["distance_from_origin"]),
+        ]);
+        t.row(vec![
+            "reversed-z Δd/d at the far corner".into(),
+            cell(&s["reversed_z_relative_step_at_far_corner"]),
+        ]);
+        out += &h("Scale");
+        out += &t.render(md);
+    }
+
+    let p = &r["shadow_plan"];
+    out += &h("Shadow plan (default view)");
+    if p["light"].is_null() {
+        out += &format!("{}\n", cell(&p["reason"]));
+    } else {
+        out += &format!(
+            "light {} ({}), map {}² {}, {} view(s), {}\n",
+            cell(&p["light"]),
+            cell(&p["light_type"]),
+            cell(&p["map_texels"]),
+            cell(&p["format"]),
+            cell(&p["cascades"]),
+            bytes(&p["gpu_bytes"])
+        );
+        let mut t = Table::new(&[
+            "view",
+            "from depth",
+            "to depth",
+            "texel (world)",
+            "draws inside",
+        ]);
+        for (i, v) in arr(&p["views"]).iter().enumerate() {
+            t.row(vec![
+                i.to_string(),
+                cell(&v["from_depth"]),
+                if v["to_depth"].is_null() {
+                    "∞".into()
+                } else {
+                    cell(&v["to_depth"])
+                },
+                cell(&v["texel_world"]),
+                cell(&v["draws_inside"]),
+            ]);
+        }
+        out += &t.render(md);
+    }
+
+    let mut t = Table::new(&[
+        "mesh",
+        "name",
+        "inst",
+        "prim",
+        "mode",
+        "verts",
+        "indices",
+        "tris",
+        "material",
+        "attributes",
+    ]);
+    for m in arr(&r["meshes"]) {
+        for p in arr(&m["primitives"]) {
+            t.row(vec![
+                cell(&m["index"]),
+                cell(&m["name"]),
+                cell(&m["instances"]),
+                cell(&p["index"]),
+                cell(&p["mode"]),
+                cell(&p["vertices"]),
+                format!("{} {}", cell(&p["indices"]), cell(&p["index_type"])),
+                cell(&p["triangles"]),
+                cell(&p["material"]),
+                cell(&p["attributes"]),
+            ]);
+        }
+    }
+    out += &h("Meshes");
+    out += &t.render(md);
+
+    let mut t = Table::new(&[
+        "material",
+        "name",
+        "alpha",
+        "double-sided",
+        "textures",
+        "tangents",
+        "kd (factors)",
+        "ks (factors)",
+        "shininess",
+    ]);
+    for m in arr(&r["materials"]) {
+        let tex: Vec<String> = arr(&m["textures"])
+            .iter()
+            .map(|x| {
+                format!(
+                    "{}:{}{}{}",
+                    cell(&x["slot"]),
+                    cell(&x["texture"]),
+                    if x["tex_coord"].as_u64().unwrap_or(0) > 0 {
+                        format!(" uv{}", cell(&x["tex_coord"]))
+                    } else {
+                        String::new()
+                    },
+                    if x["transform"].as_bool().unwrap_or(false) {
+                        " (transform)"
+                    } else {
+                        ""
+                    }
+                )
+            })
+            .collect();
+        let bp = &m["blinn_phong"];
+        t.row(vec![
+            cell(&m["index"]),
+            cell(&m["name"]),
+            format!(
+                "{}{}",
+                cell(&m["alpha_mode"]),
+                if m["alpha_mode"] == "MASK" {
+                    format!(" {}", cell(&m["alpha_cutoff"]))
+                } else {
+                    String::new()
+                }
+            ),
+            cell(&m["double_sided"]),
+            tex.join(" "),
+            cell(&m["tangents"]),
+            cell(&bp["kd"]),
+            cell(&bp["ks"]),
+            cell(&bp["shininess"]),
+        ]);
+    }
+    out += &h("Materials (as Blinn-Phong)");
+    out += &t.render(md);
+
+    let mut t = Table::new(&["texture", "image", "size", "colour space", "mips", "GPU"]);
+    for x in arr(&r["textures"]) {
+        t.row(vec![
+            cell(&x["index"]),
+            cell(&x["image"]),
+            format!("{}×{}", cell(&x["width"]), cell(&x["height"])),
+            cell(&x["color_space"]),
+            cell(&x["mip_levels"]),
+            bytes(&x["gpu_bytes"]),
+        ]);
+    }
+    out += &h("Textures");
+    out += &t.render(md);
+
+    let st = &r["scene_tree"];
+    let nodes = arr(&st["nodes"]);
+    let mut t = Table::new(&[
+        "node",
+        "name",
+        "in scene",
+        "mesh",
+        "camera",
+        "light",
+        "translation",
+        "children",
+    ]);
+    for n in nodes.iter().take(40) {
+        t.row(vec![
+            cell(&n["index"]),
+            cell(&n["name"]),
+            cell(&n["in_scene"]),
+            cell(&n["mesh"]),
+            cell(&n["camera"]),
+            cell(&n["light"]),
+            cell(&n["translation"]),
+            arr(&n["children"]).len().to_string(),
+        ]);
+    }
+    out += &h("Nodes");
+    out += &t.render(md);
+    if nodes.len() > 40 {
+        out += &format!("… {} more (all in --json)\n", nodes.len() - 40);
+    }
+    if !arr(&st["cameras"]).is_empty() || !arr(&st["lights"]).is_empty() {
+        let mut t = Table::new(&["camera / light", "type", "values"]);
+        for c in arr(&st["cameras"]) {
+            t.row(vec![
+                format!("camera {}", cell(&c["index"])),
+                cell(&c["type"]),
+                format!(
+                    "yfov {} znear {} zfar {}",
+                    cell(&c["yfov"]),
+                    cell(&c["znear"]),
+                    cell(&c["zfar"])
+                ),
+            ]);
+        }
+        for l in arr(&st["lights"]) {
+            t.row(vec![
+                format!("light {}", cell(&l["index"])),
+                cell(&l["type"]),
+                format!(
+                    "intensity {} {}, colour {}, range {}",
+                    cell(&l["intensity"]),
+                    cell(&l["intensity_unit"]),
+                    cell(&l["color"]),
+                    cell(&l["range"])
+                ),
+            ]);
+        }
+        out += &h("Cameras and lights");
+        out += &t.render(md);
+    }
+
+    let f = arr(&r["findings"]);
+    out += &h(&format!("Findings ({})", f.len()));
+    if f.is_empty() {
+        out += "none\n";
+    } else {
+        let mut t = Table::new(&["severity", "code", "pointer", "message"]);
+        for x in f {
+            t.row(vec![
+                cell(&x["severity"]),
+                cell(&x["code"]),
+                cell(&x["pointer"]),
+                cell(&x["message"]),
+            ]);
+        }
+        out += &t.render(md);
+    }
+    out
+}

@@ -1,0 +1,91 @@
+//! The shadow plan of a view as JSON, for `umbra inspect`: which light casts, the map size and
+//! format, each shadow view (cascade) with the depth it covers and its texel's world size, how
+//! many draws fall inside it, and the memory the maps take.
+
+use super::frame::plan_frame;
+use super::settings::{ShadowFormat, View};
+use crate::math::Aabb;
+use crate::scene::{LightKind, Scene};
+use glam::Mat4;
+use serde_json::{json, Value};
+
+/// Whether `b` lies inside the x/y extent of `clip` (depth ignored: casters between the light and
+/// the view's near plane still cast, the pass clamps their depth).
+fn inside_xy(b: &Aabb, clip: &Mat4) -> bool {
+    let r = clip.transpose();
+    let planes = [
+        r.w_axis + r.x_axis,
+        r.w_axis - r.x_axis,
+        r.w_axis + r.y_axis,
+        r.w_axis - r.y_axis,
+    ];
+    !planes.iter().any(|p| {
+        let n = p.truncate();
+        let v = glam::Vec3::select(n.cmpge(glam::Vec3::ZERO), b.max, b.min);
+        n.dot(v) + p.w < 0.0
+    })
+}
+
+/// The shadow plan of `view` at `w`×`h` (the CPU side of a frame; no GPU needed).
+pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
+    let draws: Vec<Aabb> = scene
+        .instances
+        .iter()
+        .flat_map(|i| {
+            scene.meshes[i.mesh]
+                .primitives
+                .iter()
+                .map(move |p| p.bounds().transformed(&i.world_from_model))
+        })
+        .collect();
+    let plan = plan_frame(
+        &scene.lights,
+        &scene.bounds(),
+        &draws,
+        view,
+        w as f32 / h.max(1) as f32,
+        h,
+        false,
+    );
+    let Some(li) = plan.shadow_light.filter(|_| plan.shadows_on) else {
+        return json!({"light": null, "reason": "no light casts a shadow (or shadows are off)"});
+    };
+    let l = &plan.lights[li];
+    let kind = match l.kind {
+        LightKind::Directional => "directional",
+        LightKind::Spot { .. } => "spot",
+        LightKind::Point => "point",
+    };
+    let bytes_per_texel = match view.shadow.format {
+        ShadowFormat::D16 => 2u64,
+        ShadowFormat::D32 => 4,
+    };
+    let size = view.shadow.map_size as u64;
+    let mut near = view.camera.near;
+    let views: Vec<Value> = plan
+        .shadow_views
+        .iter()
+        .map(|v| {
+            let casters = draws
+                .iter()
+                .filter(|b| inside_xy(b, &v.light_clip_from_world))
+                .count();
+            let out = json!({"from_depth": near, "to_depth": if v.far.is_finite() { json!(v.far) } else { json!(null) },
+                             "texel_world": v.texel_world, "draws_inside": casters});
+            near = v.far;
+            out
+        })
+        .collect();
+    json!({
+        "light": li,
+        "light_type": kind,
+        "map_texels": size,
+        "format": match view.shadow.format { ShadowFormat::D16 => "D16", ShadowFormat::D32 => "D32" },
+        "cascades": plan.shadow_views.len(),
+        "views": views,
+        "texel_world_nearest": plan.shadow_views.first().map(|v| v.texel_world),
+        "texel_world_farthest": plan.shadow_views.last().map(|v| v.texel_world),
+        "gpu_bytes": size * size * bytes_per_texel * plan.shadow_views.len().max(1) as u64,
+        "image": [w, h],
+    })
+}
