@@ -35,19 +35,27 @@ fn main() {
     }
 }
 
-fn render(a: RenderArgs) -> anyhow::Result<()> {
-    let scene = load_scene(a.scene.as_ref(), &a.view)?;
-    let mut view = make_view(&scene, &a.view)?;
-    let ctx = Context::new(&ContextDesc {
-        validation: if a.validation {
+/// An offscreen context on `device` with the binary's pipeline cache, validated when asked.
+fn offscreen_context(
+    validation: bool,
+    device: Option<String>,
+) -> anyhow::Result<std::sync::Arc<Context>> {
+    Ok(Context::new(&ContextDesc {
+        validation: if validation {
             Validation::Required
         } else {
             Validation::Off
         },
-        device: a.device.clone(),
+        device,
         pipeline_cache: app::pipeline_cache_path(),
         ..Default::default()
-    })?;
+    })?)
+}
+
+fn render(a: RenderArgs) -> anyhow::Result<()> {
+    let scene = load_scene(a.scene.as_ref(), &a.view)?;
+    let mut view = make_view(&scene, &a.view)?;
+    let ctx = offscreen_context(a.validation, a.device.clone())?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     app::cli::apply_budget(&scene, &mut view, &a.view, &mut renderer)?;
     let (w, h) = a.view.size;
@@ -102,11 +110,7 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
     use umbra::render::ViewMode;
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut view = make_view(&scene, &a.view)?;
-    let ctx = Context::new(&ContextDesc {
-        device: a.device.clone(),
-        pipeline_cache: app::pipeline_cache_path(),
-        ..Default::default()
-    })?;
+    let ctx = offscreen_context(false, a.device.clone())?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     app::cli::apply_budget(&scene, &mut view, &a.view, &mut renderer)?;
     renderer.set_read_depth(true);
@@ -213,16 +217,7 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
         })
         .filter(|k| done.contains(k))
         .count();
-    let ctx = Context::new(&ContextDesc {
-        validation: if a.validation {
-            Validation::Required
-        } else {
-            Validation::Off
-        },
-        device: a.device.clone(),
-        pipeline_cache: app::pipeline_cache_path(),
-        ..Default::default()
-    })?;
+    let ctx = offscreen_context(a.validation, a.device.clone())?;
     eprintln!(
         "sweep: {} scene(s), {} configuration(s) per view, {total} runs ({already} already in {}) on {}",
         scenes.len(),
@@ -452,11 +447,7 @@ fn median_of(frames: &[FrameStats], f: &dyn Fn(&FrameStats) -> Option<f64>) -> O
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut base = make_view(&scene, &a.view)?;
-    let ctx = Context::new(&ContextDesc {
-        device: a.device.clone(),
-        pipeline_cache: app::pipeline_cache_path(),
-        ..Default::default()
-    })?;
+    let ctx = offscreen_context(false, a.device.clone())?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     app::cli::apply_budget(&scene, &mut base, &a.view, &mut renderer)?;
     let (w, h) = a.view.size;
