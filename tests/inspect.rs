@@ -167,6 +167,21 @@ fn known_defects_are_reported_with_codes_and_pointers() {
         "POSITION:f32x3"
     );
     assert_eq!(r["meshes"][0]["primitives"][0]["index_type"], "u16");
+    // `render` prints the same codes and pointers in its warning lines.
+    let o = Command::new(env!("CARGO_BIN_EXE_umbra"))
+        .args(["render", path.to_str().unwrap(), "--size", "32x18", "-o"])
+        .arg(dir.join("out.png"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    for tag in [
+        "[MESH_NORMALS_MISSING /meshes/0/primitives/0]",
+        "[MESH_DEGENERATE_TRIANGLES /meshes/0/primitives/0]",
+        "[MATERIAL_ALPHA_BLEND /materials/1]",
+    ] {
+        assert!(err.contains(tag), "{tag} not in:\n{err}");
+    }
     // The text view names them too, and says how many.
     let o = Command::new(env!("CARGO_BIN_EXE_umbra"))
         .args(["inspect", path.to_str().unwrap()])

@@ -108,7 +108,7 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
         bail!("{spec}: no such file, and not demo, town, grazing, double-sided or spheres:N");
     };
     for w in &s.warnings {
-        eprintln!("warning: {}: {w}", s.name);
+        print_warning(&s.name, w);
     }
     if ground && path.exists() {
         umbra::scene::shapes::add_ground(&mut s);
@@ -464,6 +464,18 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::from_array(v))
 }
 
+/// Prints one loader warning as `warning: NAME: MESSAGE [CODE POINTER]`, with the finding code
+/// and JSON pointer that `umbra inspect` reports for it (`scene::inspect::classify_warning`).
+pub fn print_warning(scene: &str, w: &str) {
+    let (code, pointer) = umbra::scene::inspect::classify_warning(w);
+    let at = if pointer.is_empty() {
+        String::new()
+    } else {
+        format!(" {pointer}")
+    };
+    eprintln!("warning: {scene}: {w} [{code}{at}]");
+}
+
 /// Loads SCENE or builds the demo, prints its warnings (`warning: NAME: …` on stderr, one per
 /// line), and adds a ground plane when asked.
 pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene> {
@@ -479,7 +491,7 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
     };
     let ground = a.ground;
     for w in &s.warnings {
-        eprintln!("warning: {}: {w}", s.name);
+        print_warning(&s.name, w);
     }
     if ground {
         umbra::scene::shapes::add_ground(&mut s);

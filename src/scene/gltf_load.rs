@@ -284,7 +284,8 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         if mat.alpha_mode == AlphaMode::Blend {
             mat.alpha_mode = AlphaMode::Opaque;
             scene.warn(format!(
-                "material '{}': alpha blending not supported yet, drawn opaque",
+                "material {} '{}': alpha blending not supported yet, drawn opaque",
+                m.index().unwrap_or(0),
                 mat.name
             ));
         }

@@ -159,6 +159,8 @@ pub fn classify_warning(message: &str) -> (&'static str, String) {
         format!("/nodes/{i}")
     } else if let Some(i) = num_after("camera ") {
         format!("/cameras/{i}")
+    } else if let Some(i) = num_after("material ") {
+        format!("/materials/{i}")
     } else {
         String::new()
     };
@@ -568,18 +570,6 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                "reversed_z_relative_step_at_far_corner": relative_gap(DepthMapping::ReversedInfiniteF32, near, far.max(near)),
                "near_plane_assumed": near})
     };
-    // Loader messages name materials by name: point them at the material.
-    for f in findings.iter_mut() {
-        if f["code"] == "MATERIAL_ALPHA_BLEND" && f["pointer"] == "" {
-            let msg = f["message"].as_str().unwrap_or("").to_string();
-            if let Some(i) = arr(&doc, "materials").iter().position(|m| {
-                m["alphaMode"] == "BLEND"
-                    && msg.contains(&format!("'{}'", m["name"].as_str().unwrap_or("")))
-            }) {
-                f["pointer"] = json!(format!("/materials/{i}"));
-            }
-        }
-    }
     let meta = std::fs::metadata(path).map_err(io)?;
     Ok(json!({
         "schema": SCHEMA,
@@ -638,8 +628,8 @@ mod tests {
             "NORMAL_MAP_WITHOUT_UVS"
         );
         assert_eq!(
-            classify_warning("material 'Lens': alpha blending not supported yet, drawn opaque").0,
-            "MATERIAL_ALPHA_BLEND"
+            classify_warning("material 5 'Lens': alpha blending not supported yet, drawn opaque"),
+            ("MATERIAL_ALPHA_BLEND", "/materials/5".to_string())
         );
         assert_eq!(classify_warning("something new").0, "LOADER_WARNING");
         for (code, sev, _) in FINDING_CODES {
