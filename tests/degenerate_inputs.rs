@@ -74,13 +74,29 @@ fn nan_positions_and_zero_area_triangles_are_dropped_or_kept_with_warnings() {
         |_| {},
     );
     let s = load_gltf(&p).unwrap();
-    let w = s.warnings.join("\n");
+    let w = s
+        .warnings
+        .iter()
+        .map(|w| format!("{} [{} {}]", w.message, w.code, w.pointer))
+        .collect::<Vec<_>>()
+        .join("\n");
     assert!(
         w.contains("1 triangles with non-finite positions dropped"),
         "{w}"
     );
     assert!(w.contains("1 zero-area triangles"), "{w}");
     assert!(w.contains("no normals; computed smooth normals"), "{w}");
+    // Each with its code and the primitive's pointer (what `render` prints and `inspect` reports).
+    for code in [
+        "MESH_NONFINITE_POSITIONS",
+        "MESH_DEGENERATE_TRIANGLES",
+        "MESH_NORMALS_MISSING",
+    ] {
+        assert!(
+            w.contains(&format!("[{code} /meshes/0/primitives/0]")),
+            "{code}: {w}"
+        );
+    }
     assert_eq!(s.triangle_count(), 2);
     assert!(s.bounds().min.is_finite() && s.bounds().max.is_finite());
     render_clean(&s);
@@ -109,7 +125,11 @@ fn normal_map_without_uvs_is_ignored_with_a_warning() {
     );
     let s = load_gltf(&p).unwrap();
     assert!(
-        s.warnings.iter().any(|w| w.contains("normal map ignored")),
+        s.warnings
+            .iter()
+            .any(|w| w.message.contains("normal map ignored")
+                && w.code == "NORMAL_MAP_WITHOUT_UVS"
+                && w.pointer == "/meshes/0/primitives/0"),
         "{:?}",
         s.warnings
     );
@@ -129,7 +149,10 @@ fn a_scene_without_instances_renders_the_background() {
         },
     );
     let s = load_gltf(&p).unwrap();
-    assert!(s.warnings.iter().any(|w| w.contains("no mesh instances")));
+    assert!(s
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("no mesh instances") && w.code == "SCENE_EMPTY"));
     let img = render_clean(&s);
     let first = *img.get_pixel(0, 0);
     assert!(

@@ -464,16 +464,15 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::from_array(v))
 }
 
-/// Prints one loader warning as `warning: NAME: MESSAGE [CODE POINTER]`, with the finding code
-/// and JSON pointer that `umbra inspect` reports for it (`scene::inspect::classify_warning`).
-pub fn print_warning(scene: &str, w: &str) {
-    let (code, pointer) = umbra::scene::inspect::classify_warning(w);
-    let at = if pointer.is_empty() {
+/// Prints one loader warning as `warning: NAME: MESSAGE [CODE POINTER]`: the finding code and
+/// JSON pointer that `umbra inspect` reports for it.
+pub fn print_warning(scene: &str, w: &umbra::scene::Warning) {
+    let at = if w.pointer.is_empty() {
         String::new()
     } else {
-        format!(" {pointer}")
+        format!(" {}", w.pointer)
     };
-    eprintln!("warning: {scene}: {w} [{code}{at}]");
+    eprintln!("warning: {scene}: {} [{}{at}]", w.message, w.code);
 }
 
 /// Loads SCENE or builds the demo, prints its warnings (`warning: NAME: …` on stderr, one per

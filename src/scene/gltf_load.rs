@@ -224,10 +224,15 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     }
     let decoded = decode_all(&sources);
     let mut image_slots: Vec<Option<usize>> = Vec::new();
-    for ((name, what, data), result) in sources.iter().zip(decoded) {
+    for (i, ((name, what, data), result)) in sources.iter().zip(decoded).enumerate() {
+        let image = format!("/images/{i}");
         match (data, result) {
             (Err(e), _) => {
-                scene.warn(format!("{what} not loaded ({e}); using a default"));
+                scene.warn(
+                    "IMAGE_NOT_LOADED",
+                    image,
+                    format!("{what} not loaded ({e}); using a default"),
+                );
                 image_slots.push(None);
             }
             (Ok(_), Ok((w, h, rgba))) => {
@@ -240,9 +245,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 image_slots.push(Some(scene.textures.len() - 1));
             }
             (Ok(_), Err(msg)) => {
-                scene.warn(format!(
-                    "{what} could not be decoded ({msg}); using a default"
-                ));
+                scene.warn(
+                    "IMAGE_NOT_LOADED",
+                    image,
+                    format!("{what} could not be decoded ({msg}); using a default"),
+                );
                 image_slots.push(None);
             }
         }
@@ -283,11 +290,15 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         };
         if mat.alpha_mode == AlphaMode::Blend {
             mat.alpha_mode = AlphaMode::Opaque;
-            scene.warn(format!(
-                "material {} '{}': alpha blending not supported yet, drawn opaque",
-                m.index().unwrap_or(0),
-                mat.name
-            ));
+            let i = m.index().unwrap_or(0);
+            scene.warn(
+                "MATERIAL_ALPHA_BLEND",
+                format!("/materials/{i}"),
+                format!(
+                    "material {i} '{}': alpha blending not supported yet, drawn opaque",
+                    mat.name
+                ),
+            );
         }
         if pbr
             .base_color_texture()
@@ -301,7 +312,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         scene.materials.push(mat);
     }
     if uses_transform {
-        scene.warn("KHR_texture_transform is ignored (not supported yet)");
+        scene.warn(
+            "TEXTURE_TRANSFORM_IGNORED",
+            "/extensionsUsed",
+            "KHR_texture_transform is ignored (not supported yet)",
+        );
     }
     let default_material = scene.materials.len();
     scene.materials.push(Material::default());
@@ -346,10 +361,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;
         if !world.is_finite() {
-            scene.warn(format!(
-                "node {} has a non-finite transform; skipped",
-                node.index()
-            ));
+            scene.warn(
+                "NODE_NONFINITE_TRANSFORM",
+                format!("/nodes/{}", node.index()),
+                format!("node {} has a non-finite transform; skipped", node.index()),
+            );
             continue;
         }
         if let Some(m) = node.mesh() {
@@ -371,10 +387,14 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                     });
                 }
                 gltf::camera::Projection::Orthographic(_) => {
-                    scene.warn(format!(
-                        "camera {} is orthographic; not supported, skipped",
-                        c.index()
-                    ));
+                    scene.warn(
+                        "CAMERA_ORTHOGRAPHIC",
+                        format!("/cameras/{}", c.index()),
+                        format!(
+                            "camera {} is orthographic; not supported, skipped",
+                            c.index()
+                        ),
+                    );
                 }
             }
         }
@@ -406,7 +426,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         }
     }
     if scene.instances.is_empty() {
-        scene.warn("the scene has no mesh instances");
+        scene.warn("SCENE_EMPTY", "", "the scene has no mesh instances");
     }
     Ok(scene)
 }
@@ -434,10 +454,15 @@ fn read_primitive(
 ) -> Result<Option<Primitive>, LoadError> {
     use gltf::mesh::Mode;
     let label = format!("mesh {} primitive {}", mesh.index(), prim.index());
+    let at = format!("/meshes/{}/primitives/{}", mesh.index(), prim.index());
     check_attribute_types(path, &label, prim)?;
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
     let Some(positions) = reader.read_positions() else {
-        scene.warn(format!("{label} has no POSITION; skipped"));
+        scene.warn(
+            "MESH_NO_POSITION",
+            at,
+            format!("{label} has no POSITION; skipped"),
+        );
         return Ok(None);
     };
     let positions: Vec<Vec3> = positions.map(Vec3::from_array).collect();
@@ -470,9 +495,11 @@ fn read_primitive(
             .flat_map(|i| [raw_indices[0], raw_indices[i - 1], raw_indices[i]])
             .collect(),
         other => {
-            scene.warn(format!(
-                "{label}: mode {other:?} is not drawn (triangles only)"
-            ));
+            scene.warn(
+                "MESH_UNSUPPORTED_MODE",
+                at,
+                format!("{label}: mode {other:?} is not drawn (triangles only)"),
+            );
             return Ok(None);
         }
     };
@@ -485,21 +512,33 @@ fn read_primitive(
         .copied()
         .collect();
     if indices.len() / 3 != before {
-        scene.warn(format!(
-            "{label}: {} triangles with non-finite positions dropped",
-            before - indices.len() / 3
-        ));
+        scene.warn(
+            "MESH_NONFINITE_POSITIONS",
+            at.clone(),
+            format!(
+                "{label}: {} triangles with non-finite positions dropped",
+                before - indices.len() / 3
+            ),
+        );
     }
     let degenerate = count_degenerate(&positions, &indices);
     if degenerate > 0 {
-        scene.warn(format!("{label}: {degenerate} zero-area triangles"));
+        scene.warn(
+            "MESH_DEGENERATE_TRIANGLES",
+            at.clone(),
+            format!("{label}: {degenerate} zero-area triangles"),
+        );
     }
     let normals: Vec<Vec3> = match reader.read_normals() {
         Some(it) => it
             .map(|v| Vec3::from_array(v).try_normalize().unwrap_or(Vec3::Y))
             .collect(),
         None => {
-            scene.warn(format!("{label}: no normals; computed smooth normals"));
+            scene.warn(
+                "MESH_NORMALS_MISSING",
+                at.clone(),
+                format!("{label}: no normals; computed smooth normals"),
+            );
             compute_smooth_normals(&positions, &indices)
         }
     };
@@ -520,9 +559,11 @@ fn read_primitive(
         None => (vec![Vec2::ZERO; n], false),
     };
     if reader.read_colors(0).is_some() {
-        scene.warn(format!(
-            "{label}: vertex colours (COLOR_0) are ignored (not supported yet)"
-        ));
+        scene.warn(
+            "MESH_COLORS_IGNORED",
+            at.clone(),
+            format!("{label}: vertex colours (COLOR_0) are ignored (not supported yet)"),
+        );
     }
     let material = prim.material().index().unwrap_or(default_material);
     let mut p = Primitive {
@@ -552,17 +593,23 @@ fn read_primitive(
         }
         None if wants_normal_map && has_uvs => {
             if !generate_mikktspace(&mut p) {
-                scene.warn(format!(
-                    "{label}: MikkTSpace tangent generation failed; normal map may be wrong"
-                ));
+                scene.warn(
+                    "MESH_TANGENTS_FAILED",
+                    at.clone(),
+                    format!(
+                        "{label}: MikkTSpace tangent generation failed; normal map may be wrong"
+                    ),
+                );
             }
         }
         None => p.tangents = p.normals.iter().map(|n| fallback_tangent(*n)).collect(),
     }
     if wants_normal_map && !has_uvs {
-        scene.warn(format!(
-            "{label}: normal map ignored: the primitive has no TEXCOORD_0"
-        ));
+        scene.warn(
+            "NORMAL_MAP_WITHOUT_UVS",
+            at,
+            format!("{label}: normal map ignored: the primitive has no TEXCOORD_0"),
+        );
         let mut m = scene.materials[material].clone();
         m.normal_texture = None;
         m.name = format!("{} (no UVs)", m.name);

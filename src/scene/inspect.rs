@@ -4,7 +4,7 @@
 //! umbra maps them to Blinn-Phong, textures with their GPU size, totals counted the way the
 //! Khronos glTF-Validator counts them (every primitive of every mesh once) and as rendered (per
 //! instance in the default scene), the scene's scale and its depth-precision consequence, and
-//! findings with stable codes and JSON pointers.
+//! findings with stable codes and JSON pointers (`scene::warning`).
 //!
 //! Read from the file's JSON (after `load_gltf` has validated it, so references are in range) and
 //! from the loaded [`Scene`] (decoded image sizes, repaired geometry). The shadow plan is added by
@@ -12,6 +12,7 @@
 
 use super::gltf_input::json_part;
 use super::gltf_load::LoadError;
+use super::warning::severity_of;
 use super::{blinn_phong_params, Scene};
 use crate::math::precision::{relative_gap, DepthMapping};
 use serde_json::{json, Map, Value};
@@ -26,153 +27,6 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_unlit",
     "KHR_texture_transform",
 ];
-
-/// Finding codes: (code, severity, what it means). Loader warnings map onto these by
-/// `classify_warning`; `render` prints the same codes in its warnings.
-pub const FINDING_CODES: &[(&str, &str, &str)] = &[
-    (
-        "MESH_NORMALS_MISSING",
-        "info",
-        "a primitive has no NORMAL; umbra computes smooth normals",
-    ),
-    (
-        "MESH_TANGENTS_FAILED",
-        "warning",
-        "MikkTSpace tangent generation failed; the normal map may be wrong",
-    ),
-    (
-        "MESH_COLORS_IGNORED",
-        "warning",
-        "vertex colours (COLOR_0) are ignored",
-    ),
-    (
-        "NODE_NONFINITE_TRANSFORM",
-        "warning",
-        "a node with a non-finite transform was skipped",
-    ),
-    (
-        "CAMERA_ORTHOGRAPHIC",
-        "warning",
-        "orthographic cameras are skipped",
-    ),
-    (
-        "MESH_NONFINITE_POSITIONS",
-        "warning",
-        "triangles with NaN or infinite positions were dropped",
-    ),
-    ("MESH_DEGENERATE_TRIANGLES", "info", "zero-area triangles"),
-    (
-        "MESH_NO_POSITION",
-        "warning",
-        "a primitive without POSITION was skipped",
-    ),
-    (
-        "MESH_UNSUPPORTED_MODE",
-        "warning",
-        "points or lines are not drawn",
-    ),
-    (
-        "MATERIAL_ALPHA_BLEND",
-        "warning",
-        "alpha blending is drawn opaque",
-    ),
-    (
-        "TEXTURE_TRANSFORM_IGNORED",
-        "warning",
-        "KHR_texture_transform is ignored",
-    ),
-    (
-        "IMAGE_NOT_LOADED",
-        "warning",
-        "an image could not be read or decoded; its slots use defaults",
-    ),
-    (
-        "NORMAL_MAP_WITHOUT_UVS",
-        "warning",
-        "a normal map on a primitive without TEXCOORD_0 is ignored",
-    ),
-    (
-        "EXTENSION_UNSUPPORTED",
-        "info",
-        "an extension used by the file that umbra ignores",
-    ),
-    ("SCENE_EMPTY", "warning", "the scene has no mesh instances"),
-    (
-        "UNUSED_MESH",
-        "info",
-        "a mesh no node of the rendered scene instances",
-    ),
-    ("UNUSED_MATERIAL", "info", "a material no primitive uses"),
-    ("UNUSED_TEXTURE", "info", "a texture no material uses"),
-    (
-        "LOADER_WARNING",
-        "warning",
-        "another repair or unsupported feature met while loading",
-    ),
-];
-
-/// The code of a loader warning message (see `FINDING_CODES`) and the JSON pointer it names,
-/// if any ("mesh 2 primitive 0" → `/meshes/2/primitives/0`, "image 3" → `/images/3`).
-pub fn classify_warning(message: &str) -> (&'static str, String) {
-    let m = message.to_ascii_lowercase();
-    let code = if m.starts_with("node ") && m.contains("non-finite") {
-        "NODE_NONFINITE_TRANSFORM"
-    } else if m.contains("orthographic") {
-        "CAMERA_ORTHOGRAPHIC"
-    } else if m.contains("no normals") {
-        "MESH_NORMALS_MISSING"
-    } else if m.contains("tangent generation failed") {
-        "MESH_TANGENTS_FAILED"
-    } else if m.contains("non-finite positions") {
-        "MESH_NONFINITE_POSITIONS"
-    } else if m.contains("zero-area") {
-        "MESH_DEGENERATE_TRIANGLES"
-    } else if m.contains("no position") {
-        "MESH_NO_POSITION"
-    } else if m.contains("is not drawn") {
-        "MESH_UNSUPPORTED_MODE"
-    } else if m.contains("color_0") {
-        "MESH_COLORS_IGNORED"
-    } else if m.contains("alpha blending") {
-        "MATERIAL_ALPHA_BLEND"
-    } else if m.contains("texture_transform") {
-        "TEXTURE_TRANSFORM_IGNORED"
-    } else if m.starts_with("image ") {
-        "IMAGE_NOT_LOADED"
-    } else if m.contains("normal map ignored") {
-        "NORMAL_MAP_WITHOUT_UVS"
-    } else if m.contains("no mesh instances") {
-        "SCENE_EMPTY"
-    } else {
-        "LOADER_WARNING"
-    };
-    let num_after = |key: &str| -> Option<usize> {
-        let i = m.find(key)? + key.len();
-        let digits: String = m[i..].chars().take_while(|c| c.is_ascii_digit()).collect();
-        digits.parse().ok()
-    };
-    let pointer = if let (Some(me), Some(p)) = (num_after("mesh "), num_after("primitive ")) {
-        format!("/meshes/{me}/primitives/{p}")
-    } else if let Some(i) = num_after("image ") {
-        format!("/images/{i}")
-    } else if let Some(i) = num_after("node ") {
-        format!("/nodes/{i}")
-    } else if let Some(i) = num_after("camera ") {
-        format!("/cameras/{i}")
-    } else if let Some(i) = num_after("material ") {
-        format!("/materials/{i}")
-    } else {
-        String::new()
-    };
-    (code, pointer)
-}
-
-fn severity_of(code: &str) -> &'static str {
-    FINDING_CODES
-        .iter()
-        .find(|c| c.0 == code)
-        .map_or("warning", |c| c.1)
-}
 
 fn finding(code: &str, pointer: String, message: String) -> Value {
     json!({"code": code, "severity": severity_of(code), "pointer": pointer, "message": message})
@@ -259,8 +113,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
         .map_err(|e| super::gltf_load::invalid(path, e))?;
     let mut findings: Vec<Value> = Vec::new();
     for w in &scene.warnings {
-        let (code, pointer) = classify_warning(w);
-        findings.push(finding(code, pointer, w.clone()));
+        findings.push(finding(w.code, w.pointer.clone(), w.message.clone()));
     }
     let accessors = arr(&doc, "accessors");
     let glb = bytes.starts_with(b"glTF");
@@ -597,45 +450,6 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn warnings_map_to_codes_and_pointers() {
-        assert_eq!(
-            classify_warning("mesh 2 primitive 1: no normals; computed smooth normals"),
-            ("MESH_NORMALS_MISSING", "/meshes/2/primitives/1".to_string())
-        );
-        assert_eq!(
-            classify_warning("image 3 could not be decoded (bad PNG); using a default"),
-            ("IMAGE_NOT_LOADED", "/images/3".to_string())
-        );
-        assert_eq!(
-            classify_warning("node 4 has a non-finite transform; skipped"),
-            ("NODE_NONFINITE_TRANSFORM", "/nodes/4".to_string())
-        );
-        assert_eq!(
-            classify_warning("mesh 0 primitive 0 has no POSITION; skipped").0,
-            "MESH_NO_POSITION"
-        );
-        assert_eq!(
-            classify_warning("mesh 1 primitive 0: mode LineStrip is not drawn (triangles only)").0,
-            "MESH_UNSUPPORTED_MODE"
-        );
-        assert_eq!(
-            classify_warning(
-                "mesh 1 primitive 2: normal map ignored: the primitive has no TEXCOORD_0"
-            )
-            .0,
-            "NORMAL_MAP_WITHOUT_UVS"
-        );
-        assert_eq!(
-            classify_warning("material 5 'Lens': alpha blending not supported yet, drawn opaque"),
-            ("MATERIAL_ALPHA_BLEND", "/materials/5".to_string())
-        );
-        assert_eq!(classify_warning("something new").0, "LOADER_WARNING");
-        for (code, sev, _) in FINDING_CODES {
-            assert!(["info", "warning", "error"].contains(sev), "{code}");
-        }
-    }
 
     #[test]
     fn mip_chain_sizes() {

@@ -12,7 +12,9 @@ pub mod synthetic;
 pub mod tangents;
 pub mod topology;
 mod types;
+pub mod warning;
 
 pub use gltf_load::{load_gltf, LoadError};
 pub use material::{blinn_phong_params, shade_blinn_phong, BlinnPhong};
 pub use types::*;
+pub use warning::Warning;

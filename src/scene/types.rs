@@ -249,7 +249,7 @@ pub struct Scene {
     /// Cameras from the file (world space).
     pub cameras: Vec<Camera>,
     /// Repairs and unsupported features met while loading.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<super::Warning>,
     /// Bounds to frame with the default camera when they differ from `bounds()` (set when a
     /// helper such as a ground plane is added).
     pub framing: Option<Aabb>,
@@ -283,11 +283,16 @@ impl Scene {
             .sum()
     }
 
-    /// Records a warning in `warnings` (logged at debug level; front ends print the list).
-    pub fn warn(&mut self, msg: impl Into<String>) {
-        let m = msg.into();
-        log::debug!("{}: {m}", self.name);
-        self.warnings.push(m);
+    /// Records a warning with its code (`scene::warning::FINDING_CODES`) and the JSON pointer
+    /// of the object it is about (logged at debug level; front ends print the list).
+    pub fn warn(&mut self, code: &'static str, pointer: impl Into<String>, msg: impl Into<String>) {
+        let message = msg.into();
+        log::debug!("{}: {message} [{code}]", self.name);
+        self.warnings.push(super::Warning {
+            code,
+            pointer: pointer.into(),
+            message,
+        });
     }
 
     /// A camera that frames the bounds from the front-right, above.

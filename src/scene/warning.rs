@@ -1,0 +1,123 @@
+//! Loader warnings with stable codes and JSON pointers: what `render` prints and `umbra inspect`
+//! reports as findings.
+
+/// One repair or unsupported feature met while loading.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Warning {
+    /// Stable code (`FINDING_CODES`).
+    pub code: &'static str,
+    /// JSON pointer into the file (`/meshes/2/primitives/0`), or empty when it names no object.
+    pub pointer: String,
+    /// What happened, for people.
+    pub message: String,
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+/// Finding codes: (code, severity, what it means). The loader's warnings and `umbra inspect`'s
+/// own findings use these.
+pub const FINDING_CODES: &[(&str, &str, &str)] = &[
+    (
+        "MESH_NORMALS_MISSING",
+        "info",
+        "a primitive has no NORMAL; umbra computes smooth normals",
+    ),
+    (
+        "MESH_TANGENTS_FAILED",
+        "warning",
+        "MikkTSpace tangent generation failed; the normal map may be wrong",
+    ),
+    (
+        "MESH_COLORS_IGNORED",
+        "warning",
+        "vertex colours (COLOR_0) are ignored",
+    ),
+    (
+        "MESH_NONFINITE_POSITIONS",
+        "warning",
+        "triangles with NaN or infinite positions were dropped",
+    ),
+    ("MESH_DEGENERATE_TRIANGLES", "info", "zero-area triangles"),
+    (
+        "MESH_NO_POSITION",
+        "warning",
+        "a primitive without POSITION was skipped",
+    ),
+    (
+        "MESH_UNSUPPORTED_MODE",
+        "warning",
+        "points or lines are not drawn",
+    ),
+    (
+        "NODE_NONFINITE_TRANSFORM",
+        "warning",
+        "a node with a non-finite transform was skipped",
+    ),
+    (
+        "CAMERA_ORTHOGRAPHIC",
+        "warning",
+        "orthographic cameras are skipped",
+    ),
+    (
+        "MATERIAL_ALPHA_BLEND",
+        "warning",
+        "alpha blending is drawn opaque",
+    ),
+    (
+        "TEXTURE_TRANSFORM_IGNORED",
+        "warning",
+        "KHR_texture_transform is ignored",
+    ),
+    (
+        "IMAGE_NOT_LOADED",
+        "warning",
+        "an image could not be read or decoded; its slots use defaults",
+    ),
+    (
+        "NORMAL_MAP_WITHOUT_UVS",
+        "warning",
+        "a normal map on a primitive without TEXCOORD_0 is ignored",
+    ),
+    (
+        "EXTENSION_UNSUPPORTED",
+        "info",
+        "an extension used by the file that umbra ignores",
+    ),
+    ("SCENE_EMPTY", "warning", "the scene has no mesh instances"),
+    (
+        "UNUSED_MESH",
+        "info",
+        "a mesh no node of the rendered scene instances",
+    ),
+    ("UNUSED_MATERIAL", "info", "a material no primitive uses"),
+    ("UNUSED_TEXTURE", "info", "a texture no material uses"),
+];
+
+/// The severity of `code` (`FINDING_CODES`; "warning" for an unknown code).
+pub fn severity_of(code: &str) -> &'static str {
+    FINDING_CODES
+        .iter()
+        .find(|c| c.0 == code)
+        .map_or("warning", |c| c.1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_are_unique_with_known_severities() {
+        for (i, (code, sev, _)) in FINDING_CODES.iter().enumerate() {
+            assert!(["info", "warning", "error"].contains(sev), "{code}");
+            assert!(
+                FINDING_CODES[..i].iter().all(|c| c.0 != *code),
+                "{code} listed twice"
+            );
+        }
+        assert_eq!(severity_of("UNUSED_MESH"), "info");
+    }
+}
