@@ -52,9 +52,17 @@ fn budget_choice_measures_within_budget_on_the_town() {
         v
     });
     for budget in [2e-3, 5e-4] {
-        let c = budget::choose(&mut renderer, &reference, &scene, &view, W, H, budget)
-            .unwrap()
-            .expect("the sun casts shadows");
+        let c = budget::choose(
+            &mut renderer,
+            &reference,
+            &scene,
+            &view,
+            (W, H),
+            budget,
+            None,
+        )
+        .unwrap()
+        .expect("the sun casts shadows");
         assert!(c.met, "budget {budget}: not met, tried {:#?}", c.verified);
         assert!(c.verified.len() <= budget::MAX_VERIFIED);
         let mut v = view.clone();

@@ -718,6 +718,7 @@ mod tests {
             measured: Some(0.0005),
             met: true,
             verified: Vec::new(),
+            current_measured: None,
             probes: 0,
             ms: 0.0,
         };
@@ -766,6 +767,8 @@ pub struct BudgetChoice {
     pub met: bool,
     /// Every candidate rendered, in order.
     pub verified: Vec<Verified>,
+    /// The misclassification of the running configuration passed to `choose`, if any.
+    pub current_measured: Option<f64>,
     /// Probe rays cast.
     pub probes: usize,
     /// Time the choice took (ms), probe and renders included.
@@ -906,16 +909,17 @@ pub fn next_candidate(
 }
 
 /// Chooses the cheapest configuration for `view` whose misclassification is within `budget`
-/// (module documentation: probe, predict, verify). `None` when no candidate applies (no light
-/// casts a shadow).
+/// (module documentation: probe, predict, verify); with `current`, the running configuration is
+/// measured too (`BudgetChoice::current_measured`, for `keep_current`). `None` when no candidate
+/// applies (no light casts a shadow).
 pub fn choose(
     renderer: &mut crate::render::Renderer,
     reference: &ReferenceScene,
     scene: &Scene,
     view: &View,
-    w: u32,
-    h: u32,
+    (w, h): (u32, u32),
     budget: f64,
+    current: Option<&super::grid::Config>,
 ) -> Result<Option<BudgetChoice>, crate::gpu::GpuError> {
     let t0 = std::time::Instant::now();
     let probe = probe_view(reference, scene, view, w, h, PROBE_STRIDE);
@@ -984,12 +988,21 @@ pub fn choose(
             }
         }
     };
+    // The running configuration (the viewer's), measured with the same probe.
+    let current_measured = match current {
+        None => None,
+        Some(c) => match verified.iter().find(|v| &v.prediction.config == c) {
+            Some(v) => Some(v.measured),
+            None => Some(measure(renderer, &probe, view, c)?),
+        },
+    };
     Ok(Some(BudgetChoice {
         budget,
         chosen,
         measured,
         met,
         verified,
+        current_measured,
         probes: probe.probes.len(),
         ms: t0.elapsed().as_secs_f64() * 1e3,
     }))
@@ -1044,7 +1057,7 @@ pub fn check_view(
     rows: &[super::sweep::Row],
 ) -> Result<Option<CheckRow>, crate::gpu::GpuError> {
     let view = View::new(camera);
-    let Some(c) = choose(renderer, reference, scene, &view, w, h, budget)? else {
+    let Some(c) = choose(renderer, reference, scene, &view, (w, h), budget, None)? else {
         return Ok(None);
     };
     let mut v = view.clone();

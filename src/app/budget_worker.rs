@@ -60,20 +60,19 @@ impl BudgetWorker {
             while let Ok(r) = req_rx.recv() {
                 let out = (|| -> anyhow::Result<Outcome> {
                     let (w, h) = r.size;
-                    let choice =
-                        budget::choose(&mut renderer, &reference, &scene, &r.view, w, h, budget)?
-                            .ok_or_else(|| anyhow::anyhow!("no light casts a shadow"))?;
-                    let kept = match &r.current {
-                        Some((c, cost)) if *c != choice.chosen.config => {
-                            let probe = budget::probe_view(
-                                &reference,
-                                &scene,
-                                &r.view,
-                                w,
-                                h,
-                                budget::PROBE_STRIDE,
-                            );
-                            let m = budget::measure(&mut renderer, &probe, &r.view, c)?;
+                    let running = r.current.as_ref().map(|c| &c.0);
+                    let choice = budget::choose(
+                        &mut renderer,
+                        &reference,
+                        &scene,
+                        &r.view,
+                        (w, h),
+                        budget,
+                        running,
+                    )?
+                    .ok_or_else(|| anyhow::anyhow!("no light casts a shadow"))?;
+                    let kept = match (&r.current, choice.current_measured) {
+                        (Some((c, cost)), Some(m)) if *c != choice.chosen.config => {
                             budget::keep_current(&choice, *cost, m)
                         }
                         _ => false,

@@ -402,7 +402,7 @@ pub fn apply_budget(
         return Ok(());
     };
     let reference = umbra::reference::ReferenceScene::new(scene);
-    let Some(c) = budget::choose(renderer, &reference, scene, view, a.size.0, a.size.1, b)? else {
+    let Some(c) = budget::choose(renderer, &reference, scene, view, a.size, b, None)? else {
         eprintln!("warning: --shadow-budget: no light casts a shadow; settings unchanged");
         return Ok(());
     };
