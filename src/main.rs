@@ -106,29 +106,21 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
 
 #[cfg(feature = "reference")]
 fn compare(a: CompareArgs) -> anyhow::Result<()> {
-    use umbra::reference::{compare as compare_frames, ReferenceScene};
-    use umbra::render::ViewMode;
+    use umbra::reference::{score, ReferenceScene};
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut view = make_view(&scene, &a.view)?;
     let ctx = offscreen_context(false, a.device.clone())?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     app::cli::apply_budget(&scene, &mut view, &a.view, &mut renderer)?;
-    renderer.set_read_depth(true);
     let (w, h) = a.view.size;
-    view.mode = ViewMode::Lit;
-    let lit = renderer.render(&view, w, h)?;
-    view.mode = ViewMode::Shadow;
-    let shadow = renderer.render(&view, w, h)?;
     let t0 = std::time::Instant::now();
     let reference = ReferenceScene::new(&scene);
     let build_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let frame = reference.render(&lit.plan, w, h, view.ambient);
-    let reference_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let depth = lit
-        .depth
-        .as_deref()
-        .ok_or_else(|| anyhow::anyhow!("no depth read back"))?;
-    let (metrics, diff) = compare_frames(&lit.image, &shadow.image, depth, &lit.plan, &frame);
+    let mut exact = None;
+    let scored = score(&mut renderer, &reference, &view, (w, h), &mut exact)?;
+    let reference_ms = build_ms + scored.reference_ms;
+    let (metrics, diff, lit) = (scored.metrics, scored.diff, scored.lit);
+    let frame = exact.ok_or_else(|| anyhow::anyhow!("no reference frame"))?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     for (name, img) in [
         ("gpu.png", &lit.image),

@@ -8,8 +8,8 @@ use common::*;
 use umbra::analysis::budget::{self, PROBE_STRIDE};
 use umbra::analysis::grid::Grid;
 use umbra::analysis::sweep::{run_view, Row, SweepOptions};
-use umbra::reference::{compare, ReferenceScene};
-use umbra::render::{Renderer, View, ViewMode};
+use umbra::reference::{score, ReferenceScene};
+use umbra::render::{Renderer, View};
 use umbra::scene::synthetic::town_scene;
 
 const W: u32 = 320;
@@ -17,23 +17,10 @@ const H: u32 = 180;
 
 /// Full-image misclassification of `view` (as `umbra compare`).
 fn measured(renderer: &mut Renderer, reference: &ReferenceScene, view: &View) -> f64 {
-    let mut v = view.clone();
-    v.mode = ViewMode::Lit;
-    let lit = renderer.render(&v, W, H).unwrap();
-    v.mode = ViewMode::Shadow;
-    renderer.set_read_depth(true);
-    let shadow = renderer.render(&v, W, H).unwrap();
-    renderer.set_read_depth(false);
-    let exact = reference.render(&lit.plan, W, H, v.ambient);
-    compare(
-        &lit.image,
-        &shadow.image,
-        shadow.depth.as_deref().unwrap(),
-        &lit.plan,
-        &exact,
-    )
-    .0
-    .misclassified
+    score(renderer, reference, view, (W, H), &mut None)
+        .unwrap()
+        .metrics
+        .misclassified
 }
 
 #[test]

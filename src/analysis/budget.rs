@@ -1062,21 +1062,7 @@ pub fn check_view(
     };
     let mut v = view.clone();
     v.shadow = c.chosen.config.shadow;
-    v.mode = crate::render::ViewMode::Lit;
-    let lit = renderer.render(&v, w, h)?;
-    v.mode = crate::render::ViewMode::Shadow;
-    renderer.set_read_depth(true);
-    let shadow = renderer.render(&v, w, h);
-    renderer.set_read_depth(false);
-    let shadow = shadow?;
-    let exact = reference.render(&lit.plan, w, h, view.ambient);
-    let (m, _) = crate::reference::compare(
-        &lit.image,
-        &shadow.image,
-        shadow.depth.as_deref().unwrap_or(&[]),
-        &lit.plan,
-        &exact,
-    );
+    let m = crate::reference::score(renderer, reference, &v, (w, h), &mut None)?.metrics;
     let of: Vec<&super::sweep::Row> = rows
         .iter()
         .filter(|r| r.scene == scene.name && r.view == view_name)

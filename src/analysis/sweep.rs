@@ -4,7 +4,7 @@
 
 use super::grid::{filter_name, format_name, Config};
 use crate::gpu::GpuError;
-use crate::reference::{compare, ReferenceFrame, ReferenceScene};
+use crate::reference::{ReferenceFrame, ReferenceScene};
 use crate::render::{FrameStats, Renderer, View, ViewMode};
 use crate::scene::Camera;
 use serde::{Deserialize, Serialize};
@@ -185,15 +185,14 @@ fn run_batch(
     // Accuracy, once per configuration.
     let mut scored = Vec::with_capacity(todo.len());
     for c in &todo {
-        renderer.set_read_depth(false);
-        let lit = renderer.render(&view_of(c, ViewMode::Lit), w, h)?;
-        renderer.set_read_depth(true);
-        let shadow = renderer.render(&view_of(c, ViewMode::Shadow), w, h)?;
-        renderer.set_read_depth(false);
-        let reference_frame = exact
-            .get_or_insert_with(|| reference.render(&lit.plan, w, h, View::new(camera).ambient));
-        let depth = shadow.depth.as_deref().unwrap_or(&[]);
-        let (m, _) = compare(&lit.image, &shadow.image, depth, &lit.plan, reference_frame);
+        let s = crate::reference::score(
+            renderer,
+            reference,
+            &view_of(c, ViewMode::Lit),
+            (w, h),
+            exact,
+        )?;
+        let (m, lit) = (s.metrics, s.lit);
         scored.push((m, lit.plan.shadow_views.len().max(1) as u32));
         tick();
     }

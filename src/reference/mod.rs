@@ -5,7 +5,9 @@
 pub mod bvh;
 pub mod metrics;
 pub mod raycast;
+pub mod score;
 
 pub use bvh::{Bvh, Hit};
 pub use metrics::{compare, Metrics};
 pub use raycast::{Probe, ReferenceFrame, ReferenceScene};
+pub use score::{score, Scored};
