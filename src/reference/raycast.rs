@@ -59,6 +59,27 @@ pub struct Probe {
     pub visible: bool,
 }
 
+/// The primary ray through image position (x, y) of the camera with clip → world `inv` at `eye`.
+fn primary_ray(inv: &glam::Mat4, eye: Vec3, x: f32, y: f32, w: u32, h: u32) -> Ray {
+    let n = pixel_to_ndc(x, y, w, h);
+    let far = *inv * Vec4::new(n.x, n.y, 1e-3, 1.0);
+    Ray::new(
+        eye,
+        (far.truncate() / far.w - eye).normalize_or(Vec3::NEG_Z),
+    )
+}
+
+/// Turns a hit's geometric normal towards the viewer along `dir`, as the shader does; the
+/// returned flag says whether the shading normals flip too (a back face whose interpolated normal
+/// also faces away).
+fn face_viewer(ng: Vec3, n_geo: Vec3, dir: Vec3) -> (Vec3, bool) {
+    if ng.dot(dir) > 0.0 {
+        (-ng, n_geo.dot(dir) > 0.0)
+    } else {
+        (ng, false)
+    }
+}
+
 fn srgb_decode(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
@@ -209,6 +230,27 @@ impl<'a> ReferenceScene<'a> {
         (!occluded, dir, radiance)
     }
 
+    /// Geometric and interpolated normals (world space, as stored: not yet turned to the viewer)
+    /// at a hit.
+    fn hit_normals(&self, h: &Hit) -> (Vec3, Vec3) {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let inst = &self.scene.instances[r.instance as usize];
+        let idx = [0, 1, 2].map(|k| prim.indices[r.first as usize + k] as usize);
+        let pw = idx.map(|i| inst.world_from_model.transform_point3(prim.positions[i]));
+        let ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
+        if prim.normals.len() != prim.positions.len() {
+            return (ng, ng);
+        }
+        let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
+        let n =
+            prim.normals[idx[0]] * w.x + prim.normals[idx[1]] * w.y + prim.normals[idx[2]] * w.z;
+        (
+            ng,
+            (self.normal_mats[r.instance as usize] * n).normalize_or(ng),
+        )
+    }
+
     /// Exact visibility at chosen pixel centres of `plan`'s camera (for sparse probes: the error
     /// budget's prediction). `None` where the ray hits nothing.
     pub fn probe(
@@ -223,36 +265,13 @@ impl<'a> ReferenceScene<'a> {
         pixels
             .par_iter()
             .map(|&(x, y)| {
-                let n = pixel_to_ndc(x, y, width, height);
-                let far = inv * Vec4::new(n.x, n.y, 1e-3, 1.0);
-                let dir = (far.truncate() / far.w - eye).normalize_or(Vec3::NEG_Z);
-                let ray = Ray::new(eye, dir);
+                let ray = primary_ray(&inv, eye, x, y, width, height);
                 let h = self.bvh.intersect(&ray, 0.0, f32::INFINITY)?;
-                let r = self.refs[h.triangle as usize];
-                let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
-                let inst = &self.scene.instances[r.instance as usize];
-                let i0 = r.first as usize;
-                let pw = [0, 1, 2].map(|k| {
-                    inst.world_from_model
-                        .transform_point3(prim.positions[prim.indices[i0 + k] as usize])
-                });
                 // The same normals, flips and facing test as `shade`.
-                let mut ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
-                let idx = [0, 1, 2].map(|k| prim.indices[i0 + k] as usize);
-                let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
-                let mut n_geo = if prim.normals.len() == prim.positions.len() {
-                    let n = prim.normals[idx[0]] * w.x
-                        + prim.normals[idx[1]] * w.y
-                        + prim.normals[idx[2]] * w.z;
-                    (self.normal_mats[r.instance as usize] * n).normalize_or(ng)
-                } else {
-                    ng
-                };
-                if ng.dot(ray.dir) > 0.0 && n_geo.dot(ray.dir) > 0.0 {
+                let (ng, mut n_geo) = self.hit_normals(&h);
+                let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+                if flip {
                     n_geo = -n_geo;
-                    ng = -ng;
-                } else if ng.dot(ray.dir) > 0.0 {
-                    ng = -ng;
                 }
                 let p = ray.at(h.t);
                 let visible = match plan.shadow_light {
@@ -289,10 +308,7 @@ impl<'a> ReferenceScene<'a> {
                     (i as u32 % width) as f32 + 0.5,
                     (i as u32 / width) as f32 + 0.5,
                 );
-                let n = pixel_to_ndc(x, y, width, height);
-                let far = inv * Vec4::new(n.x, n.y, 1e-3, 1.0);
-                let dir = (far.truncate() / far.w - eye).normalize_or(Vec3::NEG_Z);
-                let ray = Ray::new(eye, dir);
+                let ray = primary_ray(&inv, eye, x, y, width, height);
                 match self.bvh.intersect(&ray, 0.0, f32::INFINITY) {
                     None => (None, f32::INFINITY, background),
                     Some(h) => {
@@ -334,13 +350,9 @@ impl<'a> ReferenceScene<'a> {
             prim.indices[r.first as usize + 2] as usize,
         ];
         let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
-        let lerp3 = |a: &[Vec3]| a[idx[0]] * w.x + a[idx[1]] * w.y + a[idx[2]] * w.z;
         let p = ray.at(h.t);
-        let nm = self.normal_mats[r.instance as usize];
         let m3 = Mat3::from_mat4(inst.world_from_model);
-        let pw = idx.map(|i| inst.world_from_model.transform_point3(prim.positions[i]));
-        let mut ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
-        let mut n_geo = (nm * lerp3(&prim.normals)).normalize_or(ng);
+        let (ng, mut n_geo) = self.hit_normals(h);
         let uv = prim.uvs[idx[0]] * w.x + prim.uvs[idx[1]] * w.y + prim.uvs[idx[2]] * w.z;
         let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];
         let base = mat.base_color
@@ -373,12 +385,10 @@ impl<'a> ReferenceScene<'a> {
             );
         }
         // Back faces (seen only on double-sided materials on the GPU) flip like the shader does.
-        if ng.dot(ray.dir) > 0.0 && n_geo.dot(ray.dir) > 0.0 {
+        let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+        if flip {
             n_geo = -n_geo;
             n = -n;
-            ng = -ng;
-        } else if ng.dot(ray.dir) > 0.0 {
-            ng = -ng;
         }
         let mr = self.sample(
             mat.metallic_roughness_texture.map(|t| t.texture),
