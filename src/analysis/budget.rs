@@ -22,10 +22,8 @@
 //!    `MAX_VERIFIED` renders. The choice is the cheapest verified candidate measured within the
 //!    budget, so the budget holds by measurement, not only by the model.
 
-use crate::math::Aabb;
 use crate::reference::{Probe, ReferenceScene};
-use crate::render::frame::{plan_frame, FramePlan};
-use crate::render::{ShadowSettings, View};
+use crate::render::{FramePlan, ScenePlanner, ShadowSettings, View};
 use crate::scene::{LightKind, Scene};
 use glam::Vec3;
 
@@ -72,21 +70,9 @@ pub struct Features {
     pub edge_term: f64,
 }
 
-/// World boxes of every instance's primitives (the receivers cascades are split over).
-pub fn receiver_boxes(scene: &Scene) -> Vec<Aabb> {
-    let mut out = Vec::new();
-    for inst in &scene.instances {
-        for p in &scene.meshes[inst.mesh].primitives {
-            out.push(p.bounds().transformed(&inst.world_from_model));
-        }
-    }
-    out
-}
-
-/// The plan the renderer would make for `view` with `shadow` (CPU only).
-pub fn plan_for(
-    scene: &Scene,
-    receivers: &[Aabb],
+/// The plan the renderer would make for `view` with `shadow` instead of its own settings.
+fn plan_with(
+    planner: &ScenePlanner,
     view: &View,
     shadow: ShadowSettings,
     w: u32,
@@ -94,27 +80,19 @@ pub fn plan_for(
 ) -> FramePlan {
     let mut v = view.clone();
     v.shadow = shadow;
-    plan_frame(
-        &scene.lights,
-        &scene.bounds(),
-        receivers,
-        &v,
-        w as f32 / h.max(1) as f32,
-        h,
-        false,
-    )
+    planner.plan(&v, w, h)
 }
 
 /// Ray-casts the exact visibility at every `stride`-th pixel centre of `view`.
 pub fn probe_view(
     reference: &ReferenceScene,
-    scene: &Scene,
+    planner: &ScenePlanner,
     view: &View,
     w: u32,
     h: u32,
     stride: u32,
 ) -> ViewProbe {
-    let plan = plan_for(scene, &[], view, view.shadow, w, h);
+    let plan = planner.plan(view, w, h);
     let stride = stride.max(1);
     let mut probe = ViewProbe {
         cols: w.div_ceil(stride),
@@ -273,7 +251,7 @@ pub fn feature_rows(
     configs: &[super::grid::Config],
     rows: &[super::sweep::Row],
 ) -> Vec<FeatureRow> {
-    let receivers = receiver_boxes(scene);
+    let planner = ScenePlanner::new(scene);
     let mut out = Vec::new();
     for (name, camera) in views {
         let of: Vec<&super::sweep::Row> = rows
@@ -283,12 +261,12 @@ pub fn feature_rows(
         let Some(first) = of.first() else { continue };
         let (w, h) = (first.width_px, first.height_px);
         let view = View::new(*camera);
-        let probe = probe_view(reference, scene, &view, w, h, PROBE_STRIDE);
+        let probe = probe_view(reference, &planner, &view, w, h, PROBE_STRIDE);
         for r in of {
             let Some(c) = configs.iter().find(|c| c.name() == r.config) else {
                 continue;
             };
-            let plan = plan_for(scene, &receivers, &view, c.shadow, w, h);
+            let plan = plan_with(&planner, &view, c.shadow, w, h);
             let f = features(&probe, &plan, &view);
             out.push(FeatureRow {
                 scene: r.scene.clone(),
@@ -342,11 +320,10 @@ pub fn predict(coeffs: &Coeffs, f: &Features) -> f64 {
 /// larger maps); without it the passes weigh 4:1.
 pub fn predict_all(
     probe: &ViewProbe,
-    scene: &Scene,
+    planner: &ScenePlanner,
     view: &View,
     base_ms: Option<(f64, f64)>,
 ) -> Vec<Prediction> {
-    let receivers = receiver_boxes(scene);
     let (w, h) = (probe.width, probe.height);
     let configs = super::grid::Grid::full().configs();
     let (bc, bs) = base_ms.unwrap_or((4.0, 1.0));
@@ -362,7 +339,7 @@ pub fn predict_all(
         else {
             continue;
         };
-        let plan = plan_for(scene, &receivers, view, c.shadow, w, h);
+        let plan = plan_with(planner, view, c.shadow, w, h);
         let f = features(probe, &plan, view);
         out.push(Prediction {
             config: c.clone(),
@@ -922,7 +899,8 @@ pub fn choose(
     current: Option<&super::grid::Config>,
 ) -> Result<Option<BudgetChoice>, crate::gpu::GpuError> {
     let t0 = std::time::Instant::now();
-    let probe = probe_view(reference, scene, view, w, h, PROBE_STRIDE);
+    let planner = ScenePlanner::new(scene);
+    let probe = probe_view(reference, &planner, view, w, h, PROBE_STRIDE);
     // This view's split between the passes, from the default configuration (second of two
     // frames: the first may compile pipelines or allocate the map).
     let base = super::grid::Grid::full()
@@ -937,7 +915,7 @@ pub fn choose(
         let st = renderer.render(&v, w, h)?.stats;
         base_ms = st.gpu_camera_ms.zip(st.gpu_shadow_ms);
     }
-    let preds = predict_all(&probe, scene, view, base_ms);
+    let preds = predict_all(&probe, &planner, view, base_ms);
     if preds.is_empty() {
         return Ok(None);
     }

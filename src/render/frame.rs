@@ -226,6 +226,45 @@ impl FramePlan {
     }
 }
 
+/// What planning a frame of one scene needs, gathered once (CPU only: no GPU scene), for tools
+/// that plan many views or settings (`umbra inspect`, the error budget).
+pub struct ScenePlanner {
+    lights: Vec<Light>,
+    bounds: Aabb,
+    receivers: Vec<Aabb>,
+}
+
+impl ScenePlanner {
+    /// Gathers `scene`'s lights, bounds and draw boxes.
+    pub fn new(scene: &crate::scene::Scene) -> Self {
+        let receivers = scene.draw_bounds();
+        let bounds = receivers.iter().fold(Aabb::EMPTY, |b, r| b.union(r)); // = scene.bounds()
+        Self {
+            lights: scene.lights.clone(),
+            bounds,
+            receivers,
+        }
+    }
+
+    /// The draw boxes.
+    pub fn receivers(&self) -> &[Aabb] {
+        &self.receivers
+    }
+
+    /// The plan the renderer makes for `view` at `w`×`h`.
+    pub fn plan(&self, view: &View, w: u32, h: u32) -> FramePlan {
+        plan_frame(
+            &self.lights,
+            &self.bounds,
+            &self.receivers,
+            view,
+            w as f32 / h.max(1) as f32,
+            h,
+            false,
+        )
+    }
+}
+
 /// Plans a frame for `view` of a scene with `scene_lights` and `bounds`, rendered at `aspect`;
 /// `receivers` (each draw's world box, may be empty) bound the depths cascades are split over;
 /// `height_px`, the image height, sets the pixel footprint the automatic cascade count compares

@@ -16,7 +16,7 @@ pub(crate) mod uniforms;
 #[cfg(feature = "viewer")]
 pub(crate) mod window;
 
-pub use frame::{effective_lights, FramePlan};
+pub use frame::{effective_lights, FramePlan, ScenePlanner};
 pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 pub use settings::{Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};
 #[cfg(feature = "viewer")]

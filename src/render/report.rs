@@ -2,7 +2,6 @@
 //! format, each shadow view (cascade) with the depth it covers and its texel's world size, how
 //! many draws fall inside it, and the memory the maps take.
 
-use super::frame::plan_frame;
 use super::settings::{ShadowFormat, View};
 use crate::math::Aabb;
 use crate::scene::{LightKind, Scene};
@@ -28,25 +27,9 @@ fn inside_xy(b: &Aabb, clip: &Mat4) -> bool {
 
 /// The shadow plan of `view` at `w`×`h` (the CPU side of a frame; no GPU needed).
 pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
-    let draws: Vec<Aabb> = scene
-        .instances
-        .iter()
-        .flat_map(|i| {
-            scene.meshes[i.mesh]
-                .primitives
-                .iter()
-                .map(move |p| p.bounds().transformed(&i.world_from_model))
-        })
-        .collect();
-    let plan = plan_frame(
-        &scene.lights,
-        &scene.bounds(),
-        &draws,
-        view,
-        w as f32 / h.max(1) as f32,
-        h,
-        false,
-    );
+    let planner = super::frame::ScenePlanner::new(scene);
+    let draws = planner.receivers();
+    let plan = planner.plan(view, w, h);
     let Some(li) = plan.shadow_light.filter(|_| plan.shadows_on) else {
         return json!({"light": null, "reason": "no light casts a shadow (or shadows are off)"});
     };

@@ -260,13 +260,22 @@ pub struct Scene {
 impl Scene {
     /// World-space bounds of all instances.
     pub fn bounds(&self) -> Aabb {
-        let mut b = Aabb::EMPTY;
-        for inst in &self.instances {
-            for p in &self.meshes[inst.mesh].primitives {
-                b = b.union(&p.bounds().transformed(&inst.world_from_model));
-            }
-        }
-        b
+        self.draw_bounds()
+            .iter()
+            .fold(Aabb::EMPTY, |b, d| b.union(d))
+    }
+
+    /// World bounds of every draw (each instance's primitives).
+    pub fn draw_bounds(&self) -> Vec<Aabb> {
+        self.instances
+            .iter()
+            .flat_map(|i| {
+                self.meshes[i.mesh]
+                    .primitives
+                    .iter()
+                    .map(move |p| p.bounds().transformed(&i.world_from_model))
+            })
+            .collect()
     }
 
     /// Total triangles drawn (instances counted).
