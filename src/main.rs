@@ -52,6 +52,20 @@ fn offscreen_context(
     })?)
 }
 
+/// Destroys the context (its renderers must be gone) and fails if the validation layer reported
+/// anything of warning or error severity, destroy-time and leak messages included.
+fn finish_context(ctx: std::sync::Arc<Context>) -> anyhow::Result<()> {
+    let log = ctx.validation_log.clone();
+    drop(ctx);
+    if log.problem_count() > 0 {
+        anyhow::bail!(
+            "{} validation message(s) of warning or error severity",
+            log.problem_count()
+        );
+    }
+    Ok(())
+}
+
 fn render(a: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut view = make_view(&scene, &a.view)?;
@@ -92,16 +106,8 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         scene.name, s.triangles, s.casters_drawn, frame.plan.shadow_views.len(), frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
     );
     // Count after the renderer and the context are gone, so destroy-time and leak messages count.
-    let log = ctx.validation_log.clone();
     drop(renderer);
-    drop(ctx);
-    if log.problem_count() > 0 {
-        anyhow::bail!(
-            "{} validation message(s) of warning or error severity",
-            log.problem_count()
-        );
-    }
-    Ok(())
+    finish_context(ctx)
 }
 
 #[cfg(feature = "reference")]
@@ -401,15 +407,7 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
         csv_path.display(),
         names.len()
     );
-    let log = ctx.validation_log.clone();
-    drop(ctx);
-    if log.problem_count() > 0 {
-        anyhow::bail!(
-            "{} validation message(s) of warning or error severity",
-            log.problem_count()
-        );
-    }
-    Ok(())
+    finish_context(ctx)
 }
 
 fn inspect(a: app::cli::InspectArgs) -> anyhow::Result<()> {

@@ -478,14 +478,7 @@ pub const COST_BASE: &str = "2048-d32-pcf2x2-camera-default";
 /// times scatter by 15–25 % between configurations that do the same camera work; these
 /// estimates use 3–12 timings each.
 pub fn denoised_ms(rows: &[&super::sweep::Row]) -> Vec<(String, f64, f64)> {
-    let med = |mut v: Vec<f64>| -> f64 {
-        v.sort_by(f64::total_cmp);
-        if v.is_empty() {
-            f64::NAN
-        } else {
-            v[v.len() / 2]
-        }
-    };
+    let med = super::sweep::median;
     rows.iter()
         .map(|r| {
             let cam = med(rows

@@ -45,16 +45,33 @@ fn register_font() {
     });
 }
 
-/// The label of a front point: map size, filter, fitting (and format/bias when not the default).
-pub fn short_label(r: &Row) -> String {
-    let mut s = format!("{} {} {}", r.map_texels, r.filter, r.method);
-    if r.format != "d32" {
-        s.push_str(&format!(" {}", r.format));
+/// A configuration's short label: map size, filter, fitting, and format and bias when not the
+/// defaults (`2048 pcf2x2 cascades4`, `4096 nearest scene d16 bias:low`).
+fn label(map: u32, filter: &str, method: &str, format: &str, bias: &str) -> String {
+    let mut s = format!("{map} {filter} {method}");
+    if format != "d32" {
+        s.push_str(&format!(" {format}"));
     }
-    if r.bias != "default" {
-        s.push_str(&format!(" bias:{}", r.bias));
+    if bias != "default" {
+        s.push_str(&format!(" bias:{bias}"));
     }
     s
+}
+
+/// The label of a sweep row's configuration (the chart's front points).
+pub fn short_label(r: &Row) -> String {
+    label(r.map_texels, &r.filter, &r.method, &r.format, &r.bias)
+}
+
+/// The same label for a configuration.
+pub fn short_label_of(c: &super::grid::Config) -> String {
+    label(
+        c.shadow.map_size,
+        super::grid::filter_name(c.shadow.pcf),
+        &c.method(),
+        super::grid::format_name(c.shadow.format),
+        c.bias,
+    )
 }
 
 /// Tick values 1, 2, 5 × 10ⁿ within [lo, hi]; a finer 1, 1.5, 2, 3, 4, 5, 7 sequence where that
@@ -84,23 +101,6 @@ fn ticks_with(lo: f64, hi: f64, mantissas: &[f64]) -> Vec<f64> {
         e += 1;
     }
     out
-}
-
-/// The same label for a configuration.
-pub fn short_label_of(c: &super::grid::Config) -> String {
-    let mut s = format!(
-        "{} {} {}",
-        c.shadow.map_size,
-        super::grid::filter_name(c.shadow.pcf),
-        c.method()
-    );
-    if c.shadow.format != crate::render::ShadowFormat::D32 {
-        s.push_str(" d16");
-    }
-    if c.bias != "default" {
-        s.push_str(&format!(" bias:{}", c.bias));
-    }
-    s
 }
 
 fn y_of(r: &Row) -> f64 {

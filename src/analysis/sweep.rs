@@ -103,7 +103,8 @@ impl Default for SweepOptions {
     }
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+/// The median of `v` (the upper middle for an even count; NaN when empty).
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     if v.is_empty() {
         return f64::NAN;
     }
@@ -350,23 +351,6 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, SweepIoError> {
         .map_err(|source| SweepIoError::Csv { path: p, source })
 }
 
-/// Writes `rows` as CSV, replacing the file.
-pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), SweepIoError> {
-    let p = path.display().to_string();
-    let mut w = csv::Writer::from_path(path).map_err(|source| SweepIoError::Csv {
-        path: p.clone(),
-        source,
-    })?;
-    for r in rows {
-        w.serialize(r).map_err(|source| SweepIoError::Csv {
-            path: p.clone(),
-            source,
-        })?;
-    }
-    w.flush()
-        .map_err(|source| SweepIoError::Io { path: p, source })
-}
-
 /// Appends rows to a CSV, writing the header first when the file is new or empty. Each row is
 /// flushed, so an interrupted sweep loses nothing it measured.
 pub struct CsvAppender {
@@ -464,7 +448,11 @@ pub(crate) mod tests {
         let path = dir.join("sweep.csv");
         let _ = std::fs::remove_file(&path);
         let rows = vec![row("demo", "a", 12.5, 0.001), row("demo", "b", 30.25, 0.0)];
-        write_csv(&path, &rows).unwrap();
+        let mut w = CsvAppender::open(&path).unwrap();
+        for r in &rows {
+            w.push(r).unwrap();
+        }
+        drop(w);
         assert_eq!(
             read_csv(&path).unwrap(),
             rows,
