@@ -327,15 +327,6 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
         wr.flush()?;
         if a.fit_budget {
             use umbra::analysis::budget;
-            let mut model = Vec::new();
-            for f in ["nearest", "pcf2x2", "pcf3x3", "pcf5x5"] {
-                let of: Vec<&budget::FeatureRow> = feats.iter().filter(|r| r.filter == f).collect();
-                if of.is_empty() {
-                    continue;
-                }
-                model.push(budget::fit_coeffs(f, &of));
-            }
-            let costs = budget::relative_costs(&rows);
             let provenance = format!(
                 "Fitted to {} rows of {} ({}) at {}x{} on {}.",
                 feats.len(),
@@ -346,7 +337,7 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
                 ctx.device_name
             );
             let p = a.out.join("budget-model.rs");
-            std::fs::write(&p, budget::model_source(&model, &costs, &provenance))
+            std::fs::write(&p, budget::fit_model(&feats, &rows, &provenance))
                 .with_context(|| format!("writing {}", p.display()))?;
         }
     }

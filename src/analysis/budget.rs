@@ -542,6 +542,20 @@ pub fn relative_costs(rows: &[super::sweep::Row]) -> Vec<(String, f64, f64)> {
         .collect()
 }
 
+/// Fits the model to a sweep: coefficients per filter from its rows' prediction terms `feats`
+/// (`feature_rows`), costs from its `rows` (`relative_costs`); returns the Rust source of
+/// `analysis::model` with `provenance` in its header.
+pub fn fit_model(feats: &[FeatureRow], rows: &[super::sweep::Row], provenance: &str) -> String {
+    let model: Vec<Coeffs> = ["nearest", "pcf2x2", "pcf3x3", "pcf5x5"]
+        .into_iter()
+        .filter_map(|f| {
+            let of: Vec<&FeatureRow> = feats.iter().filter(|r| r.filter == f).collect();
+            (!of.is_empty()).then(|| fit_coeffs(f, &of))
+        })
+        .collect();
+    model_source(&model, &relative_costs(rows), provenance)
+}
+
 /// Rust source of `analysis::model` for fitted coefficients and costs.
 pub fn model_source(model: &[Coeffs], costs: &[(String, f64, f64)], provenance: &str) -> String {
     let mut s = String::new();

@@ -295,7 +295,7 @@ impl Image {
                 | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
         );
         let mips = if can_blit {
-            32 - width.max(height).max(1).leading_zeros()
+            crate::math::mip_levels(width, height)
         } else {
             1
         };

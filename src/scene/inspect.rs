@@ -89,17 +89,11 @@ fn mode_name(mode: u64) -> &'static str {
 
 /// Bytes of an RGBA8 texture with its full mip chain.
 pub fn mip_chain_bytes(w: u32, h: u32) -> (u32, u64) {
-    let (mut w, mut h) = (w.max(1) as u64, h.max(1) as u64);
-    let (mut levels, mut bytes) = (0u32, 0u64);
-    loop {
-        bytes += w * h * 4;
-        levels += 1;
-        if w == 1 && h == 1 {
-            return (levels, bytes);
-        }
-        w = (w / 2).max(1);
-        h = (h / 2).max(1);
-    }
+    let levels = crate::math::mip_levels(w, h);
+    let bytes = (0..levels)
+        .map(|l| ((w >> l).max(1) as u64) * ((h >> l).max(1) as u64) * 4)
+        .sum();
+    (levels, bytes)
 }
 
 /// The report of the glTF file at `path`, already loaded as `scene` (by `load_gltf`).
