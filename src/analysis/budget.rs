@@ -325,12 +325,16 @@ pub fn predict_all(
     base_ms: Option<(f64, f64)>,
 ) -> Vec<Prediction> {
     let (w, h) = (probe.width, probe.height);
-    let configs = super::grid::Grid::full().configs();
+    let configs: std::collections::HashMap<String, super::grid::Config> = super::grid::Grid::full()
+        .configs()
+        .into_iter()
+        .map(|c| (c.name(), c))
+        .collect();
     let (bc, bs) = base_ms.unwrap_or((4.0, 1.0));
     let mut out = Vec::new();
     for (name, cam, shadow) in super::model::COSTS {
         let cost = (bc * cam + bs * shadow) / (bc + bs);
-        let Some(c) = configs.iter().find(|c| c.name() == name) else {
+        let Some(c) = configs.get(name) else {
             continue;
         };
         let Some(k) = super::model::MODEL
