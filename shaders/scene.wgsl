@@ -67,7 +67,8 @@ struct Frame {
     // x: shadow-map size in texels, y: normal-offset bias in texels,
     // z: unused (texel sizes are in `cascade_texel`), w: 1 if shadows on
     shadow: vec4<f32>,
-    // w: index of the shadowed light (MAX_LIGHTS + 1 when none); xyz unused
+    // w: index of the shadowed light (MAX_LIGHTS + 1 when none); xyz: the eye the cascades are
+    // split from (the shadow-fitting camera)
     shadow_light: vec4<f32>,
     // x: constant bias in shadow texels, applied towards the light
     bias: vec4<f32>,
@@ -80,7 +81,8 @@ struct Frame {
     cascade_blend: vec4<f32>,
     // Per cascade: world size of one texel (directional) or per unit distance (spot).
     cascade_texel: vec4<f32>,
-    // xyz: camera forward (view depth = dot(p - eye, forward)); w: number of shadow views.
+    // xyz: the shadow-fitting camera's forward (view depth = dot(p - shadow_light.xyz, forward));
+    // w: number of shadow views.
     camera_forward: vec4<f32>,
     // x: view mode, y: PCF kernel width in bilinear taps (0 = single nearest compare),
     // z: 1 if hardware linear comparison filtering is used, w: number of lights
@@ -178,7 +180,7 @@ fn bilinear_compare(p: vec2<f32>, layer: i32, depth: f32, size: i32) -> f32 {
 // growing from 0 to 1 across the band (interleaved-gradient dither: no seam line, and every
 // lookup stays a single exact one, which llvmpipe, running both sides of every branch, pays once).
 fn shadow_view_index(p: vec3<f32>, pixel: vec2<f32>) -> i32 {
-    let d = dot(p - frame.camera_position.xyz, frame.camera_forward.xyz);
+    let d = dot(p - frame.shadow_light.xyz, frame.camera_forward.xyz);
     let n = i32(frame.camera_forward.w);
     var c = 0;
     for (var k = 0; k < 3; k++) {

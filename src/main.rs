@@ -27,6 +27,8 @@ fn main() {
         Command::Inspect(a) => inspect(a),
         #[cfg(feature = "sweep")]
         Command::Sweep(a) => sweep(a),
+        #[cfg(feature = "sweep")]
+        Command::Stability(a) => stability(a),
     };
     if let Err(e) = result {
         let msg = format!("{e:#}").replace('\n', " ");
@@ -169,6 +171,73 @@ fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
         resize_script: a.resize_script,
         shadow_budget: a.view.shadow_budget,
     })
+}
+
+#[cfg(feature = "sweep")]
+fn stability(a: app::cli::StabilityArgs) -> anyhow::Result<()> {
+    use umbra::analysis::stability::{report, StabilityOptions};
+    let spec = if a.builtin {
+        "stability".to_string()
+    } else {
+        a.scene.clone().unwrap_or_else(|| "demo".into())
+    };
+    let scene = app::cli::load_named(&spec, a.ground)?;
+    let (w, h) = a.size;
+    let camera = umbra::analysis::grid::sweep_views(&scene, w as f32 / h.max(1) as f32)
+        .into_iter()
+        .next()
+        .map(|v| v.1)
+        .ok_or_else(|| anyhow::anyhow!("{}: no view", scene.name))?;
+    let view = umbra::render::View::new(camera);
+    let wall =
+        (a.builtin || spec == "stability").then_some(umbra::scene::synthetic::STABILITY_WALL_HALF);
+    let ctx = offscreen_context(a.validation, a.device.clone())?;
+    let bar = indicatif::ProgressBar::new(report::planned_steps(a.quick, wall.is_some()));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} [{elapsed_precise}, ETA {eta_precise}] {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let r = report::run(
+        &ctx,
+        &scene,
+        &view,
+        &Default::default(),
+        &StabilityOptions {
+            size: a.size,
+            quick: a.quick,
+        },
+        wall,
+        &mut |phase| {
+            bar.set_message(phase.to_string());
+            bar.inc(1);
+        },
+    )?;
+    bar.finish_and_clear();
+    report::write(&r, &a.out)?;
+    let failed = r.verdicts.iter().filter(|v| v.pass == Some(false)).count();
+    for v in &r.verdicts {
+        let res = match v.pass {
+            Some(true) => "pass",
+            Some(false) => "FAIL",
+            None => "n/a ",
+        };
+        println!("{res}  {}: {}", v.criterion, v.measured);
+    }
+    let total = r.seconds.last().map_or(0.0, |s| s.1);
+    println!(
+        "stability of {}: {} of {} thresholds met in {total:.0} s -> {}",
+        scene.name,
+        r.verdicts.len() - failed,
+        r.verdicts.len(),
+        a.out.join("stability.md").display()
+    );
+    finish_context(ctx)?;
+    if a.strict && failed > 0 {
+        anyhow::bail!("{failed} stability threshold(s) not met");
+    }
+    Ok(())
 }
 
 #[cfg(feature = "sweep")]

@@ -276,19 +276,31 @@ where
 /// Draws the chart of `rows` to `svg` and `png`. Shapes: cross = nearest, small dot = PCF 2×2,
 /// triangle = PCF 3×3, ring = PCF 5×5.
 pub fn write_pareto(rows: &[Row], title: &str, svg: &Path, png: &Path) -> Result<(), ChartError> {
+    write_svg_png(
+        svg,
+        png,
+        |root| draw(root, rows, title),
+        |root| draw(root, rows, title),
+    )
+}
+
+/// Writes one chart of [`SIZE`] twice: `draw_svg` onto an SVG file, `draw_png` onto a bitmap
+/// saved as PNG (text drawn with the embedded font).
+pub(crate) fn write_svg_png(
+    svg: &Path,
+    png: &Path,
+    draw_svg: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> Result<(), String>,
+    draw_png: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> Result<(), String>,
+) -> Result<(), ChartError> {
     register_font();
     let err = |p: &Path, m: String| ChartError {
         path: p.display().to_string(),
         message: m,
     };
-    draw(SVGBackend::new(svg, SIZE).into_drawing_area(), rows, title).map_err(|m| err(svg, m))?;
+    draw_svg(SVGBackend::new(svg, SIZE).into_drawing_area()).map_err(|m| err(svg, m))?;
     let mut buf = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
-    draw(
-        BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area(),
-        rows,
-        title,
-    )
-    .map_err(|m| err(png, m))?;
+    draw_png(BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area())
+        .map_err(|m| err(png, m))?;
     let img = image::RgbImage::from_raw(SIZE.0, SIZE.1, buf)
         .ok_or_else(|| err(png, "buffer size".into()))?;
     img.save(png).map_err(|x| err(png, x.to_string()))

@@ -8,8 +8,10 @@
 pub mod budget;
 pub mod chart;
 pub mod grid;
+pub mod lines;
 pub mod model;
 pub mod pareto;
+pub mod stability;
 pub mod sweep;
 
 pub use grid::{sweep_views, Config, Grid};

@@ -42,6 +42,47 @@ pub enum Command {
     /// Resumes from DIR/sweep.csv when interrupted.
     #[cfg(feature = "sweep")]
     Sweep(SweepArgs),
+    /// Stability where shadow methods fail: sun elevation 0.5°–90° (acne, leaks, the bias
+    /// trade-off), shimmer along a flythrough per shadow method, the scene far from the origin and
+    /// scaled, degenerate views and input; each against the exact reference. Writes
+    /// DIR/stability.json, charts (SVG + PNG) and DIR/stability.md with the thresholds judged.
+    #[cfg(feature = "sweep")]
+    Stability(StabilityArgs),
+}
+
+/// `umbra stability`.
+#[cfg(feature = "sweep")]
+#[derive(Args, Debug)]
+pub struct StabilityArgs {
+    /// A glTF file, `demo`, or a generated scene (`town`, `grazing`, `stability`, …); the demo
+    /// when none.
+    #[arg(conflicts_with = "builtin")]
+    pub scene: Option<String>,
+    /// The built-in stress scene (a thin wall for the contact gap, a box, spheres and a torus).
+    #[arg(long)]
+    pub builtin: bool,
+    /// Output folder.
+    #[arg(long, default_value = "stability")]
+    pub out: PathBuf,
+    /// Fewer angles, frames and cases (a first look; what the tests run).
+    #[arg(long)]
+    pub quick: bool,
+    /// Image size WxH of every probe.
+    #[arg(long, default_value = "640x360", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Add a ground plane under glTF models (as `render --ground`).
+    #[arg(long)]
+    pub ground: bool,
+    /// Exit 1 when a threshold fails (the summary says which either way).
+    #[arg(long)]
+    pub strict: bool,
+    /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Enable the Khronos validation layer: messages are counted per degenerate case, and the
+    /// command exits 1 on any.
+    #[arg(long)]
+    pub validation: bool,
 }
 
 /// `umbra sweep`.
@@ -105,7 +146,7 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
     } else if let Some(s) = umbra::scene::synthetic::by_name(spec) {
         s
     } else {
-        bail!("{spec}: no such file, and not demo, town, grazing, double-sided or spheres:N");
+        bail!("{spec}: no such file, and not demo, town, grazing, stability, double-sided or spheres:N");
     };
     for w in &s.warnings {
         print_warning(&s.name, w);
@@ -279,8 +320,9 @@ pub struct ViewArgs {
     pub no_culling: bool,
     /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided
     /// primitives), `town` (2 km across, cameras at eye height and on a roof), `grazing` (a sun 6° above the
-    /// horizon over posts, spheres and crates) or `spheres:N` (an
-    /// N×N grid of 1,200-triangle spheres).
+    /// horizon over posts, spheres and crates), `stability` (a thin wall, a box, spheres and a
+    /// torus: the stability suite's scene) or `spheres:N` (an N×N grid of 1,200-triangle
+    /// spheres).
     #[arg(long)]
     pub synthetic: Option<String>,
     /// Image size WxH.
@@ -484,7 +526,7 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
         (None, None) => demo_scene(),
         (None, Some(name)) => umbra::scene::synthetic::by_name(name).ok_or_else(|| {
             anyhow!(
-                "--synthetic {name}: expected double-sided, town, grazing or spheres:N with N in 1..=256"
+                "--synthetic {name}: expected double-sided, town, grazing, stability or spheres:N with N in 1..=256"
             )
         })?,
     };

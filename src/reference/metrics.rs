@@ -85,16 +85,41 @@ pub fn flip(reference: &image::RgbaImage, test: &image::RgbaImage) -> f64 {
     nv_flip::FlipPool::from_image(&err).mean() as f64
 }
 
-/// Compares a GPU frame (lit image, shadow view, depth buffer) with the reference for the same
-/// plan. Returns the metrics and a difference image: the reference in grey, false shadow red,
-/// false light blue.
-pub fn compare(
-    gpu_lit: &image::RgbaImage,
+/// How one pixel's GPU shadow classification compares with the exact one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelClass {
+    /// Not judged: GPU and reference see different surfaces (or nothing).
+    Unjudged,
+    /// GPU agrees with the exact visibility.
+    Correct,
+    /// GPU in shadow where the exact answer is lit (acne when away from edges).
+    FalseShadow,
+    /// GPU lit where the exact answer is in shadow (leaks, peter-panning).
+    FalseLight,
+}
+
+/// Per-pixel comparison of a GPU shadow-visibility frame with the reference.
+pub struct Classified {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// The class of each pixel (row-major).
+    pub class: Vec<PixelClass>,
+    /// Within `EDGE_PIXELS` of an exact shadow boundary.
+    pub edge: Vec<bool>,
+    /// Pixels seen by exactly one of GPU and reference (left out).
+    pub coverage_mismatch: usize,
+}
+
+/// Classifies every pixel of a GPU shadow-visibility frame (`gpu_shadow`, thresholded at 0.5, and
+/// its depth buffer) against the reference for the same plan.
+pub fn classify(
     gpu_shadow: &image::RgbaImage,
     gpu_depth: &[f32],
     plan: &FramePlan,
     reference: &ReferenceFrame,
-) -> (Metrics, image::RgbaImage) {
+) -> Classified {
     let (w, h) = (reference.width, reference.height);
     let inv = plan.clip_from_world.inverse();
     let eye = plan.camera_position;
@@ -113,10 +138,6 @@ pub fn compare(
         let r = reference.distance[i];
         ((dist - r).abs() <= 0.01 * r + 1e-4).then_some(vis)
     };
-    let judged: Vec<Option<bool>> = (0..h)
-        .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| same(x, y))
-        .collect();
     // Exact boundary pixels, then the band within EDGE_PIXELS of them.
     let mut boundary = vec![false; (w * h) as usize];
     for y in 0..h as i32 {
@@ -153,36 +174,80 @@ pub fn compare(
             }
         }
     }
+    let mut class = vec![PixelClass::Unjudged; (w * h) as usize];
+    let mut coverage_mismatch = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let Some(exact) = same(x, y) else {
+                if reference.visibility[i].is_some() || gpu_depth[i] > 0.0 {
+                    coverage_mismatch += 1;
+                }
+                continue;
+            };
+            let gpu_lit = gpu_shadow.get_pixel(x, y)[0] >= 128;
+            class[i] = match (exact, gpu_lit) {
+                (true, false) => PixelClass::FalseShadow,
+                (false, true) => PixelClass::FalseLight,
+                _ => PixelClass::Correct,
+            };
+        }
+    }
+    Classified {
+        width: w,
+        height: h,
+        class,
+        edge,
+        coverage_mismatch,
+    }
+}
+
+/// Compares a GPU frame (lit image, shadow view, depth buffer) with the reference for the same
+/// plan. Returns the metrics and a difference image: the reference in grey, false shadow red,
+/// false light blue.
+pub fn compare(
+    gpu_lit: &image::RgbaImage,
+    gpu_shadow: &image::RgbaImage,
+    gpu_depth: &[f32],
+    plan: &FramePlan,
+    reference: &ReferenceFrame,
+) -> (Metrics, image::RgbaImage) {
+    let c = classify(gpu_shadow, gpu_depth, plan, reference);
+    summarise(&c, gpu_lit, reference)
+}
+
+/// The metrics and the difference image of classified pixels (see [`compare`]).
+pub fn summarise(
+    c: &Classified,
+    gpu_lit: &image::RgbaImage,
+    reference: &ReferenceFrame,
+) -> (Metrics, image::RgbaImage) {
+    let (w, h) = (c.width, c.height);
     let mut diff = image::RgbaImage::new(w, h);
-    let (mut n, mut fs, mut fl, mut ne, mut me, mut mi, mut mismatch) =
-        (0usize, 0usize, 0usize, 0usize, 0usize, 0usize, 0usize);
+    let (mut n, mut fs, mut fl, mut ne, mut me, mut mi) =
+        (0usize, 0usize, 0usize, 0usize, 0usize, 0usize);
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
             let g = reference.image.get_pixel(x, y);
             let grey = ((g[0] as u32 + g[1] as u32 + g[2] as u32) / 6) as u8;
             diff.put_pixel(x, y, image::Rgba([grey, grey, grey, 255]));
-            let has_ref = reference.visibility[i].is_some();
-            let has_gpu = gpu_depth[i] > 0.0;
-            let Some(exact) = judged[i] else {
-                if has_ref || has_gpu {
-                    mismatch += 1;
-                }
+            let k = c.class[i];
+            if k == PixelClass::Unjudged {
                 continue;
-            };
+            }
             n += 1;
-            let gpu_lit = gpu_shadow.get_pixel(x, y)[0] >= 128;
-            let wrong = gpu_lit != exact;
-            if edge[i] {
+            let wrong = k != PixelClass::Correct;
+            if c.edge[i] {
                 ne += 1;
                 me += wrong as usize;
             } else {
                 mi += wrong as usize;
             }
-            if exact && !gpu_lit {
+            if k == PixelClass::FalseShadow {
                 fs += 1;
                 diff.put_pixel(x, y, image::Rgba([255, 0, 0, 255]));
-            } else if !exact && gpu_lit {
+            } else if k == PixelClass::FalseLight {
                 fl += 1;
                 diff.put_pixel(x, y, image::Rgba([0, 80, 255, 255]));
             }
@@ -199,7 +264,7 @@ pub fn compare(
         flip: flip(&reference.image, gpu_lit),
         judged_pixels: n,
         edge_pixels: ne,
-        coverage_mismatch: mismatch,
+        coverage_mismatch: c.coverage_mismatch,
     };
     (m, diff)
 }

@@ -8,6 +8,6 @@ pub mod raycast;
 pub mod score;
 
 pub use bvh::{Bvh, Hit};
-pub use metrics::{compare, Metrics};
+pub use metrics::{classify, compare, summarise, Classified, Metrics, PixelClass};
 pub use raycast::{Probe, ReferenceFrame, ReferenceScene};
 pub use score::{score, Scored};

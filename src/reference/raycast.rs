@@ -44,7 +44,13 @@ pub struct ReferenceFrame {
     pub distance: Vec<f32>,
     /// The reference image (sRGB), exact hard shadows.
     pub image: image::RgbaImage,
+    /// Per pixel: the surface seen is curved (its interpolated normal leaves the flat face's by
+    /// more than 1°); false for flat faces and for the background.
+    pub curved: Vec<bool>,
 }
+
+/// cos 1°: a surface whose interpolated normal leaves the face normal by more is curved.
+const CURVED_COS: f32 = 0.999_847_7;
 
 /// What a probe ray found.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -301,7 +307,7 @@ impl<'a> ReferenceScene<'a> {
         let n = (width * height) as usize;
         let c = crate::render::core::CLEAR_COLOR;
         let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];
-        let results: Vec<(Option<bool>, f32, [u8; 4])> = (0..n)
+        let results: Vec<(Option<bool>, f32, [u8; 4], bool)> = (0..n)
             .into_par_iter()
             .map(|i| {
                 let (x, y) = (
@@ -310,9 +316,10 @@ impl<'a> ReferenceScene<'a> {
                 );
                 let ray = primary_ray(&inv, eye, x, y, width, height);
                 match self.bvh.intersect(&ray, 0.0, f32::INFINITY) {
-                    None => (None, f32::INFINITY, background),
+                    None => (None, f32::INFINITY, background, false),
                     Some(h) => {
                         let (vis, rgb) = self.shade(plan, &ray, &h, ambient);
+                        let (ng, n) = self.hit_normals(&h);
                         (
                             Some(vis),
                             h.t,
@@ -322,6 +329,7 @@ impl<'a> ReferenceScene<'a> {
                                 srgb_encode(rgb.z),
                                 255,
                             ],
+                            ng.dot(n).abs() < CURVED_COS,
                         )
                     }
                 }
@@ -337,6 +345,7 @@ impl<'a> ReferenceScene<'a> {
             visibility: results.iter().map(|r| r.0).collect(),
             distance: results.iter().map(|r| r.1).collect(),
             image,
+            curved: results.iter().map(|r| r.3).collect(),
         }
     }
 

@@ -1,7 +1,7 @@
 //! One GPU frame scored against the exact reference: what `umbra compare`, the sweep and the
 //! error budget's checks all measure.
 
-use super::metrics::{compare, Metrics};
+use super::metrics::{classify, summarise, Classified, Metrics};
 use super::raycast::{ReferenceFrame, ReferenceScene};
 use crate::gpu::GpuError;
 use crate::render::{RenderedFrame, Renderer, View, ViewMode};
@@ -14,6 +14,8 @@ pub struct Scored {
     pub diff: image::RgbaImage,
     /// The lit GPU frame (image, plan, timings).
     pub lit: RenderedFrame,
+    /// Every pixel's classification (false shadow, false light, edge band).
+    pub classified: Classified,
     /// Time spent ray-casting the reference in this call (ms; 0 when `exact` was given).
     pub reference_ms: f64,
 }
@@ -41,9 +43,11 @@ pub fn score(
     let frame = exact.get_or_insert_with(|| reference.render(&lit.plan, w, h, view.ambient));
     let reference_ms = t0.elapsed().as_secs_f64() * 1e3;
     let depth = shadow.depth.as_deref().unwrap_or(&[]);
-    let (metrics, diff) = compare(&lit.image, &shadow.image, depth, &lit.plan, frame);
+    let classified = classify(&shadow.image, depth, &lit.plan, frame);
+    let (metrics, diff) = summarise(&classified, &lit.image, frame);
     Ok(Scored {
         metrics,
+        classified,
         diff,
         lit,
         reference_ms,

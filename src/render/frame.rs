@@ -154,6 +154,26 @@ fn cascade_views(
         .collect()
 }
 
+/// Steps per octave of the snapped receiver depth range.
+const DEPTH_RANGE_STEPS_PER_OCTAVE: f32 = 4.0;
+
+/// The receiver depth range widened to steps of 2^(1/4) (near rounded down, far up), within
+/// `limits`: with snapping, the cascade splits (and so each cascade's extent) then change only
+/// when the range crosses a step, not every frame the camera moves.
+pub fn quantise_depth_range(near: f32, far: f32, limits: (f32, f32)) -> (f32, f32) {
+    let q = |x: f32, up: bool| {
+        if !(x.is_finite() && x > 0.0) {
+            return x;
+        }
+        let k = x.log2() * DEPTH_RANGE_STEPS_PER_OCTAVE;
+        let k = if up { k.ceil() } else { k.floor() };
+        (k / DEPTH_RANGE_STEPS_PER_OCTAVE).exp2()
+    };
+    let n = q(near, false).max(limits.0);
+    let f = q(far, true).min(limits.1).max(n);
+    (n, f)
+}
+
 /// The view-depth range (near, far) where the camera frustum meets the receivers' boxes `parts`
 /// (the scene `bounds` when there are none, or too many to clip each), within the frustum's own
 /// range; the frustum's range when nothing is in view.
@@ -280,6 +300,7 @@ pub fn plan_frame(
     hw_compare: bool,
 ) -> FramePlan {
     let lights = effective_lights(scene_lights, view);
+    let fit_camera = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
     let proj = camera_projection(&view.camera, aspect);
     let clip_from_world = proj * view.camera.view_from_world();
     let shadow_light = lights
@@ -291,7 +312,7 @@ pub fn plan_frame(
         let l = &lights[i];
         match l.kind {
             LightKind::Directional => {
-                let fit_cam = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
+                let fit_cam = fit_camera;
                 let fit = |camera| {
                     fit_directional(&DirectionalFitInput {
                         direction: l.direction,
@@ -309,6 +330,10 @@ pub fn plan_frame(
                         // (Per frame, so only when the count is not fixed at one map.)
                         let (near, far) = match view.shadow.cascades {
                             1 => (frustum.near, frustum.far),
+                            _ if view.shadow.snap => {
+                                let (n, f) = receiver_depths(&frustum, bounds, receivers);
+                                quantise_depth_range(n, f, (frustum.near, frustum.far))
+                            }
                             _ => receiver_depths(&frustum, bounds, receivers),
                         };
                         // The automatic count fits one map first; when it stays at one, that is
@@ -357,21 +382,19 @@ pub fn plan_frame(
             0.0,
             if shadows_on { 1.0 } else { 0.0 },
         ),
-        // No shadowed light: an index the shader's light loop never reaches.
-        shadow_light: Vec4::new(
-            0.0,
-            0.0,
-            0.0,
-            shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32),
-        ),
+        // No shadowed light: an index the shader's light loop never reaches. xyz: the eye the
+        // cascades were split from (the fitting camera, which is the view's unless a test or
+        // the stability suite fits the shadows to another camera).
+        shadow_light: fit_camera
+            .position()
+            .extend(shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32)),
         bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
         // Set with the casters (`shadow_pass::plan_casters`); until then every lookup is lit.
         shadow_rect: [Vec4::new(1.0, 1.0, -1.0, -1.0); 4],
         cascade_far: Vec4::splat(f32::MAX),
         cascade_blend: Vec4::splat(f32::MAX),
         cascade_texel: Vec4::ZERO,
-        camera_forward: (view
-            .camera
+        camera_forward: (fit_camera
             .view_from_world()
             .inverse()
             .transform_vector3(Vec3::NEG_Z))

@@ -36,7 +36,8 @@ pub struct FrameUniform {
     pub ambient: Vec4,
     /// x map size, y normal offset (texels), z unused (texel sizes: `cascade_texel`), w enabled.
     pub shadow: Vec4,
-    /// w: index of the shadowed light (`MAX_LIGHTS + 1` when none); xyz unused.
+    /// w: index of the shadowed light (`MAX_LIGHTS + 1` when none); xyz: the eye cascades are
+    /// split from (the shadow-fitting camera's position; view depth = dot(p − eye, forward)).
     pub shadow_light: Vec4,
     /// x constant bias in shadow texels (towards the light).
     pub bias: Vec4,
@@ -49,7 +50,7 @@ pub struct FrameUniform {
     pub cascade_blend: Vec4,
     /// Per cascade: world size of one texel (directional), or per unit distance (spot).
     pub cascade_texel: Vec4,
-    /// xyz: the camera's forward direction (view depth = dot(p − eye, forward)); w: cascade count.
+    /// xyz: the shadow-fitting camera's forward direction; w: cascade count.
     pub camera_forward: Vec4,
     /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
     pub modes: [u32; 4],

@@ -143,6 +143,40 @@ pub fn uv_sphere(radius: f32, segments: u32, rings: u32) -> Primitive {
     p
 }
 
+/// A torus around +Y centred at the origin: tube centre circle of radius `major`, tube radius
+/// `minor`, `segments` around the ring and `sides` around the tube.
+pub fn torus(major: f32, minor: f32, segments: u32, sides: u32) -> Primitive {
+    let mut p = Primitive {
+        material: 0,
+        has_uvs: true,
+        ..Default::default()
+    };
+    for i in 0..=segments {
+        let u = i as f32 / segments as f32;
+        let phi = u * std::f32::consts::TAU;
+        let (sp, cp) = phi.sin_cos();
+        let ring = Vec3::new(cp, 0.0, -sp);
+        for j in 0..=sides {
+            let v = j as f32 / sides as f32;
+            let theta = v * std::f32::consts::TAU;
+            let n = ring * theta.cos() + Vec3::Y * theta.sin();
+            p.positions.push(ring * major + n * minor);
+            p.normals.push(n);
+            p.uvs.push(Vec2::new(u, v));
+            p.tangents.push(Vec3::new(-sp, 0.0, -cp).extend(1.0));
+        }
+    }
+    let row = sides + 1;
+    for i in 0..segments {
+        for j in 0..sides {
+            let a = i * row + j;
+            let b = a + row;
+            p.indices.extend([a, a + 1, b, b, a + 1, b + 1]);
+        }
+    }
+    p
+}
+
 /// Appends a single-primitive mesh with its own material and one instance; returns the mesh index.
 pub fn add_object(
     scene: &mut Scene,

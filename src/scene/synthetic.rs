@@ -2,7 +2,7 @@
 //! (about 52k triangles in 12 primitives, every material double-sided), grids of spheres for
 //! frame time against triangle count, and a town for shadows at every distance.
 
-use super::shapes::{add_object, colored, cuboid, plane, uv_sphere};
+use super::shapes::{add_object, colored, cuboid, plane, torus, uv_sphere};
 use super::{Camera, Light, Scene};
 use glam::{Mat4, Vec3};
 
@@ -214,13 +214,80 @@ pub fn grazing_scene() -> Scene {
     s
 }
 
-/// The generated scene called `name`: `double-sided`, `town`, `grazing` or `spheres:N`
+/// Half extents of the stability scene's thin wall (standing on the ground at the origin, its
+/// broad faces towards ±Z): where peter-panning shows first.
+pub const STABILITY_WALL_HALF: Vec3 = Vec3::new(1.5, 1.0, 0.02);
+
+/// The stability suite's built-in scene (`--builtin`): a 30 m ground, the thin wall
+/// [`STABILITY_WALL_HALF`] at the origin, a 1 m box, two spheres (smooth, 48×32, and coarse,
+/// 12×8) and a torus lying flat (curved receivers that shadow themselves), lit by a sun at 35°
+/// on the wall's +Z side; one camera looking over the wall's shadow.
+pub fn stability_scene() -> Scene {
+    let mut s = Scene {
+        name: "stability".into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "ground",
+        plane(30.0, 1.0),
+        colored(Vec3::splat(0.75), 1.0),
+        Mat4::IDENTITY,
+    );
+    add_object(
+        &mut s,
+        "wall",
+        cuboid(STABILITY_WALL_HALF),
+        colored(Vec3::new(0.7, 0.3, 0.2), 1.0),
+        Mat4::from_translation(Vec3::Y * STABILITY_WALL_HALF.y),
+    );
+    add_object(
+        &mut s,
+        "box",
+        cuboid(Vec3::splat(0.5)),
+        colored(Vec3::new(0.6, 0.45, 0.25), 0.8),
+        Mat4::from_translation(Vec3::new(-3.5, 0.5, 2.0)) * Mat4::from_rotation_y(0.5),
+    );
+    for (i, (segments, rings, x)) in [(48u32, 32u32, 3.0f32), (12, 8, 4.5)]
+        .into_iter()
+        .enumerate()
+    {
+        add_object(
+            &mut s,
+            &format!("sphere {i}"),
+            uv_sphere(0.7, segments, rings),
+            colored(Vec3::new(0.3, 0.45, 0.7), 0.4),
+            Mat4::from_translation(Vec3::new(x, 0.7, 1.5 - 3.0 * i as f32)),
+        );
+    }
+    add_object(
+        &mut s,
+        "torus",
+        torus(0.8, 0.3, 48, 24),
+        colored(Vec3::new(0.5, 0.6, 0.3), 0.5),
+        Mat4::from_translation(Vec3::new(-3.0, 0.3, -3.0)),
+    );
+    s.lights.push(Light::sun(
+        Light::sun_direction(35f32.to_radians(), 0.0),
+        2.0,
+    ));
+    s.cameras.push(Camera::look_at(
+        Vec3::new(5.0, 6.0, -11.0),
+        Vec3::new(0.0, 0.0, -1.5),
+        55f32.to_radians(),
+        0.05,
+    ));
+    s
+}
+
+/// The generated scene called `name`: `double-sided`, `town`, `grazing`, `stability` or `spheres:N`
 /// (1 ≤ N ≤ 256); `None` for any other name.
 pub fn by_name(name: &str) -> Option<Scene> {
     match name {
         "double-sided" => Some(double_sided_scene()),
         "town" => Some(town_scene()),
         "grazing" => Some(grazing_scene()),
+        "stability" => Some(stability_scene()),
         _ => match name.strip_prefix("spheres:").map(str::parse::<u32>) {
             Some(Ok(n)) if (1..=256).contains(&n) => Some(sphere_grid(n)),
             _ => None,

@@ -1,0 +1,272 @@
+//! Stability where shadow methods fail (feature `sweep`): probes that stress a scene where shadow
+//! mapping is known to break, each measured against the exact ray-cast reference and returned as
+//! serialisable rows, then judged against stated thresholds ([`report`]).
+//!
+//! - [`light`]: sun elevation from 0.5° to 90° × azimuths: acne (false shadow away from exact
+//!   edges) on planar and curved receivers, leaks; a bias sweep for the acne / peter-panning
+//!   trade-off; and, on the built-in scene, the contact gap at a thin wall's base in texels.
+//! - [`shimmer`]: a cubic Bézier flythrough; the fraction of fixed world points whose shadow
+//!   classification flips between consecutive frames, per shadow method.
+//! - [`precision`]: the scene translated to 10⁰…10⁶ units and scaled 10⁻³…10⁴.
+//! - [`degenerate`]: degenerate lights, cameras and scenes: each must render with no validation
+//!   message, finite depth and its documented result.
+
+pub mod degenerate;
+pub mod light;
+pub mod precision;
+pub mod report;
+pub mod shimmer;
+
+use crate::gpu::GpuError;
+use crate::reference::{classify, Classified, PixelClass, ReferenceFrame, ReferenceScene};
+use crate::render::{RenderedFrame, Renderer, View, ViewMode};
+use serde::Serialize;
+
+/// Schema name of `stability.json`.
+pub const SCHEMA: &str = "umbra-stability/1";
+
+/// Pixel counts of one frame classified against the exact reference. Acne is false shadow that
+/// does not belong to a misplaced shadow edge or a silhouette: a false-shadow region (8-connected)
+/// that touches no exactly shadowed pixel, no edge band (2 pixels around exact edges,
+/// `reference::metrics::EDGE_PIXELS`) and no silhouette (where one pixel sample of a surface seen
+/// edge-on decides). A shadow drawn too wide, which at grazing sun reaches far past any pixel
+/// band, is false shadow at the edge, not acne. Planar and curved split the judged
+/// pixels by the receiver (curved: interpolated normal more than 1° off the face normal).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Counts {
+    /// Pixels where GPU and reference see the same surface.
+    pub judged: usize,
+    /// Judged pixels on planar receivers.
+    pub planar: usize,
+    /// Judged pixels on curved receivers.
+    pub curved: usize,
+    /// Acne on planar receivers.
+    pub acne_planar: usize,
+    /// Acne on curved receivers.
+    pub acne_curved: usize,
+    /// False shadow attached to an exact shadow, its edge band or a silhouette.
+    pub false_shadow_edge: usize,
+    /// False light away from edges (leaks).
+    pub false_light_interior: usize,
+    /// False light within the edge bands (peter-panning shows here first).
+    pub false_light_edge: usize,
+}
+
+impl Counts {
+    /// Counts the classes of `c` against the exact frame it was classified with.
+    pub fn of(c: &Classified, exact: &ReferenceFrame) -> Self {
+        let attached = attached_false_shadow(c, exact);
+        let mut k = Counts::default();
+        for (i, class) in c.class.iter().enumerate() {
+            if *class == PixelClass::Unjudged {
+                continue;
+            }
+            k.judged += 1;
+            let bent = exact.curved.get(i).copied().unwrap_or(false);
+            if bent {
+                k.curved += 1;
+            } else {
+                k.planar += 1;
+            }
+            match *class {
+                PixelClass::FalseShadow if attached[i] => k.false_shadow_edge += 1,
+                PixelClass::FalseShadow if bent => k.acne_curved += 1,
+                PixelClass::FalseShadow => k.acne_planar += 1,
+                PixelClass::FalseLight if c.edge[i] => k.false_light_edge += 1,
+                PixelClass::FalseLight => k.false_light_interior += 1,
+                _ => {}
+            }
+        }
+        k
+    }
+
+    /// All misclassified pixels.
+    pub fn misclassified(&self) -> usize {
+        self.acne_planar
+            + self.acne_curved
+            + self.false_shadow_edge
+            + self.false_light_interior
+            + self.false_light_edge
+    }
+
+    /// Misclassified fraction of the judged pixels.
+    pub fn misclassified_fraction(&self) -> f64 {
+        fraction(self.misclassified(), self.judged)
+    }
+
+    /// Acne fraction of the judged pixels (planar and curved).
+    pub fn acne_fraction(&self) -> f64 {
+        fraction(self.acne_planar + self.acne_curved, self.judged)
+    }
+
+    /// False-light fraction of the judged pixels (edges and interior).
+    pub fn false_light_fraction(&self) -> f64 {
+        fraction(
+            self.false_light_interior + self.false_light_edge,
+            self.judged,
+        )
+    }
+}
+
+/// Relative jump in distance between neighbouring pixels that marks a silhouette.
+const SILHOUETTE_JUMP: f32 = 0.05;
+
+/// False-shadow pixels 8-connected (through false shadow) to an edge band, to a pixel the exact
+/// answer shadows, or to a silhouette (a neighbour not judged, or more than 5 % nearer or
+/// farther).
+fn attached_false_shadow(c: &Classified, exact: &ReferenceFrame) -> Vec<bool> {
+    let (w, h) = (c.width as i64, c.height as i64);
+    let fs = |i: usize| c.class[i] == PixelClass::FalseShadow;
+    let mut attached = vec![false; c.class.len()];
+    let mut stack: Vec<usize> = Vec::new();
+    let neighbours = |i: usize| {
+        let (x, y) = (i as i64 % w, i as i64 / w);
+        (-1..=1i64)
+            .flat_map(move |dy| (-1..=1i64).map(move |dx| (x + dx, y + dy)))
+            .filter(move |&(nx, ny)| nx >= 0 && ny >= 0 && nx < w && ny < h)
+            .map(move |(nx, ny)| (ny * w + nx) as usize)
+    };
+    let seeds: Vec<usize> = (0..c.class.len())
+        .filter(|&i| {
+            let d = exact.distance[i];
+            fs(i)
+                && (c.edge[i]
+                    || neighbours(i).any(|j| {
+                        exact.visibility[j] == Some(false)
+                            || c.class[j] == PixelClass::Unjudged
+                            || (exact.distance[j] - d).abs() > SILHOUETTE_JUMP * d
+                    }))
+        })
+        .collect();
+    for i in seeds {
+        attached[i] = true;
+        stack.push(i);
+    }
+    while let Some(i) = stack.pop() {
+        for j in neighbours(i) {
+            if fs(j) && !attached[j] {
+                attached[j] = true;
+                stack.push(j);
+            }
+        }
+    }
+    attached
+}
+
+/// a / b, 0 when b is 0.
+pub fn fraction(a: usize, b: usize) -> f64 {
+    if b == 0 {
+        0.0
+    } else {
+        a as f64 / b as f64
+    }
+}
+
+/// Renders `view`'s shadow visibility (with depth) at `w`×`h`.
+pub fn shadow_frame(
+    renderer: &mut Renderer,
+    view: &View,
+    (w, h): (u32, u32),
+) -> Result<RenderedFrame, GpuError> {
+    let mut v = view.clone();
+    v.mode = ViewMode::Shadow;
+    renderer.set_read_depth(true);
+    let f = renderer.render(&v, w, h);
+    renderer.set_read_depth(false);
+    f
+}
+
+/// One frame classified against the exact reference: the counts, the GPU frame and the exact
+/// frame (which depends on the camera and lights only, so a caller may keep it for other shadow
+/// settings of the same view: pass it back as `exact`).
+pub fn classify_view(
+    renderer: &mut Renderer,
+    reference: &ReferenceScene,
+    view: &View,
+    size: (u32, u32),
+    exact: &mut Option<ReferenceFrame>,
+) -> Result<(Counts, RenderedFrame), GpuError> {
+    let f = shadow_frame(renderer, view, size)?;
+    let frame =
+        exact.get_or_insert_with(|| reference.render(&f.plan, size.0, size.1, view.ambient));
+    let c = classify(&f.image, f.depth.as_deref().unwrap_or(&[]), &f.plan, frame);
+    Ok((Counts::of(&c, frame), f))
+}
+
+/// The world size of one texel of the plan's finest shadow view (0 without one).
+pub fn finest_texel(f: &RenderedFrame) -> f64 {
+    f.plan
+        .shadow_views
+        .iter()
+        .map(|v| v.texel_world as f64)
+        .reduce(f64::min)
+        .unwrap_or(0.0)
+}
+
+/// What the suite measures and how finely.
+#[derive(Clone, Debug)]
+pub struct StabilityOptions {
+    /// Frame size for every probe.
+    pub size: (u32, u32),
+    /// Fewer angles, frames and cases (for tests and a first look).
+    pub quick: bool,
+}
+
+impl Default for StabilityOptions {
+    fn default() -> Self {
+        Self {
+            size: (640, 360),
+            quick: false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 12×8 frame on one flat surface: exact shadow in columns 0–3, everything judged.
+    fn frame(gpu_shadow: &[(u32, u32)]) -> (Classified, ReferenceFrame) {
+        let (w, h) = (12u32, 8u32);
+        let n = (w * h) as usize;
+        let visibility: Vec<Option<bool>> = (0..n).map(|i| Some(i as u32 % w >= 4)).collect();
+        let exact = ReferenceFrame {
+            width: w,
+            height: h,
+            visibility,
+            distance: vec![10.0; n],
+            image: image::RgbaImage::new(w, h),
+            curved: vec![false; n],
+        };
+        let mut class = vec![PixelClass::Correct; n];
+        for &(x, y) in gpu_shadow {
+            class[(y * w + x) as usize] = PixelClass::FalseShadow;
+        }
+        // Edge band: columns 2–5 (2 pixels around the boundary between columns 3 and 4).
+        let edge = (0..n).map(|i| (2..=5).contains(&(i as u32 % w))).collect();
+        (
+            Classified {
+                width: w,
+                height: h,
+                class,
+                edge,
+                coverage_mismatch: 0,
+            },
+            exact,
+        )
+    }
+
+    #[test]
+    fn isolated_false_shadow_is_acne_and_a_widened_shadow_is_not() {
+        // A speck in the lit middle: acne.
+        let (c, e) = frame(&[(8, 4), (9, 4)]);
+        let k = Counts::of(&c, &e);
+        assert_eq!((k.acne_planar, k.false_shadow_edge), (2, 0));
+        // The shadow drawn 5 columns too wide (reaching past the edge band): attached, not acne.
+        let wide: Vec<(u32, u32)> = (0..8).flat_map(|y| (4..9).map(move |x| (x, y))).collect();
+        let (c, e) = frame(&wide);
+        let k = Counts::of(&c, &e);
+        assert_eq!((k.acne_planar, k.false_shadow_edge), (0, 40));
+        assert_eq!(k.judged, 96);
+    }
+}

@@ -1,0 +1,178 @@
+//! Shimmer along a camera path: how many fixed world points change shadow classification between
+//! consecutive frames while nothing but the camera moves.
+//!
+//! A world point's classification in frame i is what frame i's shadow maps (fitted to camera i)
+//! say about it. To read both frames' answers at exactly the same points, pair (i, i+1) renders
+//! camera i's pixels twice: with the shadows fitted to camera i (frame i as the user sees it) and
+//! fitted to camera i+1 (frame i+1's maps, cascades chosen by camera i+1's depths). The light and
+//! the points are fixed, so their exact visibility is the same in both; every flip is shimmer.
+//! Points count when camera i+1's frustum contains them too.
+
+use super::{fraction, shadow_frame};
+use crate::gpu::GpuError;
+use crate::math::bezier::CubicBezier;
+use crate::math::projection::pixel_to_ndc;
+use crate::math::Aabb;
+use crate::render::frame::camera_projection;
+use crate::render::{Renderer, ShadowSettings, View};
+use crate::scene::Camera;
+use glam::{Mat4, Vec3, Vec4};
+use serde::Serialize;
+
+/// A shadow method the path is flown with.
+#[derive(Clone, Debug)]
+pub struct Method {
+    /// Its name in the results.
+    pub name: String,
+    /// Its settings.
+    pub shadow: ShadowSettings,
+}
+
+/// The methods compared: a single map fitted to the camera snapped and unsnapped, four cascades
+/// snapped and unsnapped, and the defaults (automatic cascade count).
+pub fn methods(defaults: &ShadowSettings) -> Vec<Method> {
+    let mut out = Vec::new();
+    for (name, cascades, snap) in [
+        ("single map, snapped", 1, true),
+        ("single map, unsnapped", 1, false),
+        ("4 cascades, snapped", 4, true),
+        ("4 cascades, unsnapped", 4, false),
+    ] {
+        out.push(Method {
+            name: name.into(),
+            shadow: ShadowSettings {
+                cascades,
+                snap,
+                ..*defaults
+            },
+        });
+    }
+    out.push(Method {
+        name: "defaults".into(),
+        shadow: *defaults,
+    });
+    out
+}
+
+/// The flythrough (over `frames` frames; the suite takes 4 s at 60 fps): a cubic Bézier from the view's eye, dipping low past the scene's centre (close
+/// to its casters), to the far side a quarter turn around; the camera looks at a target that
+/// drifts across the scene and its field of view narrows to 60 % and back.
+pub fn camera_path(start: &Camera, bounds: &Aabb, frames: usize) -> Vec<Camera> {
+    let c = bounds.center();
+    let radius = (bounds.diagonal() * 0.5).max(1e-6);
+    let eye0 = start.position();
+    let rel = eye0 - c;
+    let turned = Mat4::from_rotation_y(std::f32::consts::FRAC_PI_2).transform_vector3(rel);
+    let low = bounds.min.y + 0.15 * (bounds.max.y - bounds.min.y) + 0.05 * radius;
+    let mut p1 = c + rel * 0.45;
+    p1.y = low.max(c.y - 0.3 * radius);
+    let mut p2 = c + turned * 0.5;
+    p2.y = low + 0.1 * radius;
+    let path = CubicBezier {
+        p: [eye0, p1, p2, c + turned],
+    };
+    let target = CubicBezier {
+        p: [
+            c,
+            c + Vec3::new(0.2, -0.1, 0.0) * radius,
+            c + Vec3::new(-0.2, -0.1, 0.2) * radius,
+            c,
+        ],
+    };
+    (0..frames)
+        .map(|i| {
+            let t = i as f32 / (frames.max(2) - 1) as f32;
+            let fov = start.fov_y * (1.0 - 0.4 * (std::f32::consts::PI * t).sin());
+            let mut cam = Camera::look_at(path.eval(t), target.eval(t), fov, start.near);
+            cam.far = start.far;
+            cam
+        })
+        .collect()
+}
+
+/// One method's flips along the path.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShimmerSeries {
+    /// The method.
+    pub method: String,
+    /// Cascades (0 = automatic).
+    pub cascades: u32,
+    /// Origin snapped to whole texels, extent quantised.
+    pub snapped: bool,
+    /// Per consecutive pair (i, i+1): points compared.
+    pub points: Vec<usize>,
+    /// Per pair: points whose classification flipped.
+    pub flipped: Vec<usize>,
+    /// Mean over pairs of the flipped fraction.
+    pub mean_fraction: f64,
+    /// Largest flipped fraction of one pair.
+    pub max_fraction: f64,
+}
+
+/// Flies `path` with every method; `progress` is called once per frame rendered.
+pub fn shimmer(
+    renderer: &mut Renderer,
+    view: &View,
+    path: &[Camera],
+    methods: &[Method],
+    size: (u32, u32),
+    progress: &mut dyn FnMut(),
+) -> Result<Vec<ShimmerSeries>, GpuError> {
+    let (w, h) = size;
+    let aspect = w as f32 / h.max(1) as f32;
+    let mut out = Vec::new();
+    for m in methods {
+        let (mut points, mut flipped) = (Vec::new(), Vec::new());
+        for pair in path.windows(2) {
+            let mut v = view.clone();
+            v.shadow = m.shadow;
+            v.camera = pair[0];
+            v.shadow_fit_camera = None;
+            let a = shadow_frame(renderer, &v, size)?;
+            v.shadow_fit_camera = Some(pair[1]);
+            let b = shadow_frame(renderer, &v, size)?;
+            progress();
+            progress();
+            let inv = a.plan.clip_from_world.inverse();
+            let next = camera_projection(&pair[1], aspect) * pair[1].view_from_world();
+            let depth = a.depth.as_deref().unwrap_or(&[]);
+            let (mut n, mut f) = (0usize, 0usize);
+            for y in 0..h {
+                for x in 0..w {
+                    let i = (y * w + x) as usize;
+                    let d = depth.get(i).copied().unwrap_or(0.0);
+                    if d <= 0.0 {
+                        continue;
+                    }
+                    let nd = pixel_to_ndc(x as f32 + 0.5, y as f32 + 0.5, w, h);
+                    let p = inv * Vec4::new(nd.x, nd.y, d, 1.0);
+                    let q = next * (p.truncate() / p.w).extend(1.0);
+                    if q.w <= 0.0 || q.x.abs() > q.w || q.y.abs() > q.w {
+                        continue;
+                    }
+                    n += 1;
+                    let lit_a = a.image.get_pixel(x, y)[0] >= 128;
+                    let lit_b = b.image.get_pixel(x, y)[0] >= 128;
+                    f += (lit_a != lit_b) as usize;
+                }
+            }
+            points.push(n);
+            flipped.push(f);
+        }
+        let fr: Vec<f64> = points
+            .iter()
+            .zip(&flipped)
+            .map(|(&n, &f)| fraction(f, n))
+            .collect();
+        out.push(ShimmerSeries {
+            method: m.name.clone(),
+            cascades: m.shadow.cascades,
+            snapped: m.shadow.snap,
+            mean_fraction: fr.iter().sum::<f64>() / fr.len().max(1) as f64,
+            max_fraction: fr.iter().copied().fold(0.0, f64::max),
+            points,
+            flipped,
+        });
+    }
+    Ok(out)
+}
