@@ -59,7 +59,17 @@ fn range(vals: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 }
 
 macro_rules! draw_body {
-    ($chart:ident, $c:ident, $root:ident, $e:ident) => {{
+    ($chart:ident, $c:ident, $root:ident, $e:ident, $fmt_x:ident) => {{
+        $chart
+            .configure_mesh()
+            .x_desc(&$c.x_desc)
+            .y_desc(&$c.y_desc)
+            .x_label_formatter(&$fmt_x)
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 16))
+            .draw()
+            .map_err($e)?;
         for (k, s) in $c.series.iter().enumerate() {
             let color = PALETTE[k % PALETTE.len()];
             let pts: Vec<(f64, f64)> = s
@@ -156,33 +166,13 @@ where
                 y_axis,
             )
             .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc(&c.x_desc)
-            .y_desc(&c.y_desc)
-            .x_label_formatter(&fmt_x)
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 16))
-            .draw()
-            .map_err(e)?;
-        draw_body!(chart, c, root, e);
+        draw_body!(chart, c, root, e, fmt_x);
     } else {
         let pad = ((x1 - x0) * 0.03).max(1e-9);
         let mut chart = builder
             .build_cartesian_2d((x0 - pad)..(x1 + pad), y_axis)
             .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc(&c.x_desc)
-            .y_desc(&c.y_desc)
-            .x_label_formatter(&fmt_x)
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 16))
-            .draw()
-            .map_err(e)?;
-        draw_body!(chart, c, root, e);
+        draw_body!(chart, c, root, e, fmt_x);
     }
     Ok(())
 }
