@@ -36,6 +36,7 @@ pub(crate) mod parallel;
 pub mod reference;
 pub mod render;
 pub mod scene;
+pub mod table;
 
 pub use gpu::{Context, ContextDesc, GpuError, Validation, ValidationLog};
 pub use render::{

@@ -1,66 +1,7 @@
 //! `umbra inspect`'s text and Markdown views of the JSON report (`scene::inspect`).
 
 use serde_json::Value;
-
-/// A table: header and rows, printed aligned (text) or as Markdown.
-struct Table {
-    head: Vec<String>,
-    rows: Vec<Vec<String>>,
-}
-
-impl Table {
-    fn new(head: &[&str]) -> Self {
-        Self {
-            head: head.iter().map(|s| s.to_string()).collect(),
-            rows: Vec::new(),
-        }
-    }
-
-    fn row(&mut self, r: Vec<String>) {
-        self.rows.push(r);
-    }
-
-    fn render(&self, md: bool) -> String {
-        let mut out = String::new();
-        if md {
-            out += &format!("| {} |\n", self.head.join(" | "));
-            out += &format!("|{}\n", "---|".repeat(self.head.len()));
-            for r in &self.rows {
-                out += &format!("| {} |\n", r.join(" | "));
-            }
-            return out;
-        }
-        let n = self.head.len();
-        let mut w = vec![0usize; n];
-        for r in std::iter::once(&self.head).chain(&self.rows) {
-            for (i, c) in r.iter().enumerate().take(n) {
-                w[i] = w[i].max(c.chars().count());
-            }
-        }
-        let line = |r: &Vec<String>| {
-            r.iter()
-                .enumerate()
-                .map(|(i, c)| format!("{c:<width$}", width = w[i]))
-                .collect::<Vec<_>>()
-                .join("  ")
-                .trim_end()
-                .to_string()
-        };
-        out += &line(&self.head);
-        out.push('\n');
-        out += &w
-            .iter()
-            .map(|k| "-".repeat(*k))
-            .collect::<Vec<_>>()
-            .join("  ");
-        out.push('\n');
-        for r in &self.rows {
-            out += &line(r);
-            out.push('\n');
-        }
-        out
-    }
-}
+use umbra::table::Table;
 
 /// A JSON value as a short cell: strings bare, null as "–", arrays joined, floats to 4 digits.
 fn cell(v: &Value) -> String {

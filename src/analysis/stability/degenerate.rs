@@ -4,10 +4,9 @@
 //! edges (at most [`INTERIOR_BOUND`] of judged pixels misclassified), or for the empty scene
 //! nothing but the background.
 
-use super::{classify_view, Counts};
+use super::{classify_scene, Counts};
 use crate::gpu::{Context, GpuError};
-use crate::reference::ReferenceScene;
-use crate::render::{Renderer, SceneOptions, View, ViewMode};
+use crate::render::{SceneOptions, View, ViewMode};
 use crate::scene::shapes::{add_object, colored};
 use crate::scene::{Camera, Light, Primitive, Scene};
 use glam::{Mat4, Vec2, Vec3, Vec4};
@@ -219,9 +218,7 @@ pub fn degenerate(
     for case in cases(scene, view, quick) {
         let s = case.scene.as_ref().unwrap_or(scene);
         let before = ctx.validation_log.problem_count();
-        let mut renderer = Renderer::with_options(ctx, s, options)?;
-        let reference = ReferenceScene::new(s);
-        let (counts, f) = classify_view(&mut renderer, &reference, &case.view, size, &mut None)?;
+        let (counts, f, mut renderer) = classify_scene(ctx, s, options, &case.view, size)?;
         let mut lit_view = case.view.clone();
         lit_view.mode = ViewMode::Lit;
         let lit = renderer.render(&lit_view, size.0, size.1)?;

@@ -193,6 +193,21 @@ pub fn classify_view(
     Ok((Counts::of(&c, frame), f))
 }
 
+/// `view` of `scene` classified on a renderer and a reference of its own, for probes that change
+/// the scene itself; the renderer is returned for further frames.
+pub fn classify_scene(
+    ctx: &std::sync::Arc<crate::gpu::Context>,
+    scene: &crate::scene::Scene,
+    options: &crate::render::SceneOptions,
+    view: &View,
+    size: (u32, u32),
+) -> Result<(Counts, RenderedFrame, Renderer), GpuError> {
+    let mut renderer = Renderer::with_options(ctx, scene, options)?;
+    let reference = ReferenceScene::new(scene);
+    let (c, f) = classify_view(&mut renderer, &reference, view, size, &mut None)?;
+    Ok((c, f, renderer))
+}
+
 /// The world size of one texel of the plan's finest shadow view (0 without one).
 pub fn finest_texel(f: &RenderedFrame) -> f64 {
     f.plan

@@ -7,11 +7,10 @@
 //! standard-z float buffer (an analytic control from `math::precision`: umbra has no standard-z
 //! render path).
 
-use super::{classify_view, finest_texel, Counts};
+use super::{classify_scene, finest_texel, Counts};
 use crate::gpu::{Context, GpuError};
 use crate::math::precision::{relative_gap, DepthMapping};
-use crate::reference::ReferenceScene;
-use crate::render::{Renderer, SceneOptions, View};
+use crate::render::{SceneOptions, View};
 use crate::scene::{LightKind, Scene};
 use glam::{Mat4, Vec3};
 use serde::Serialize;
@@ -118,9 +117,7 @@ pub fn precision(
         let m = Mat4::from_translation(dir * offset as f32)
             * Mat4::from_scale(Vec3::splat(scale as f32));
         let (placed, v) = place(scene, view, m, scale as f32);
-        let mut renderer = Renderer::with_options(ctx, &placed, options)?;
-        let reference = ReferenceScene::new(&placed);
-        let (c, f) = classify_view(&mut renderer, &reference, &v, size, &mut None)?;
+        let (c, f, _) = classify_scene(ctx, &placed, options, &v, size)?;
         progress();
         let far_point = (offset + (centre.length() as f64 + radius) * scale).abs();
         let dist = (view.camera.position() - centre).length() as f64 * scale;

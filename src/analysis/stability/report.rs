@@ -13,6 +13,7 @@ use crate::reference::ReferenceScene;
 use crate::render::frame::ScenePlanner;
 use crate::render::{Renderer, SceneOptions, View};
 use crate::scene::Scene;
+use crate::table::Table;
 use glam::Vec3;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -444,6 +445,17 @@ impl WriteError {
     }
 }
 
+/// The bias sweep's rows: sun directions with more than one bias factor.
+fn bias_rows(r: &StabilityReport) -> impl Iterator<Item = &AngleRow> {
+    r.light_angle.iter().filter(|a| {
+        r.light_angle
+            .iter()
+            .filter(|b| b.elevation_deg == a.elevation_deg && b.azimuth_deg == a.azimuth_deg)
+            .count()
+            > 1
+    })
+}
+
 /// Per elevation at the defaults: the worst over azimuths of `f`.
 fn worst_by_elevation(r: &StabilityReport, f: impl Fn(&AngleRow) -> f64) -> Vec<(f64, f64)> {
     let mut out: Vec<(f64, f64)> = Vec::new();
@@ -491,17 +503,8 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
     let mut bias = Vec::new();
     let mut marks = Vec::new();
     for e in bias_elevations {
-        let rows: Vec<&AngleRow> = r
-            .light_angle
-            .iter()
+        let rows: Vec<&AngleRow> = bias_rows(r)
             .filter(|a| a.elevation_deg == e && a.bias_scale > 0.0)
-            .filter(|a| {
-                r.light_angle
-                    .iter()
-                    .filter(|b| b.elevation_deg == e && b.azimuth_deg == a.azimuth_deg)
-                    .count()
-                    > 1
-            })
             .collect();
         if rows.is_empty() {
             continue;
@@ -654,44 +657,48 @@ pub fn markdown(r: &StabilityReport) -> String {
         total.round(),
         if r.quick { " (quick)" } else { "" }
     );
-    let _ = writeln!(m, "| criterion | measured | result |\n|---|---|---|");
+    let mut t = Table::new(&["criterion", "measured", "result"]);
     for v in &r.verdicts {
         let res = match v.pass {
             Some(true) => "pass",
             Some(false) => "**FAIL**",
             None => "n/a",
         };
-        let _ = writeln!(m, "| {} | {} | {res} |", v.criterion, v.measured);
+        t.row(vec![v.criterion.clone(), v.measured.clone(), res.into()]);
     }
+    m += &t.render(true);
     let _ = writeln!(
         m,
-        "\nAcne: false shadow more than 2 pixels from an exact shadow edge. False light: lit where \
-         the exact answer is shadow (leaks, peter-panning). Fractions are of the pixels where the \
-         GPU and the ray-cast reference see the same surface.\n"
+        "\nAcne: false shadow that touches no exactly shadowed pixel, no 2-pixel band around an \
+         exact shadow edge and no silhouette (a shadow drawn too wide is edge error, not acne). \
+         False light: lit where the exact answer is shadow (leaks, peter-panning). Fractions are \
+         of the pixels where the GPU and the ray-cast reference see the same surface.\n"
     );
     let _ = writeln!(
         m,
         "## Light angle (defaults, worst azimuth)\n\n![light angle](light-angle.png)\n"
     );
-    let _ = writeln!(
-        m,
-        "| sun | acne planar (px) | acne curved (px) | false light | misclassified |\n|---|---|---|---|---|"
-    );
     let ap = worst_by_elevation(r, |a| a.counts.acne_planar as f64);
     let ac = worst_by_elevation(r, |a| a.counts.acne_curved as f64);
     let fl = worst_by_elevation(r, |a| a.false_light);
     let mc = worst_by_elevation(r, |a| a.misclassified);
+    let mut t = Table::new(&[
+        "sun",
+        "acne planar (px)",
+        "acne curved (px)",
+        "false light",
+        "misclassified",
+    ]);
     for i in 0..ap.len() {
-        let _ = writeln!(
-            m,
-            "| {}° | {} | {} | {} | {} |",
-            ap[i].0,
-            ap[i].1,
-            ac[i].1,
+        t.row(vec![
+            format!("{}°", ap[i].0),
+            ap[i].1.to_string(),
+            ac[i].1.to_string(),
             pct(fl[i].1),
-            pct(mc[i].1)
-        );
+            pct(mc[i].1),
+        ]);
     }
+    m += &t.render(true);
     let low: Vec<String> = ap
         .iter()
         .zip(&fl)
@@ -708,78 +715,82 @@ pub fn markdown(r: &StabilityReport) -> String {
             low.join("; ")
         );
     }
-    let _ = writeln!(m, "## Bias trade-off\n\n![bias](bias.png)\n");
-    let _ = writeln!(
-        m,
-        "| sun | bias factor | acne (px) | false light | misclassified |\n|---|---|---|---|---|"
-    );
-    let (be, _) = super::light::bias_sweep(r.quick);
-    for a in r.light_angle.iter().filter(|a| {
-        be.contains(&a.elevation_deg)
-            && r.light_angle
-                .iter()
-                .filter(|b| b.elevation_deg == a.elevation_deg && b.azimuth_deg == a.azimuth_deg)
-                .count()
-                > 1
-    }) {
-        let _ = writeln!(
-            m,
-            "| {}° | {} | {} | {} | {} |",
-            a.elevation_deg,
-            a.bias_scale,
-            a.counts.acne_planar + a.counts.acne_curved,
+    let _ = writeln!(m, "\n## Bias trade-off\n\n![bias](bias.png)\n");
+    let mut t = Table::new(&[
+        "sun",
+        "bias factor",
+        "acne (px)",
+        "false light",
+        "misclassified",
+    ]);
+    for a in bias_rows(r) {
+        t.row(vec![
+            format!("{}°", a.elevation_deg),
+            a.bias_scale.to_string(),
+            (a.counts.acne_planar + a.counts.acne_curved).to_string(),
             pct(a.false_light),
-            pct(a.misclassified)
-        );
+            pct(a.misclassified),
+        ]);
     }
+    m += &t.render(true);
     if !r.contact.is_empty() {
-        let _ = writeln!(
-            m,
-            "\n## Contact gap at the thin wall's base\n\n| sun | texel | points | gap (texels) |\n|---|---|---|---|"
-        );
+        let _ = writeln!(m, "\n## Contact gap at the thin wall's base\n");
+        let mut t = Table::new(&["sun", "texel", "points", "gap (texels)"]);
         for c in &r.contact {
-            let _ = writeln!(
-                m,
-                "| {}° | {:.2e} | {} | {} |",
-                c.elevation_deg,
-                c.texel_world,
-                c.points,
-                c.gap_texels_max.map_or("n/a".into(), |g| format!("{g:.2}"))
-            );
+            t.row(vec![
+                format!("{}°", c.elevation_deg),
+                format!("{:.2e}", c.texel_world),
+                c.points.to_string(),
+                c.gap_texels_max.map_or("n/a".into(), |g| format!("{g:.2}")),
+            ]);
         }
+        m += &t.render(true);
     }
     let _ = writeln!(
         m,
-        "\n## Shimmer along the flythrough ({} frames)\n\n![shimmer](shimmer.png)\n\n| method | mean flipped | worst frame | points per frame |\n|---|---|---|---|",
+        "\n## Shimmer along the flythrough ({} frames)\n\n![shimmer](shimmer.png)\n",
         r.path_frames
     );
+    let mut t = Table::new(&["method", "mean flipped", "worst frame", "points per frame"]);
     for s in &r.shimmer {
         let pts = s.points.iter().sum::<usize>() / s.points.len().max(1);
-        let _ = writeln!(
-            m,
-            "| {} | {:.2e} | {:.2e} | {pts} |",
-            s.method, s.mean_fraction, s.max_fraction
-        );
+        t.row(vec![
+            s.method.clone(),
+            format!("{:.2e}", s.mean_fraction),
+            format!("{:.2e}", s.max_fraction),
+            pts.to_string(),
+        ]);
     }
+    m += &t.render(true);
     let _ = writeln!(
         m,
-        "\n## Precision\n\n![precision](precision.png) ![scale](scale.png)\n\n| offset | scale | misclassified | acne | × origin | f32 position step | finest texel | depth step reversed-z | depth step standard-z (analytic) |\n|---|---|---|---|---|---|---|---|---|"
+        "\n## Precision\n\n![precision](precision.png) ![scale](scale.png)\n"
     );
+    let mut t = Table::new(&[
+        "offset",
+        "scale",
+        "misclassified",
+        "acne",
+        "× origin",
+        "f32 position step",
+        "finest texel",
+        "depth step reversed-z",
+        "depth step standard-z (analytic)",
+    ]);
     for p in &r.precision {
-        let _ = writeln!(
-            m,
-            "| {:.0e} | {:.0e} | {} | {} | {:.2} | {:.2e} | {:.2e} | {:.2e} | {:.2e} |",
-            p.offset,
-            p.scale,
+        t.row(vec![
+            format!("{:.0e}", p.offset),
+            format!("{:.0e}", p.scale),
             pct(p.misclassified),
             pct(p.acne),
-            p.ratio_to_origin,
-            p.position_step,
-            p.texel_world,
-            p.depth_step_reversed,
-            p.depth_step_standard
-        );
+            format!("{:.2}", p.ratio_to_origin),
+            format!("{:.2e}", p.position_step),
+            format!("{:.2e}", p.texel_world),
+            format!("{:.2e}", p.depth_step_reversed),
+            format!("{:.2e}", p.depth_step_standard),
+        ]);
     }
+    m += &t.render(true);
     let _ = writeln!(
         m,
         "\numbra sends world-space positions to the GPU in f32, so far from the origin the \
@@ -787,25 +798,31 @@ pub fn markdown(r: &StabilityReport) -> String {
          The camera-depth columns compare umbra's reversed-z float buffer with a standard-z float \
          buffer at the same view distance (analytic: umbra has no standard-z path).\n"
     );
-    let _ = writeln!(
-        m,
-        "## Degenerate views and input\n\n| case | documented result | triangles | validation | finite | interior misclassified | GPU ms | result |\n|---|---|---|---|---|---|---|---|"
-    );
+    let _ = writeln!(m, "## Degenerate views and input\n");
+    let mut t = Table::new(&[
+        "case",
+        "documented result",
+        "triangles",
+        "validation",
+        "finite",
+        "interior misclassified",
+        "GPU ms",
+        "result",
+    ]);
     for d in &r.degenerate {
-        let _ = writeln!(
-            m,
-            "| {} | {} | {} | {} | {} | {} | {} | {} |",
-            d.case,
-            d.expected,
-            d.triangles,
+        t.row(vec![
+            d.case.clone(),
+            d.expected.clone(),
+            d.triangles.to_string(),
             d.validation_messages
                 .map_or("off".into(), |n| format!("{n} messages")),
-            d.finite,
+            d.finite.to_string(),
             pct(d.interior_misclassified),
             d.gpu_ms.map_or("n/a".into(), |g| format!("{g:.1}")),
-            if d.ok { "pass" } else { "**FAIL**" }
-        );
+            if d.ok { "pass" } else { "**FAIL**" }.into(),
+        ]);
     }
+    m += &t.render(true);
     let _ = writeln!(m, "\n## Runtime\n");
     for (name, s) in &r.seconds {
         let _ = writeln!(m, "- {name}: {s:.1} s");
