@@ -168,7 +168,7 @@ fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
         screenshot: a.screenshot,
         device: a.device,
         validation: a.validation,
-        resize_script: a.resize_script,
+        script: app::script::expand(&a.script).map_err(|e| anyhow::anyhow!("--script: {e}"))?,
         shadow_budget: a.view.shadow_budget,
     })
 }
@@ -494,6 +494,18 @@ fn median_of(frames: &[FrameStats], f: &dyn Fn(&FrameStats) -> Option<f64>) -> O
     (!v.is_empty()).then(|| v[v.len() / 2])
 }
 
+/// Milliseconds with three significant digits down to a microsecond (GPU frames run from
+/// tenths of a millisecond to hundreds).
+fn fmt_ms(ms: f64) -> String {
+    if ms < 1.0 {
+        format!("{ms:.3}")
+    } else if ms < 10.0 {
+        format!("{ms:.2}")
+    } else {
+        format!("{ms:.1}")
+    }
+}
+
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut base = make_view(&scene, &a.view)?;
@@ -555,7 +567,11 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
                 format!("{:?}", v.shadow.pcf)
             };
             println!(
-                "| {map_label} | {pcf} | {sh:.1} | {cam:.1} | {tot:.1} | {wall:.1} | {} |",
+                "| {map_label} | {pcf} | {} | {} | {} | {} | {} |",
+                fmt_ms(sh),
+                fmt_ms(cam),
+                fmt_ms(tot),
+                fmt_ms(wall),
                 frames[0].casters_drawn
             );
         }

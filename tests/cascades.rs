@@ -76,7 +76,7 @@ struct Errors {
 /// Errors of frame `f`; the unjudged edge bands come from `bands` (the same plan for every
 /// method compared, so a coarse method is not excused by its own coarse texels).
 fn judge(f: &RenderedFrame, bands: &RenderedFrame, cam: &Camera) -> Errors {
-    let m = f.plan.clip_from_world;
+    let m = f.plan.clip_from_scene();
     let boxes = aabbs();
     let eye = cam.position();
     let forward = (cam.view_from_world().inverse()).transform_vector3(-Vec3::Z);

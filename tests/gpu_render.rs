@@ -151,7 +151,7 @@ fn lit_surface_matches_blinn_phong_on_cpu() {
     let m = blinn_phong_params(base, 0.0, 0.6);
     let mut worst = 0.0f32;
     for (px, py) in [(32, 32), (10, 50), (50, 12)] {
-        let (o, d) = pixel_ray(&f.plan.clip_from_world, px, py, w, h);
+        let (o, d) = pixel_ray(&f.plan.clip_from_scene(), px, py, w, h);
         let p = o + d * (-o.z / d.z);
         let v = (eye - p).normalize();
         let lin = m.ka * view.ambient

@@ -126,7 +126,7 @@ fn judge(
     light: &Light,
     band: f32,
 ) -> (Judged, image::RgbaImage) {
-    let m = frame.plan.clip_from_world;
+    let m = frame.plan.clip_from_scene();
     let mut diff = frame.image.clone();
     let mut j = Judged {
         judged: 0,
@@ -316,7 +316,7 @@ fn no_acne_on_a_plane_from_10_to_90_degrees() {
             view.sun_direction = Some(dir);
             view.shadow.format = depth_format;
             let f = r.render(&view, W, H).unwrap();
-            let m = f.plan.clip_from_world;
+            let m = f.plan.clip_from_scene();
             let mut ground = 0;
             let mut shadowed = 0;
             for y in 0..H {
@@ -358,7 +358,7 @@ fn shadow_touches_the_casters_base_within_two_texels() {
         );
         let f = r.render(&shadow_view(camera), W, H).unwrap();
         let texel = f.plan.texel_world();
-        let m = f.plan.clip_from_world;
+        let m = f.plan.clip_from_scene();
         let mut checked = 0;
         for k in -12..=12 {
             let p = Vec3::new(k as f32 * 0.1, 0.0, -(half.z + 2.0 * texel));

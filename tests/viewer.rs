@@ -230,3 +230,60 @@ fn viewer_soak_with_resizes_keeps_memory_flat() {
     // tests/soak.rs bounds steady growth at 2 MB). A leak of 10 kB a frame would add 4 MB here.
     assert!(growth < 4.0, "viewer memory grew: {line}");
 }
+
+/// The viewer survives what breaks renderers (issue: stability): the sun dragged down through
+/// the horizon to straight below, the camera zoomed onto its near plane and back, 1,000 scripted
+/// resizes (minimising, 1×1 and odd sizes among them), all with validation on: the run ends
+/// cleanly, prints every sun step down to −90°, and its last screenshot (framed again with `F`)
+/// has the last size and shows the scene (not one flat colour).
+#[test]
+fn viewer_survives_sun_below_horizon_near_plane_zoom_and_1000_resizes() {
+    let x = Xvfb::start();
+    let shot = out("viewer_survival.png");
+    let sizes = [
+        "64x48", "0x0", "1x1", "97x13", "13x97", "160x120", "2x300", "333x77",
+    ];
+    let mut script = vec!["key:down*40".to_string(), "wheel:3*60".to_string()];
+    script.extend(sizes.iter().cycle().take(1000).map(|s| s.to_string()));
+    script.push("wheel:-3*60".into()); // out to the far clamp (100× the scene's size)
+    script.push("key:up*40".into());
+    script.push("key:f".into()); // frame the scene again
+    script.push("120x90".into());
+    let script = script.join(",");
+    let (ok, log) = umbra(
+        &[
+            "view",
+            "--frames",
+            "10",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--size",
+            "120x90",
+            "--no-vsync",
+            "--validation",
+            "--script",
+            &script,
+        ],
+        Some(&x.display),
+    );
+    assert!(
+        ok,
+        "viewer failed:\n{}",
+        &log[log.len().saturating_sub(4000)..]
+    );
+    assert!(!log.contains("panicked"), "{log}");
+    assert!(
+        log.contains("sun: elevation -90°") && log.contains("below the horizon"),
+        "the sun went below the horizon:\n{}",
+        &log[..log.len().min(4000)]
+    );
+    let img = image::open(&shot).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (120, 90));
+    let first = img.get_pixel(0, 0);
+    let distinct = img.pixels().filter(|p| *p != first).count();
+    // Measured: 1,284 of 10,800 pixels differ from the corner (the framed demo scene).
+    assert!(
+        distinct > 1000,
+        "a flat screenshot: {distinct} pixels differ"
+    );
+}

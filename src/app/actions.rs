@@ -65,12 +65,19 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 Action::SunLeft => sun.azimuth -= 5.0,
                 Action::SunRight => sun.azimuth += 5.0,
                 Action::SunUp => sun.elevation = (sun.elevation + 5.0).min(90.0),
-                _ => sun.elevation = (sun.elevation - 5.0).max(1.0),
+                _ => sun.elevation = (sun.elevation - 5.0).max(-90.0),
             }
             sun.azimuth = (sun.azimuth + 540.0) % 360.0 - 180.0;
             view.sun_direction = Some(sun.direction());
+            let note = if sun.elevation < 0.0 {
+                " (below the horizon: upward faces unlit, the shadow map fitted from below)"
+            } else if sun.elevation < 1.0 {
+                " (on the horizon: upward faces unlit)"
+            } else {
+                ""
+            };
             format!(
-                "sun: elevation {:.0}°, azimuth {:.0}°",
+                "sun: elevation {:.0}°, azimuth {:.0}°{note}",
                 sun.elevation, sun.azimuth
             )
         }
@@ -144,10 +151,16 @@ mod tests {
         assert!(msg.contains("elevation 35"));
         let d = v.sun_direction.unwrap();
         assert!((SunAngles::from_direction(d).elevation - 35.0).abs() < 1e-3);
+        for _ in 0..7 {
+            apply(Action::SunDown, &mut v, &mut sun);
+        }
+        let msg = apply(Action::SunDown, &mut v, &mut sun);
+        assert_eq!(sun.elevation, -5.0);
+        assert!(msg.contains("below the horizon"), "{msg}");
         for _ in 0..40 {
             apply(Action::SunDown, &mut v, &mut sun);
         }
-        assert_eq!(sun.elevation, 1.0);
+        assert_eq!(sun.elevation, -90.0, "clamped straight up");
         for _ in 0..72 {
             apply(Action::SunRight, &mut v, &mut sun);
         }

@@ -229,16 +229,12 @@ pub struct ViewArgsCmd {
     /// Enable the Khronos validation layer; exit 1 on any warning or error.
     #[arg(long)]
     pub validation: bool,
-    /// Testing: window sizes to go through, e.g. 400x300,0x0,640x480 (0x0 simulates minimising).
-    #[arg(long, value_delimiter = ',', value_parser = parse_size_or_zero, hide = true)]
-    pub resize_script: Vec<(u32, u32)>,
-}
-
-fn parse_size_or_zero(s: &str) -> Result<(u32, u32), String> {
-    if s.trim() == "0x0" {
-        return Ok((0, 0));
-    }
-    parse_size(s)
+    /// Automation: inputs to play, one every two frames, comma-separated, each optionally
+    /// repeated with `*N`: `WxH` resizes (0x0 minimises), `key:NAME` presses a key (up down left
+    /// right [ ] k + - v h f tab c p), `wheel:N` scrolls N lines (positive zooms in); e.g.
+    /// `key:down*40,wheel:1*80,640x360`. With --frames, the run ends after the last step.
+    #[arg(long, alias = "resize-script", value_delimiter = ',', value_parser = super::script::parse_item)]
+    pub script: Vec<(super::script::ScriptStep, u32)>,
 }
 
 /// `umbra compare`.

@@ -10,6 +10,8 @@ pub mod cli;
 pub mod controller;
 pub mod inspect_view;
 #[cfg(feature = "viewer")]
+pub mod script;
+#[cfg(feature = "viewer")]
 pub mod viewer;
 
 /// The binary's pipeline cache file: `UMBRA_PIPELINE_CACHE` (a path, or `off`), else the user's

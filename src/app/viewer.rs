@@ -9,6 +9,7 @@
 
 use super::actions::{apply, Action, SunAngles};
 use super::controller::{Button, Controller, Input, MoveKey};
+use super::script::ScriptStep;
 use anyhow::{anyhow, Context as _};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -45,14 +46,14 @@ pub struct ViewerOptions {
     pub device: Option<String>,
     /// Khronos validation on (exit 1 on any message).
     pub validation: bool,
-    /// Window sizes to go through, one every few frames (testing); 0×0 simulates minimising.
-    pub resize_script: Vec<(u32, u32)>,
+    /// Inputs to play, one every few frames (automation, tests): `super::script`.
+    pub script: Vec<ScriptStep>,
     /// Re-choose the shadow settings for this misclassification budget as the camera moves.
     pub shadow_budget: Option<f64>,
 }
 
-/// Frames between two resize-script steps.
-const SCRIPT_STEP_FRAMES: u64 = 4;
+/// Frames between two script steps.
+const SCRIPT_STEP_FRAMES: u64 = 2;
 /// Frames after which resident memory is sampled for the end-of-run report.
 const WARM_UP_FRAMES: u64 = 100;
 
@@ -72,6 +73,28 @@ enum KeyAction {
     NextCamera,
     Screenshot,
     Quit,
+}
+
+/// The key a script names (`super::script::KEYS`).
+fn script_key(name: &str) -> Option<KeyCode> {
+    Some(match name {
+        "up" => KeyCode::ArrowUp,
+        "down" => KeyCode::ArrowDown,
+        "left" => KeyCode::ArrowLeft,
+        "right" => KeyCode::ArrowRight,
+        "[" => KeyCode::BracketLeft,
+        "]" => KeyCode::BracketRight,
+        "k" => KeyCode::KeyK,
+        "+" => KeyCode::Equal,
+        "-" => KeyCode::Minus,
+        "v" => KeyCode::KeyV,
+        "h" => KeyCode::KeyH,
+        "f" => KeyCode::KeyF,
+        "tab" => KeyCode::Tab,
+        "c" => KeyCode::KeyC,
+        "p" => KeyCode::KeyP,
+        _ => return None,
+    })
 }
 
 fn key_action(code: KeyCode) -> Option<KeyAction> {
@@ -240,28 +263,47 @@ impl App {
     }
 
     fn redraw(&mut self, el: &ActiveEventLoop) -> anyhow::Result<()> {
+        // Input script (automation): one step every few frames.
+        let step = {
+            let Some(s) = self.state.as_mut() else {
+                return Ok(());
+            };
+            s.ticks += 1;
+            let due = s.ticks % SCRIPT_STEP_FRAMES == 0 && s.script_pos < self.opts.script.len();
+            due.then(|| {
+                s.script_pos += 1;
+                self.opts.script[s.script_pos - 1]
+            })
+        };
+        if let Some(step) = step {
+            let s = self.state.as_mut().expect("state");
+            match step {
+                ScriptStep::Resize(0, _) | ScriptStep::Resize(_, 0) => {
+                    // What a minimised window reports on platforms that do: a 0×0 resize.
+                    s.minimized = true;
+                    s.renderer.resize(0, 0)?;
+                }
+                ScriptStep::Resize(w, h) => {
+                    s.minimized = false;
+                    let now = s
+                        .window
+                        .request_inner_size(PhysicalSize::new(w, h))
+                        .unwrap_or_else(|| s.window.inner_size());
+                    s.renderer.resize(now.width, now.height)?;
+                }
+                ScriptStep::Key(name) => {
+                    if let Some(code) = script_key(name) {
+                        self.key(el, code, true);
+                        self.key(el, code, false);
+                    }
+                }
+                ScriptStep::Wheel(lines) => self.wheel(lines),
+            }
+        }
         let opts = &self.opts;
         let Some(s) = self.state.as_mut() else {
             return Ok(());
         };
-        s.ticks += 1;
-        // Resize script (automation): one step every few frames.
-        if s.ticks % SCRIPT_STEP_FRAMES == 0 && s.script_pos < opts.resize_script.len() {
-            let (w, h) = opts.resize_script[s.script_pos];
-            s.script_pos += 1;
-            if w == 0 || h == 0 {
-                // What a minimised window reports on platforms that do: a 0×0 resize.
-                s.minimized = true;
-                s.renderer.resize(0, 0)?;
-            } else {
-                s.minimized = false;
-                let now = s
-                    .window
-                    .request_inner_size(PhysicalSize::new(w, h))
-                    .unwrap_or_else(|| s.window.inner_size());
-                s.renderer.resize(now.width, now.height)?;
-            }
-        }
         let now = Instant::now();
         let dt = (now - s.last_frame).as_secs_f32().min(0.25);
         s.last_frame = now;
@@ -285,7 +327,7 @@ impl App {
                 }
             }
         }
-        let last_scripted = s.script_pos >= opts.resize_script.len();
+        let last_scripted = s.script_pos >= opts.script.len();
         let final_frame = opts.frames.is_some_and(|n| s.drawn + 1 >= n) && last_scripted;
         let shot = s.want_screenshot || (final_frame && opts.screenshot.is_some());
         let t0 = Instant::now();
@@ -348,6 +390,13 @@ impl App {
             el.exit();
         }
         Ok(())
+    }
+
+    fn wheel(&mut self, lines: f32) {
+        if let Some(s) = self.state.as_mut() {
+            s.camera_index = None;
+            s.controller.handle(Input::Scroll(lines));
+        }
     }
 
     fn key(&mut self, el: &ActiveEventLoop, code: KeyCode, pressed: bool) {
@@ -469,10 +518,7 @@ impl ApplicationHandler for App {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                 };
-                if let Some(s) = self.state.as_mut() {
-                    s.camera_index = None;
-                    s.controller.handle(Input::Scroll(lines));
-                }
+                self.wheel(lines);
                 Ok(())
             }
             _ => Ok(()),
@@ -484,7 +530,7 @@ impl ApplicationHandler for App {
 
     fn about_to_wait(&mut self, el: &ActiveEventLoop) {
         if let Some(s) = &self.state {
-            let scripted = s.script_pos < self.opts.resize_script.len();
+            let scripted = s.script_pos < self.opts.script.len();
             if s.minimized && !scripted {
                 el.set_control_flow(ControlFlow::Wait);
             } else {

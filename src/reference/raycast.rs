@@ -7,7 +7,7 @@ use crate::math::projection::pixel_to_ndc;
 use crate::math::ray::Ray;
 use crate::render::frame::FramePlan;
 use crate::scene::{blinn_phong_params, shade_blinn_phong, LightKind, Scene, Texture};
-use glam::{Mat3, Vec2, Vec3, Vec4};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 /// Where a world triangle came from.
@@ -21,8 +21,14 @@ struct TriRef {
 }
 
 /// A scene prepared for ray casting: world-space triangles in a BVH, plus what shading needs.
+/// Like the renderer, it works relative to [`Scene::render_origin`] (rays, hits and the plans it
+/// reads are in those coordinates).
 pub struct ReferenceScene<'a> {
     scene: &'a Scene,
+    /// Each instance's model → world relative to `origin`.
+    matrices: Vec<Mat4>,
+    /// The point its coordinates are relative to.
+    pub origin: Vec3,
     /// The hierarchy.
     pub bvh: Bvh,
     refs: Vec<TriRef>,
@@ -110,8 +116,15 @@ impl<'a> ReferenceScene<'a> {
         let mut tris = Vec::new();
         let mut refs = Vec::new();
         let mut normal_mats = Vec::new();
+        let origin = scene.render_origin();
+        let matrices: Vec<Mat4> = scene
+            .instances
+            .iter()
+            .map(|i| crate::scene::rebased(i.world_from_model, origin))
+            .collect();
         for (ii, inst) in scene.instances.iter().enumerate() {
-            let m3 = Mat3::from_mat4(inst.world_from_model);
+            let world_from_model = matrices[ii];
+            let m3 = Mat3::from_mat4(world_from_model);
             normal_mats.push(if m3.determinant().abs() > 1e-30 {
                 m3.inverse().transpose()
             } else {
@@ -121,7 +134,7 @@ impl<'a> ReferenceScene<'a> {
                 let world: Vec<Vec3> = p
                     .positions
                     .iter()
-                    .map(|v| inst.world_from_model.transform_point3(*v))
+                    .map(|v| world_from_model.transform_point3(*v))
                     .collect();
                 for (k, t) in p.indices.chunks_exact(3).enumerate() {
                     tris.push([
@@ -146,6 +159,8 @@ impl<'a> ReferenceScene<'a> {
         let eps = (scene.bounds().diagonal() * 2e-5).max(1e-6);
         Self {
             scene,
+            matrices,
+            origin,
             bvh,
             refs,
             normal_mats,
@@ -241,9 +256,9 @@ impl<'a> ReferenceScene<'a> {
     fn hit_normals(&self, h: &Hit) -> (Vec3, Vec3) {
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
-        let inst = &self.scene.instances[r.instance as usize];
+        let world_from_model = self.matrices[r.instance as usize];
         let idx = [0, 1, 2].map(|k| prim.indices[r.first as usize + k] as usize);
-        let pw = idx.map(|i| inst.world_from_model.transform_point3(prim.positions[i]));
+        let pw = idx.map(|i| world_from_model.transform_point3(prim.positions[i]));
         let ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
         if prim.normals.len() != prim.positions.len() {
             return (ng, ng);
@@ -266,6 +281,10 @@ impl<'a> ReferenceScene<'a> {
         width: u32,
         height: u32,
     ) -> Vec<Option<Probe>> {
+        debug_assert_eq!(
+            plan.origin, self.origin,
+            "plan and reference share an origin"
+        );
         let inv = plan.clip_from_world.inverse();
         let eye = plan.camera_position;
         pixels
@@ -302,6 +321,10 @@ impl<'a> ReferenceScene<'a> {
         height: u32,
         ambient: Vec3,
     ) -> ReferenceFrame {
+        debug_assert_eq!(
+            plan.origin, self.origin,
+            "plan and reference share an origin"
+        );
         let inv = plan.clip_from_world.inverse();
         let eye = plan.camera_position;
         let n = (width * height) as usize;
@@ -352,7 +375,6 @@ impl<'a> ReferenceScene<'a> {
     fn shade(&self, plan: &FramePlan, ray: &Ray, h: &Hit, ambient: Vec3) -> (bool, Vec3) {
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
-        let inst = &self.scene.instances[r.instance as usize];
         let idx = [
             prim.indices[r.first as usize] as usize,
             prim.indices[r.first as usize + 1] as usize,
@@ -360,7 +382,7 @@ impl<'a> ReferenceScene<'a> {
         ];
         let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
         let p = ray.at(h.t);
-        let m3 = Mat3::from_mat4(inst.world_from_model);
+        let m3 = Mat3::from_mat4(self.matrices[r.instance as usize]);
         let (ng, mut n_geo) = self.hit_normals(h);
         let uv = prim.uvs[idx[0]] * w.x + prim.uvs[idx[1]] * w.y + prim.uvs[idx[2]] * w.z;
         let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];

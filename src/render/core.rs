@@ -66,6 +66,9 @@ pub struct FrameCore {
     timestamps_written: Vec<bool>,
     /// World bounds of every draw (the receivers cascades are split over).
     receiver_bounds: Vec<crate::math::Aabb>,
+    /// What the GPU's world coordinates are relative to ([`Scene::render_origin`]): draws,
+    /// lights and the planned matrices; views are rebased in [`FrameCore::prepare`].
+    pub origin: glam::Vec3,
 }
 
 impl FrameCore {
@@ -77,7 +80,8 @@ impl FrameCore {
         color_format: vk::Format,
         slots: usize,
     ) -> Result<Self, GpuError> {
-        let gpu = GpuScene::new(ctx, scene, options)?;
+        let origin = scene.render_origin();
+        let gpu = GpuScene::new(ctx, scene, options, origin)?;
         let receiver_bounds = gpu.draws.iter().map(|d| d.world_bounds).collect();
         let shadow = ShadowPass::new(ctx)?;
         let camera = CameraPass::new(ctx, &gpu, color_format, slots)?;
@@ -92,7 +96,8 @@ impl FrameCore {
         .vk("vkCreateQueryPool")?;
         Ok(Self {
             ctx: ctx.clone(),
-            lights: scene.lights.clone(),
+            lights: scene.lights.iter().map(|l| l.rebased(origin)).collect(),
+            origin,
             gpu,
             shadow,
             camera,
@@ -117,7 +122,7 @@ impl FrameCore {
             1
         };
         let hw = self.shadow.hardware_filtering(view.shadow.format);
-        let mut v = view.clone();
+        let mut v = view.rebased(self.origin);
         v.shadow.map_size = map_size;
         let mut plan = plan_frame(
             &self.lights,
@@ -128,6 +133,7 @@ impl FrameCore {
             height,
             hw,
         );
+        plan.origin = self.origin;
         let layers = plan.shadow_views.len().max(1) as u32;
         self.shadow
             .ensure_map(map_size, view.shadow.format, layers)?;

@@ -225,9 +225,24 @@ pub struct FramePlan {
     pub clip_from_world: Mat4,
     /// The shadow pass's casters and area per shadow view (set by `FrameCore::prepare`).
     pub casters: Vec<CasterPlan>,
+    /// What every position and matrix of this plan is relative to (world = plan + origin):
+    /// [`crate::scene::Scene::render_origin`] when planned by the renderer, zero from
+    /// [`plan_frame`].
+    pub origin: Vec3,
 }
 
 impl FramePlan {
+    /// The camera's clip from *absolute* world coordinates (`clip_from_world` is relative to
+    /// `origin`); for callers that work in the scene's own coordinates near the origin (f32
+    /// precision is that of the absolute coordinates).
+    pub fn clip_from_scene(&self) -> Mat4 {
+        if self.origin == Vec3::ZERO {
+            self.clip_from_world
+        } else {
+            self.clip_from_world * Mat4::from_translation(-self.origin)
+        }
+    }
+
     /// World size of a texel of the first (nearest) shadow view (directional), or per unit
     /// distance (spot); 0 without a shadow map.
     pub fn texel_world(&self) -> f32 {
@@ -247,41 +262,48 @@ impl FramePlan {
 }
 
 /// What planning a frame of one scene needs, gathered once (CPU only: no GPU scene), for tools
-/// that plan many views or settings (`umbra inspect`, the error budget).
+/// that plan many views or settings (`umbra inspect`, the error budget). Like the renderer, it
+/// works relative to the scene's [`crate::scene::Scene::render_origin`]: its plans (and the
+/// draw boxes) are rebased, with `FramePlan::origin` saying by how much.
 pub struct ScenePlanner {
     lights: Vec<Light>,
     bounds: Aabb,
     receivers: Vec<Aabb>,
+    origin: Vec3,
 }
 
 impl ScenePlanner {
     /// Gathers `scene`'s lights, bounds and draw boxes.
     pub fn new(scene: &crate::scene::Scene) -> Self {
-        let receivers = scene.draw_bounds();
+        let origin = scene.render_origin();
+        let receivers = scene.draw_bounds_rebased(origin);
         let bounds = receivers.iter().fold(Aabb::EMPTY, |b, r| b.union(r)); // = scene.bounds()
         Self {
-            lights: scene.lights.clone(),
+            lights: scene.lights.iter().map(|l| l.rebased(origin)).collect(),
             bounds,
             receivers,
+            origin,
         }
     }
 
-    /// The draw boxes.
+    /// The draw boxes (relative to the render origin).
     pub fn receivers(&self) -> &[Aabb] {
         &self.receivers
     }
 
     /// The plan the renderer makes for `view` at `w`×`h`.
     pub fn plan(&self, view: &View, w: u32, h: u32) -> FramePlan {
-        plan_frame(
+        let mut plan = plan_frame(
             &self.lights,
             &self.bounds,
             &self.receivers,
-            view,
+            &view.rebased(self.origin),
             w as f32 / h.max(1) as f32,
             h,
             false,
-        )
+        );
+        plan.origin = self.origin;
+        plan
     }
 }
 
@@ -447,6 +469,7 @@ pub fn plan_frame(
         shadow_views: views,
         clip_from_world,
         casters: Vec::new(),
+        origin: Vec3::ZERO,
     }
 }
 

@@ -279,6 +279,7 @@ impl GpuScene {
         ctx: &Arc<Context>,
         scene: &Scene,
         options: &SceneOptions,
+        origin: glam::Vec3,
     ) -> Result<Self, GpuError> {
         let anisotropy = options.resolved_anisotropy(ctx);
         // Geometry: one entry per mesh primitive, shared by all instances.
@@ -359,9 +360,12 @@ impl GpuScene {
         }
         let mut draws = Vec::new();
         let mut triangles = 0;
+        let mut bounds = Aabb::EMPTY;
         for inst in &scene.instances {
+            let world_from_model = crate::scene::rebased(inst.world_from_model, origin);
             for r in &ranges[inst.mesh] {
                 let (index_count, material) = (r.index_count, r.material);
+                bounds = bounds.union(&r.bounds.transformed(&world_from_model));
                 if index_count == 0 {
                     continue;
                 }
@@ -372,16 +376,14 @@ impl GpuScene {
                     index_count,
                     vertex_offset: r.vertex_offset,
                     material,
-                    world_from_model: inst.world_from_model,
-                    model_from_world: inst.world_from_model.inverse(),
+                    world_from_model,
+                    model_from_world: world_from_model.inverse(),
                     clusters: r.clusters,
-                    immediates: SceneImmediates::new(inst.world_from_model),
-                    world_bounds: r.bounds.transformed(&inst.world_from_model),
-                    world_plane: r
-                        .plane
-                        .and_then(|pl| world_plane(pl, &inst.world_from_model)),
+                    immediates: SceneImmediates::new(world_from_model),
+                    world_bounds: r.bounds.transformed(&world_from_model),
+                    world_plane: r.plane.and_then(|pl| world_plane(pl, &world_from_model)),
                     double_sided: mat.is_some_and(|m| m.double_sided),
-                    mirrored: glam::Mat3::from_mat4(inst.world_from_model).determinant() < 0.0,
+                    mirrored: glam::Mat3::from_mat4(world_from_model).determinant() < 0.0,
                     closed: r.closed,
                     masked: mat.is_some_and(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
                     material_bits: mat.map_or(0, material_variant_bits),
@@ -526,7 +528,7 @@ impl GpuScene {
             draws,
             material_layout,
             material_sets: sets,
-            bounds: scene.bounds(),
+            bounds,
             clusters: all_clusters,
             triangles,
             frustum_culling: options.culling,

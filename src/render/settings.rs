@@ -186,6 +186,14 @@ pub struct View {
 }
 
 impl View {
+    /// The same view in coordinates relative to `origin` (cameras moved; directions unchanged).
+    pub fn rebased(&self, origin: Vec3) -> Self {
+        let mut v = self.clone();
+        v.camera = v.camera.rebased(origin);
+        v.shadow_fit_camera = v.shadow_fit_camera.map(|c| c.rebased(origin));
+        v
+    }
+
     /// A view through `camera` with default settings.
     pub fn new(camera: Camera) -> Self {
         Self {

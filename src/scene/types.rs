@@ -160,6 +160,16 @@ pub struct Light {
 }
 
 impl Light {
+    /// The same light in coordinates relative to `origin` (see [`Scene::render_origin`]).
+    pub fn rebased(&self, origin: Vec3) -> Self {
+        let p = self.position;
+        let rel = |a: f32, o: f32| (a as f64 - o as f64) as f32;
+        Self {
+            position: Vec3::new(rel(p.x, origin.x), rel(p.y, origin.y), rel(p.z, origin.z)),
+            ..*self
+        }
+    }
+
     /// A shadow-casting sun travelling along `direction`.
     pub fn sun(direction: Vec3, intensity: f32) -> Self {
         Self {
@@ -220,6 +230,32 @@ impl Camera {
     pub fn position(&self) -> Vec3 {
         self.world_from_view.w_axis.truncate()
     }
+
+    /// The same camera in coordinates relative to `origin` (see [`Scene::render_origin`]).
+    pub fn rebased(&self, origin: Vec3) -> Self {
+        Self {
+            world_from_view: rebased(self.world_from_view, origin),
+            ..*self
+        }
+    }
+}
+
+/// `world_from_model` in coordinates relative to `origin`: the translation minus `origin`,
+/// subtracted in f64 so that a transform 10⁶ units out keeps its sub-millimetre part.
+pub fn rebased(world_from_model: Mat4, origin: Vec3) -> Mat4 {
+    if origin == Vec3::ZERO {
+        return world_from_model;
+    }
+    let t = world_from_model.w_axis;
+    let rel = |a: f32, o: f32| (a as f64 - o as f64) as f32;
+    let mut m = world_from_model;
+    m.w_axis = glam::Vec4::new(
+        rel(t.x, origin.x),
+        rel(t.y, origin.y),
+        rel(t.z, origin.z),
+        t.w,
+    );
+    m
 }
 
 /// A placed mesh.
@@ -258,6 +294,27 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The point the GPU and the reference work relative to: the origin for a scene near it,
+    /// else the centre of its bounds (when that centre is more than 4 radii from the origin).
+    /// Model and light transforms are rebased on the CPU in f64 ([`rebased`]), so the f32
+    /// positions the GPU computes are small wherever the scene lies; a scene 10⁶ units out is
+    /// drawn with the precision it has at the origin (the `precision` stability probe).
+    /// Vertex positions themselves stay as stored: a mesh whose vertices are far from its own
+    /// node's origin keeps the f32 precision of its model space.
+    pub fn render_origin(&self) -> Vec3 {
+        let b = self.bounds();
+        if b.is_empty() {
+            return Vec3::ZERO;
+        }
+        let c = b.center();
+        let radius = (b.diagonal() * 0.5).max(f32::MIN_POSITIVE);
+        if c.is_finite() && c.length() > 4.0 * radius {
+            c
+        } else {
+            Vec3::ZERO
+        }
+    }
+
     /// World-space bounds of all instances.
     pub fn bounds(&self) -> Aabb {
         self.draw_bounds()
@@ -267,13 +324,20 @@ impl Scene {
 
     /// World bounds of every draw (each instance's primitives).
     pub fn draw_bounds(&self) -> Vec<Aabb> {
+        self.draw_bounds_rebased(Vec3::ZERO)
+    }
+
+    /// Bounds of every draw relative to `origin` (transforms rebased in f64, as the renderer
+    /// places them).
+    pub fn draw_bounds_rebased(&self, origin: Vec3) -> Vec<Aabb> {
         self.instances
             .iter()
             .flat_map(|i| {
+                let m = rebased(i.world_from_model, origin);
                 self.meshes[i.mesh]
                     .primitives
                     .iter()
-                    .map(move |p| p.bounds().transformed(&i.world_from_model))
+                    .map(move |p| p.bounds().transformed(&m))
             })
             .collect()
     }

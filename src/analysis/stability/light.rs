@@ -201,7 +201,7 @@ pub fn contact_gaps(
         v.camera = Camera::look_at(centre + Vec3::Y * height, centre, fov, height * 1e-3);
         let f = shadow_frame(renderer, &v, size)?;
         progress();
-        let clip = f.plan.clip_from_world;
+        let clip = f.plan.clip_from_scene();
         let inv = clip.inverse();
         let depth_buf = f.depth.as_deref().unwrap_or(&[]);
         let (w, h) = size;

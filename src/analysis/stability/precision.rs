@@ -2,7 +2,9 @@
 //! millimetres to tens of kilometres, each classified against the exact reference.
 //!
 //! Next to each measured case: the f32 spacing of world positions at that distance from the
-//! origin (what limits a renderer that sends world-space positions to the GPU, as umbra does), and
+//! origin (the precision of the input, and what would limit a renderer that sent world-space
+//! positions to the GPU), the spacing of the positions the GPU does see (relative to
+//! `Scene::render_origin`, rebased in f64 on the CPU), and
 //! the camera-depth step at the view distance for umbra's reversed-z float buffer and for a
 //! standard-z float buffer (an analytic control from `math::precision`: umbra has no standard-z
 //! render path).
@@ -55,6 +57,9 @@ pub struct PrecisionRow {
     pub texel_world: f64,
     /// f32 spacing of world positions at the scene's farthest point from the origin.
     pub position_step: f64,
+    /// f32 spacing of the positions the GPU computes (relative to the render origin) at the
+    /// scene's farthest point from that origin.
+    pub gpu_position_step: f64,
     /// Camera-depth step at the view distance, reversed-z f32 (umbra).
     pub depth_step_reversed: f64,
     /// Camera-depth step at the view distance, standard z f32 with the far plane at twice the
@@ -123,6 +128,9 @@ pub fn precision(
         let dist = (view.camera.position() - centre).length() as f64 * scale;
         let near = (view.camera.near as f64 * scale).max(1e-12);
         let dist = dist.max(near);
+        let rel = placed.render_origin();
+        let pb = placed.bounds();
+        let gpu_far = (pb.min - rel).abs().max((pb.max - rel).abs()).length() as f64;
         let misclassified = c.misclassified_fraction();
         let origin = rows
             .first()
@@ -143,6 +151,7 @@ pub fn precision(
             },
             texel_world: finest_texel(&f),
             position_step: f32_step(far_point),
+            gpu_position_step: f32_step(gpu_far),
             depth_step_reversed: relative_gap(DepthMapping::ReversedInfiniteF32, near, dist) * dist,
             depth_step_standard: relative_gap(
                 DepthMapping::StandardF32 { far: 2.0 * dist },

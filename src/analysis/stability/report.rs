@@ -369,14 +369,15 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
                 far.offset
             ),
             measured: format!(
-                "{} vs {} ({:.2}×){}; f32 position step there {:.3e}, finest texel {:.3e}",
+                "{} vs {} ({:.2}×){}; f32 step of the scene's own coordinates there {:.3e}, of the GPU's (relative to the render origin) {:.3e}, finest texel {:.3e}",
                 pct(far.misclassified),
                 pct(o.misclassified),
                 far.ratio_to_origin,
                 begins.map_or(String::new(), |o| format!(
-                    "; the limit (f32 world positions) shows from {o:.0e} units"
+                    "; the limit shows from {o:.0e} units"
                 )),
                 far.position_step,
+                far.gpu_position_step,
                 far.texel_world
             ),
             pass: Some(far.ratio_to_origin <= FAR_RATIO_BOUND),
@@ -599,10 +600,17 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
                     points: moved.iter().map(|p| (offset_x(p), p.acne)).collect(),
                 },
                 Series {
-                    label: "f32 position step / finest texel".into(),
+                    label: "f32 step of world positions / finest texel".into(),
                     points: moved
                         .iter()
                         .map(|p| (offset_x(p), p.position_step / p.texel_world.max(1e-30)))
+                        .collect(),
+                },
+                Series {
+                    label: "f32 step on the GPU (rebased) / finest texel".into(),
+                    points: moved
+                        .iter()
+                        .map(|p| (offset_x(p), p.gpu_position_step / p.texel_world.max(1e-30)))
                         .collect(),
                 },
             ],
@@ -772,7 +780,8 @@ pub fn markdown(r: &StabilityReport) -> String {
         "misclassified",
         "acne",
         "× origin",
-        "f32 position step",
+        "f32 step, world",
+        "f32 step, GPU",
         "finest texel",
         "depth step reversed-z",
         "depth step standard-z (analytic)",
@@ -785,6 +794,7 @@ pub fn markdown(r: &StabilityReport) -> String {
             pct(p.acne),
             format!("{:.2}", p.ratio_to_origin),
             format!("{:.2e}", p.position_step),
+            format!("{:.2e}", p.gpu_position_step),
             format!("{:.2e}", p.texel_world),
             format!("{:.2e}", p.depth_step_reversed),
             format!("{:.2e}", p.depth_step_standard),
@@ -793,9 +803,12 @@ pub fn markdown(r: &StabilityReport) -> String {
     m += &t.render(true);
     let _ = writeln!(
         m,
-        "\numbra sends world-space positions to the GPU in f32, so far from the origin the \
-         position step grows past the shadow texel and shadows degrade; the table shows where. \
-         The camera-depth columns compare umbra's reversed-z float buffer with a standard-z float \
+        "\nA renderer that sent world-space f32 positions to the GPU would lose its shadows where \
+         the world step passes the shadow texel (10⁵ units for a centimetre texel). umbra \
+         rebases every transform, light and camera on the CPU, in f64, to the scene's render \
+         origin (the centre of its bounds when that lies more than 4 radii out), so the GPU works \
+         with the small relative step; the stored f32 coordinates still round the input itself \
+         (each object placed to within the world step). The camera-depth columns compare umbra's reversed-z float buffer with a standard-z float \
          buffer at the same view distance (analytic: umbra has no standard-z path).\n"
     );
     let _ = writeln!(m, "## Degenerate views and input\n");

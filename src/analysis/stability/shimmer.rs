@@ -134,7 +134,9 @@ pub fn shimmer(
             progress();
             progress();
             let inv = a.plan.clip_from_world.inverse();
-            let next = camera_projection(&pair[1], aspect) * pair[1].view_from_world();
+            // In the plan's coordinates (relative to the render origin).
+            let cam_b = pair[1].rebased(a.plan.origin);
+            let next = camera_projection(&cam_b, aspect) * cam_b.view_from_world();
             let depth = a.depth.as_deref().unwrap_or(&[]);
             let (mut n, mut f) = (0usize, 0usize);
             for y in 0..h {
