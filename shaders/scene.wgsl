@@ -43,6 +43,20 @@ const VIEW_LIT: u32 = 0u;
 const VIEW_SHADOW: u32 = 1u;
 const VIEW_NORMALS: u32 = 2u;
 const VIEW_CASCADES: u32 = 3u;
+const VIEW_UV_CHECKER: u32 = 4u;
+const VIEW_TANGENTS: u32 = 5u;
+const VIEW_BITANGENTS: u32 = 6u;
+const VIEW_BASE_COLOR: u32 = 7u;
+const VIEW_METALLIC: u32 = 8u;
+const VIEW_ROUGHNESS: u32 = 9u;
+const VIEW_DEPTH: u32 = 10u;
+const VIEW_TEXEL_DENSITY: u32 = 11u;
+const VIEW_OVERDRAW: u32 = 12u;
+// UV checker cells per unit of texture coordinate.
+const CHECKER_CELLS: f32 = 8.0;
+// Overdraw view: linear value each fragment adds (additive blending), so n layers read back as
+// n / 16 after decoding the sRGB byte.
+const OVERDRAW_STEP: f32 = 0.0625;
 
 struct Light {
     // xyz: position (point, spot); w: kind (0 directional, 1 point, 2 spot)
@@ -65,7 +79,7 @@ struct Frame {
     // rgb: ambient intensity Ia
     ambient: vec4<f32>,
     // x: shadow-map size in texels, y: normal-offset bias in texels,
-    // z: unused (texel sizes are in `cascade_texel`), w: 1 if shadows on
+    // z: view depth that the depth view draws black (the scene's far end), w: 1 if shadows on
     shadow: vec4<f32>,
     // w: index of the shadowed light (MAX_LIGHTS + 1 when none); xyz: the eye the cascades are
     // split from (the shadow-fitting camera)
@@ -292,18 +306,99 @@ fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(
     return vec4<f32>(shade(in, front_facing, base).color, 1.0);
 }
 
+// The cascade holding world point `p` by view depth alone (no dither), for the texel-density view.
+fn cascade_of(p: vec3<f32>) -> i32 {
+    let d = dot(p - frame.shadow_light.xyz, frame.camera_forward.xyz);
+    let n = i32(frame.camera_forward.w);
+    var c = 0;
+    for (var k = 0; k < 3; k++) {
+        c += select(0, 1, k + 1 < n && d > frame.cascade_far[k]);
+    }
+    return c;
+}
+
+// A colour ramp of rising brightness: dark blue, teal, yellow, white over t in [0, 1].
+fn heat(t: f32) -> vec3<f32> {
+    let x = clamp(t, 0.0, 1.0) * 3.0;
+    let c0 = vec3<f32>(0.05, 0.05, 0.4);
+    let c1 = vec3<f32>(0.1, 0.6, 0.6);
+    let c2 = vec3<f32>(0.9, 0.9, 0.2);
+    let c3 = vec3<f32>(1.0, 1.0, 1.0);
+    if x < 1.0 {
+        return mix(c0, c1, x);
+    }
+    if x < 2.0 {
+        return mix(c1, c2, x - 1.0);
+    }
+    return mix(c2, c3, x - 2.0);
+}
+
 @fragment
 fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let base = base_color(in.uv);
     if material.extra.x > 0.0 && base.a < material.extra.x {
         discard;
     }
-    let s = shade(in, front_facing, base);
+    let mode = frame.modes.x;
+    // Shadow-map texels per screen pixel (derivatives first: uniform control flow).
+    let layer = cascade_of(in.world_position);
+    let lc = frame.shadow_clip[layer] * vec4<f32>(in.world_position, 1.0);
+    let st = vec2<f32>(lc.x, -lc.y) / max(abs(lc.w), 1e-20) * (0.5 * frame.shadow.x);
+    let jx = dpdx(st);
+    let jy = dpdy(st);
+    let texels_per_pixel = sqrt(abs(jx.x * jy.y - jx.y * jy.x));
     // Debug views write values that the sRGB target stores unchanged as bytes.
-    if frame.modes.x == VIEW_SHADOW {
+    if mode == VIEW_OVERDRAW {
+        return vec4<f32>(vec3<f32>(OVERDRAW_STEP), 1.0);
+    }
+    if mode == VIEW_UV_CHECKER {
+        let cell = floor(in.uv * CHECKER_CELLS);
+        let odd = (i32(cell.x) + i32(cell.y)) & 1;
+        return vec4<f32>(srgb_to_linear(vec3<f32>(select(0.15, 0.85, odd == 1))), 1.0);
+    }
+    if mode == VIEW_BASE_COLOR {
+        return vec4<f32>(base.rgb, 1.0);
+    }
+    if mode == VIEW_METALLIC || mode == VIEW_ROUGHNESS {
+        var mr = vec4<f32>(1.0);
+        if HAS_OTHER_TEX {
+            mr = textureSample(metal_rough_tex, material_sampler, in.uv);
+        }
+        let v = select(material.params.y * mr.g, material.params.x * mr.b, mode == VIEW_METALLIC);
+        return vec4<f32>(srgb_to_linear(vec3<f32>(clamp(v, 0.0, 1.0))), 1.0);
+    }
+    if mode == VIEW_DEPTH {
+        // Linear view depth (1 / w of the fragment), white at the eye, black at the scene's far end.
+        let d = 1.0 / max(in.clip.w, 1e-30);
+        return vec4<f32>(srgb_to_linear(vec3<f32>(1.0 - clamp(d / frame.shadow.z, 0.0, 1.0))), 1.0);
+    }
+    if mode == VIEW_TEXEL_DENSITY {
+        if frame.shadow.w == 0.0 || frame.camera_forward.w < 1.0 {
+            return vec4<f32>(srgb_to_linear(vec3<f32>(0.5)), 1.0);
+        }
+        // Screen pixels per shadow texel, log2 over [1/16, 16]: dark blue where texels are finer
+        // than pixels (wasted), teal-yellow near 1:1, white where one texel spans many pixels.
+        let ppt = 1.0 / max(texels_per_pixel, 1e-20);
+        return vec4<f32>(srgb_to_linear(heat(log2(ppt) / 8.0 + 0.5)), 1.0);
+    }
+    if mode == VIEW_TANGENTS || mode == VIEW_BITANGENTS {
+        var n = normalize(in.normal);
+        let t_raw = in.tangent.xyz - n * dot(n, in.tangent.xyz);
+        var t = vec3<f32>(0.0);
+        if dot(t_raw, t_raw) > 1e-12 {
+            t = normalize(t_raw);
+        }
+        var v = t;
+        if mode == VIEW_BITANGENTS {
+            v = cross(n, t) * select(-1.0, 1.0, in.tangent.w >= 0.0);
+        }
+        return vec4<f32>(srgb_to_linear(v * 0.5 + vec3<f32>(0.5)), 1.0);
+    }
+    let s = shade(in, front_facing, base);
+    if mode == VIEW_SHADOW {
         return vec4<f32>(srgb_to_linear(vec3<f32>(s.shadow_term)), 1.0);
     }
-    if frame.modes.x == VIEW_CASCADES {
+    if mode == VIEW_CASCADES {
         var tint = vec3<f32>(0.5);
         switch s.cascade {
             case 0: { tint = vec3<f32>(1.0, 0.25, 0.2); }

@@ -56,6 +56,24 @@ impl SunAngles {
     }
 }
 
+/// The views `V` cycles through, in order.
+pub const VIEW_CYCLE: [ViewMode; 14] = [
+    ViewMode::Lit,
+    ViewMode::Shadow,
+    ViewMode::Normals,
+    ViewMode::ShadowMap,
+    ViewMode::Cascades,
+    ViewMode::TexelDensity,
+    ViewMode::UvChecker,
+    ViewMode::Tangents,
+    ViewMode::Bitangents,
+    ViewMode::BaseColor,
+    ViewMode::Metallic,
+    ViewMode::Roughness,
+    ViewMode::Depth,
+    ViewMode::Overdraw,
+];
+
 /// Applies `a` to the view (and the sun angles); returns a one-line description of the change.
 pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
     let s = &mut view.shadow;
@@ -109,13 +127,8 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
             )
         }
         Action::CycleView => {
-            view.mode = match view.mode {
-                ViewMode::Lit => ViewMode::Shadow,
-                ViewMode::Shadow => ViewMode::Normals,
-                ViewMode::Normals => ViewMode::ShadowMap,
-                ViewMode::ShadowMap => ViewMode::Cascades,
-                ViewMode::Cascades => ViewMode::Lit,
-            };
+            let i = VIEW_CYCLE.iter().position(|m| *m == view.mode).unwrap_or(0);
+            view.mode = VIEW_CYCLE[(i + 1) % VIEW_CYCLE.len()];
             format!("view: {:?}", view.mode)
         }
         Action::ToggleShadows => {
@@ -189,21 +202,15 @@ mod tests {
         apply(Action::BiasUp, &mut v, &mut sun);
         assert!((v.shadow.normal_offset - b * 1.25).abs() < 1e-6);
         let mut seen = vec![v.mode];
-        for _ in 0..5 {
+        for _ in 0..VIEW_CYCLE.len() {
             apply(Action::CycleView, &mut v, &mut sun);
             seen.push(v.mode);
         }
-        assert_eq!(
-            seen,
-            vec![
-                ViewMode::Lit,
-                ViewMode::Shadow,
-                ViewMode::Normals,
-                ViewMode::ShadowMap,
-                ViewMode::Cascades,
-                ViewMode::Lit
-            ]
-        );
+        assert_eq!(&seen[..5], &VIEW_CYCLE[..5]);
+        assert_eq!(seen[14], ViewMode::Lit, "the cycle closes");
+        let mut distinct = seen[..14].to_vec();
+        distinct.dedup();
+        assert_eq!(distinct.len(), 14, "every view once");
         assert!(apply(Action::ToggleShadows, &mut v, &mut sun).contains("off"));
     }
 }

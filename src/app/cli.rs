@@ -289,6 +289,24 @@ pub enum ViewArg {
     ShadowMap,
     /// Which cascade shades each pixel (red, green, blue, yellow), darker in shadow.
     Cascades,
+    /// Texture coordinates 0 as a checker, 8 cells per unit.
+    UvChecker,
+    /// World tangents (t·0.5+0.5).
+    Tangents,
+    /// World bitangents (b·0.5+0.5).
+    Bitangents,
+    /// Base colour, unlit.
+    BaseColor,
+    /// Metallic as grey.
+    Metallic,
+    /// Roughness as grey.
+    Roughness,
+    /// Linear view depth, white near, black at the scene's far end.
+    Depth,
+    /// Screen pixels per shadow texel as a heat map (dark blue: wasted texels; white: blocky).
+    TexelDensity,
+    /// Fragments rasterised per pixel (each adds 1/16, no depth test).
+    Overdraw,
 }
 
 /// PCF kernels.
@@ -590,6 +608,15 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         ViewArg::Normals => ViewMode::Normals,
         ViewArg::ShadowMap => ViewMode::ShadowMap,
         ViewArg::Cascades => ViewMode::Cascades,
+        ViewArg::UvChecker => ViewMode::UvChecker,
+        ViewArg::Tangents => ViewMode::Tangents,
+        ViewArg::Bitangents => ViewMode::Bitangents,
+        ViewArg::BaseColor => ViewMode::BaseColor,
+        ViewArg::Metallic => ViewMode::Metallic,
+        ViewArg::Roughness => ViewMode::Roughness,
+        ViewArg::Depth => ViewMode::Depth,
+        ViewArg::TexelDensity => ViewMode::TexelDensity,
+        ViewArg::Overdraw => ViewMode::Overdraw,
     };
     if !(16..=16384).contains(&a.shadow_map) {
         bail!("--shadow-map {} must be within 16..16384", a.shadow_map);

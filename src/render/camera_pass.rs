@@ -105,6 +105,7 @@ impl CameraPass {
             depth_clamp: false,
             depth_bias: false,
             depth_test: false,
+            additive: false,
         };
         let map_pipeline = create_pipeline(ctx, &desc)?;
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, frame_layout, slots)?;
@@ -164,7 +165,7 @@ impl CameraPass {
         &mut self,
         scene: &GpuScene,
         frame_bits: usize,
-        debug_view: bool,
+        debug_view: Option<Entry>,
     ) -> Result<(), GpuError> {
         // Modules first (cheap), then the missing pipelines compiled in parallel: on lavapipe
         // each is an LLVM compile of its shaders, the largest part of a cold first frame.
@@ -408,8 +409,8 @@ pub struct CameraCull {
     pub eye: (Vec3, f32),
     /// The frame's shader variant bits (`FramePlan::shader_variant`).
     pub frame_bits: usize,
-    /// The shadow-visibility or normals view (the debug entry point).
-    pub debug_view: bool,
+    /// A debug view's entry (`Entry::Debug` or `Entry::Overdraw`); `None` for the lit image.
+    pub debug_view: Option<Entry>,
 }
 
 /// Creates the scene pipeline of shader `variant` (in `module`) with fragment entry `entry`.
@@ -434,7 +435,7 @@ fn scene_pipeline(
                 match entry {
                     Entry::Opaque => sh::ENTRY_FS_MAIN,
                     Entry::Masked => sh::ENTRY_FS_MASKED,
-                    Entry::Debug => sh::ENTRY_FS_DEBUG,
+                    Entry::Debug | Entry::Overdraw => sh::ENTRY_FS_DEBUG,
                 },
             )),
             bindings: &bindings,
@@ -443,7 +444,8 @@ fn scene_pipeline(
             depth_format: DEPTH_FORMAT,
             depth_clamp: false,
             depth_bias: false,
-            depth_test: true,
+            depth_test: entry != Entry::Overdraw,
+            additive: entry == Entry::Overdraw,
         },
     )
 }
@@ -455,17 +457,19 @@ pub enum Entry {
     Opaque,
     /// `fs_masked`: alpha-masked materials, lit image.
     Masked,
-    /// `fs_debug`: the shadow-visibility and normals views.
+    /// `fs_debug`: the debug views (shadow visibility, normals, cascades, UV checker, …).
     Debug,
+    /// `fs_debug` with additive blending and no depth test: the overdraw view.
+    Overdraw,
 }
 
 impl Entry {
     /// The entry point for a draw of a masked or opaque material in a lit or debug view.
-    pub fn of(masked: bool, debug_view: bool) -> Entry {
+    pub fn of(masked: bool, debug_view: Option<Entry>) -> Entry {
         match (debug_view, masked) {
-            (true, _) => Entry::Debug,
-            (false, true) => Entry::Masked,
-            (false, false) => Entry::Opaque,
+            (Some(e), _) => e,
+            (None, true) => Entry::Masked,
+            (None, false) => Entry::Opaque,
         }
     }
 }

@@ -240,7 +240,11 @@ impl FrameCore {
             color.view,
             depth.view,
             extent,
-            CLEAR_COLOR,
+            if view.mode == ViewMode::Overdraw {
+                [0.0, 0.0, 0.0, 1.0]
+            } else {
+                CLEAR_COLOR
+            },
             view.mode == ViewMode::ShadowMap,
             &cull,
         );
@@ -287,12 +291,15 @@ impl FrameCore {
     }
 }
 
-/// Whether `mode` draws the scene with the debug entry point (shadow visibility, normals).
-fn is_debug_view(mode: ViewMode) -> bool {
-    matches!(
-        mode,
-        ViewMode::Shadow | ViewMode::Normals | ViewMode::Cascades
-    )
+/// The debug entry `mode` draws the scene with (`None`: the lit image, or the shadow map drawn
+/// full-screen).
+fn is_debug_view(mode: ViewMode) -> Option<super::camera_pass::Entry> {
+    use super::camera_pass::Entry;
+    match mode {
+        ViewMode::Lit | ViewMode::ShadowMap => None,
+        ViewMode::Overdraw => Some(Entry::Overdraw),
+        _ => Some(Entry::Debug),
+    }
 }
 
 /// Draws recorded in one frame, after culling.

@@ -401,7 +401,7 @@ pub fn plan_frame(
         shadow: Vec4::new(
             size as f32,
             view.shadow.normal_offset,
-            0.0,
+            far_view_depth(&view.camera, bounds),
             if shadows_on { 1.0 } else { 0.0 },
         ),
         // No shadowed light: an index the shader's light loop never reaches. xyz: the eye the
@@ -471,6 +471,38 @@ pub fn plan_frame(
         casters: Vec::new(),
         origin: Vec3::ZERO,
     }
+}
+
+/// The largest view depth of `bounds` seen from `camera` (the depth view's black end); at least
+/// the near plane.
+fn far_view_depth(camera: &Camera, bounds: &Aabb) -> f32 {
+    if bounds.is_empty() {
+        return camera.near * 2.0;
+    }
+    let m = camera.view_from_world();
+    let far = (0..8)
+        .map(|i| {
+            let c = Vec3::new(
+                if i & 1 == 0 {
+                    bounds.min.x
+                } else {
+                    bounds.max.x
+                },
+                if i & 2 == 0 {
+                    bounds.min.y
+                } else {
+                    bounds.max.y
+                },
+                if i & 4 == 0 {
+                    bounds.min.z
+                } else {
+                    bounds.max.z
+                },
+            );
+            -m.transform_point3(c).z
+        })
+        .fold(0.0f32, f32::max);
+    far.max(camera.near * 2.0)
 }
 
 /// The scene shader's frame variant bits: one light (a constant loop), shadows sampled, hardware

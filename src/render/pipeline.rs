@@ -28,6 +28,8 @@ pub struct PipelineDesc<'a> {
     pub depth_bias: bool,
     /// Depth test and write (off for full-screen passes).
     pub depth_test: bool,
+    /// Additive colour blending (ONE + ONE; the overdraw view).
+    pub additive: bool,
 }
 
 /// Creates a graphics pipeline: triangle lists, reversed-z depth test (GREATER, writes on),
@@ -66,8 +68,19 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .depth_test_enable(d.depth_test)
         .depth_write_enable(d.depth_test)
         .depth_compare_op(vk::CompareOp::GREATER);
-    let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
-        .color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let mut blend_attachment = vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA);
+    if d.additive {
+        blend_attachment = blend_attachment
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ZERO)
+            .alpha_blend_op(vk::BlendOp::ADD);
+    }
+    let blend_attachments = [blend_attachment];
     let blend =
         vk::PipelineColorBlendStateCreateInfo::default().attachments(if d.color_format.is_some() {
             &blend_attachments

@@ -19,6 +19,27 @@ pub enum ViewMode {
     /// Which shadow view (cascade) shades each pixel: red, green, blue, yellow for cascades 0–3,
     /// darkened where in shadow; grey where no map is read.
     Cascades,
+    /// Texture coordinates 0 as a grey checker, 8 cells per unit (bytes 38 and 217).
+    UvChecker,
+    /// World tangents after orthogonalising against the normal, encoded t·0.5+0.5.
+    Tangents,
+    /// World bitangents (n × t · w), encoded b·0.5+0.5.
+    Bitangents,
+    /// Base colour (factor × texture), as stored: sRGB bytes, no lighting.
+    BaseColor,
+    /// Metallic (factor × texture blue) as grey bytes.
+    Metallic,
+    /// Roughness (factor × texture green) as grey bytes.
+    Roughness,
+    /// Linear view depth: white at the eye, black at the scene's far end (`1 − z / z_far`).
+    Depth,
+    /// Screen pixels per shadow-map texel as a heat map, log2 over 1/16…16: dark blue where
+    /// texels are finer than pixels, teal-yellow near 1:1, white where a texel spans many pixels
+    /// (blocky shadows). Grey without a shadow map.
+    TexelDensity,
+    /// Fragments rasterised per pixel (no depth test, additive): each adds 1/16 in linear light,
+    /// so a pixel's byte decodes to n/16 (n up to 16).
+    Overdraw,
 }
 
 impl ViewMode {
@@ -29,6 +50,15 @@ impl ViewMode {
             ViewMode::Shadow => 1,
             ViewMode::Normals => 2,
             ViewMode::Cascades => 3,
+            ViewMode::UvChecker => 4,
+            ViewMode::Tangents => 5,
+            ViewMode::Bitangents => 6,
+            ViewMode::BaseColor => 7,
+            ViewMode::Metallic => 8,
+            ViewMode::Roughness => 9,
+            ViewMode::Depth => 10,
+            ViewMode::TexelDensity => 11,
+            ViewMode::Overdraw => 12,
         }
     }
 }

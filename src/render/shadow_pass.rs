@@ -222,6 +222,7 @@ impl ShadowPass {
                     depth_clamp: true,
                     depth_bias: true,
                     depth_test: true,
+                    additive: false,
                 },
             )?;
             self.pipeline_format = fmt;
