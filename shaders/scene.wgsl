@@ -116,7 +116,8 @@ struct Material {
 
 struct Immediates {
     world_from_model: mat4x4<f32>,
-    // columns of the normal matrix (inverse transpose of the upper 3x3); normal_x.w = sign of det
+    // columns of the normal matrix (inverse transpose of the upper 3x3); normal_x.w = sign of det,
+    // normal_y.w = 1 to tint the draw orange (the viewer's picked primitive)
     normal_x: vec4<f32>,
     normal_y: vec4<f32>,
     normal_z: vec4<f32>,
@@ -294,7 +295,12 @@ fn base_color(uv: vec2<f32>) -> vec4<f32> {
 // - fs_debug, the shadow-visibility and normals views, for every material.
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    return vec4<f32>(shade(in, front_facing, base_color(in.uv)).color, 1.0);
+    return vec4<f32>(highlight(shade(in, front_facing, base_color(in.uv)).color), 1.0);
+}
+
+// The picked primitive's tint (pc.normal_y.w = 1), none otherwise: one mix per fragment.
+fn highlight(c: vec3<f32>) -> vec3<f32> {
+    return mix(c, vec3<f32>(1.0, 0.35, 0.0), 0.5 * pc.normal_y.w);
 }
 
 @fragment
@@ -303,7 +309,7 @@ fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(
     if base.a < material.extra.x {
         discard;
     }
-    return vec4<f32>(shade(in, front_facing, base).color, 1.0);
+    return vec4<f32>(highlight(shade(in, front_facing, base).color), 1.0);
 }
 
 // The cascade holding world point `p` by view depth alone (no dither), for the texel-density view.

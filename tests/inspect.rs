@@ -194,6 +194,68 @@ fn known_defects_are_reported_with_codes_and_pointers() {
     );
 }
 
+/// Raw accessor data the loader repairs: a POSITION accessor whose declared max is not its data's,
+/// a normal of length 0.5 and a tangent with w = 0.5; each reported with its code and pointer,
+/// and the same model without the defects reports none of them.
+#[test]
+fn raw_accessor_defects_are_reported_with_codes_and_pointers() {
+    let write = |broken: bool| {
+        let mut b = Builder::default();
+        let pos = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], 3, "VEC3");
+        let len = if broken { 0.5 } else { 1.0 };
+        let nrm = b.floats(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, len], 3, "VEC3");
+        let w = if broken { 0.5 } else { -1.0 };
+        let tan = b.floats(
+            &[1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, w],
+            4,
+            "VEC4",
+        );
+        if broken {
+            b.accessor_mut(pos)["max"] = json!([5.0, 1.0, 0.0]);
+        }
+        b.mesh(
+            "raw",
+            vec![json!({"attributes": {"POSITION": pos, "NORMAL": nrm, "TANGENT": tan}})],
+        );
+        b.node(json!({"mesh": 0}), true);
+        let dir = tmp(if broken { "raw_broken" } else { "raw_clean" });
+        b.write(&dir, "raw", Container::Glb)
+    };
+    let codes = |path: &Path| -> Vec<(String, String)> {
+        let r = inspect_json(path);
+        validate(&r, &schema(), "").unwrap();
+        r["findings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| {
+                (
+                    f["code"].as_str().unwrap().into(),
+                    f["pointer"].as_str().unwrap().into(),
+                )
+            })
+            .collect()
+    };
+    let found = codes(&write(true));
+    for (code, pointer) in [
+        ("ACCESSOR_MIN_MAX_MISMATCH", "/accessors/0"),
+        (
+            "MESH_NORMALS_NOT_UNIT",
+            "/meshes/0/primitives/0/attributes/NORMAL",
+        ),
+        (
+            "MESH_TANGENTS_INVALID",
+            "/meshes/0/primitives/0/attributes/TANGENT",
+        ),
+    ] {
+        assert!(
+            found.iter().any(|f| f.0 == code && f.1 == pointer),
+            "{code} at {pointer} missing from {found:#?}"
+        );
+    }
+    assert_eq!(codes(&write(false)), Vec::<(String, String)>::new());
+}
+
 #[test]
 fn every_corpus_model_validates_against_the_schema() {
     let dir = tmp("corpus");

@@ -1,6 +1,10 @@
 //! The viewer under Xvfb on lavapipe, validation on: its screenshot matches the offscreen render
 //! of the same scene, camera and size, and resizing (through 0×0 and back) is clean.
 
+mod common;
+
+use common::gltf_builder::{Builder, Container, U16};
+use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
 use umbra::reference::metrics::{flip, psnr};
@@ -285,5 +289,114 @@ fn viewer_survives_sun_below_horizon_near_plane_zoom_and_1000_resizes() {
     assert!(
         distinct > 1000,
         "a flat screenshot: {distinct} pixels differ"
+    );
+}
+
+/// Picking: a synthetic click (`--script click:X:Y`) on two copies of a quad seen head-on picks
+/// the right node, mesh and triangle (each quad's lower-right half is triangle 0, its upper-left
+/// triangle 1), the gap between them picks nothing, the exact and GPU shadow verdicts agree, and
+/// the picked primitive is drawn tinted in the final screenshot (the other one is not).
+#[test]
+fn a_click_picks_the_node_mesh_and_triangle_under_it() {
+    let dir = out("pick_model");
+    let mut b = Builder::default();
+    let pos = b.floats(
+        &[
+            -0.5, -0.5, 0.0, 0.5, -0.5, 0.0, 0.5, 0.5, 0.0, -0.5, 0.5, 0.0,
+        ],
+        3,
+        "VEC3",
+    );
+    let nrm = b.floats(&[0.0, 0.0, 1.0].repeat(4), 3, "VEC3");
+    let idx = b.indices(&[0, 1, 2, 0, 2, 3], U16);
+    let mat = b.material(
+        json!({"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1.0]}}),
+    );
+    let mesh = b.mesh(
+        "panel",
+        vec![json!({"attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": idx, "material": mat})],
+    );
+    b.node(
+        json!({"name": "left panel", "mesh": mesh, "translation": [-0.7, 0.0, 0.0]}),
+        true,
+    );
+    b.node(
+        json!({"name": "right panel", "mesh": mesh, "translation": [0.7, 0.0, 0.0]}),
+        true,
+    );
+    let model = b.write(&dir, "panels", Container::Glb);
+    // 45° vertical field of view from 3 units at 200×150: 60.36 pixels per unit, centre (100, 75).
+    let px = |wx: f32, wy: f32| format!("{:.1}:{:.1}", 100.0 + wx * 60.36, 75.0 - wy * 60.36);
+    let clicks = [
+        px(0.7 + 0.25, -0.25),  // right panel, lower right: triangle 0
+        px(0.7 - 0.25, 0.25),   // right panel, upper left: triangle 1
+        px(0.0, 0.0),           // the gap
+        px(-0.7 + 0.25, -0.25), // left panel, lower right: triangle 0
+    ];
+    let script: Vec<String> = clicks.iter().map(|c| format!("click:{c}")).collect();
+    let shot = out("viewer_pick.png");
+    let x = Xvfb::start();
+    let (ok, log) = umbra(
+        &[
+            "view",
+            model.to_str().unwrap(),
+            "--eye=0,0,3",
+            "--target=0,0,0",
+            "--sun-dir=-0.3,-0.4,-1",
+            "--size",
+            "200x150",
+            "--frames",
+            "6",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--no-vsync",
+            "--validation",
+            "--script",
+            &script.join(","),
+        ],
+        Some(&x.display),
+    );
+    assert!(ok, "viewer failed:\n{log}");
+    let picks: Vec<&str> = log.lines().filter(|l| l.starts_with("pick: ")).collect();
+    assert_eq!(picks.len(), 4, "{log}");
+    assert!(
+        picks[0].contains("node 1 'right panel'")
+            && picks[0].contains("mesh 0 'panel'")
+            && picks[0].contains("primitive 0")
+            && picks[0].contains("material 0 'grey'")
+            && picks[0].ends_with("triangle 0"),
+        "{}",
+        picks[0]
+    );
+    assert!(
+        picks[1].contains("node 1 'right panel'") && picks[1].ends_with("triangle 1"),
+        "{}",
+        picks[1]
+    );
+    assert!(picks[2].ends_with("nothing (background)"), "{}", picks[2]);
+    assert!(
+        picks[3].contains("node 0 'left panel'") && picks[3].ends_with("triangle 0"),
+        "{}",
+        picks[3]
+    );
+    // The position line of the first pick: world (0.95, -0.25, 0) within a pixel (1/60 unit).
+    let first = log
+        .lines()
+        .skip_while(|l| !l.starts_with("pick: "))
+        .nth(1)
+        .unwrap();
+    assert!(first.contains("position (0.9"), "{first}");
+    assert!(
+        log.contains("light 0 (directional): exact lit · GPU lit"),
+        "{log}"
+    );
+    assert!(!log.contains("disagrees"), "{log}");
+    // The last pick (the left panel) is tinted orange; the right panel is not.
+    let img = image::open(&shot).unwrap().to_rgba8();
+    let left = img.get_pixel(100 - 42, 75).0;
+    let right = img.get_pixel(100 + 42, 75).0;
+    assert!(
+        left[0] as i32 > left[2] as i32 + 60 && (right[0] as i32 - right[2] as i32).abs() < 10,
+        "left {left:?}, right {right:?}"
     );
 }

@@ -231,8 +231,9 @@ pub struct ViewArgsCmd {
     pub validation: bool,
     /// Automation: inputs to play, one every two frames, comma-separated, each optionally
     /// repeated with `*N`: `WxH` resizes (0x0 minimises), `key:NAME` presses a key (up down left
-    /// right [ ] k + - v h f tab c p), `wheel:N` scrolls N lines (positive zooms in); e.g.
-    /// `key:down*40,wheel:1*80,640x360`. With --frames, the run ends after the last step.
+    /// right [ ] k + - v h f tab c p), `wheel:N` scrolls N lines (positive zooms in),
+    /// `click:X:Y` picks at window pixel (X, Y); e.g. `key:down*40,wheel:1*80,640x360,click:9:9`.
+    /// With --frames, the run ends after the last step.
     #[arg(long, alias = "resize-script", value_delimiter = ',', value_parser = super::script::parse_item)]
     pub script: Vec<(super::script::ScriptStep, u32)>,
 }

@@ -9,6 +9,8 @@ pub mod cli;
 #[cfg(feature = "viewer")]
 pub mod controller;
 pub mod inspect_view;
+#[cfg(all(feature = "viewer", feature = "reference"))]
+pub mod pick;
 #[cfg(feature = "viewer")]
 pub mod script;
 #[cfg(feature = "viewer")]

@@ -4,8 +4,9 @@
 //!
 //! A script is a comma-separated list of steps, each optionally repeated with `*N`:
 //! `WxH` resizes the window (`0x0` simulates minimising), `key:NAME` presses and releases a key
-//! (`up down left right [ ] k + - v h f tab c p`, the viewer's own bindings) and `wheel:N`
-//! scrolls N lines (positive zooms in). Example: `key:down*40,wheel:1*80,640x360*3,0x0`.
+//! (`up down left right [ ] k + - v h f tab c p`, the viewer's own bindings), `wheel:N`
+//! scrolls N lines (positive zooms in) and `click:X:Y` clicks (picks) at window pixel (X, Y).
+//! Example: `key:down*40,wheel:1*80,640x360*3,0x0,click:320:200`.
 
 /// Key names a script may press (each one of the viewer's bindings).
 pub const KEYS: &[&str] = &[
@@ -24,6 +25,8 @@ pub enum ScriptStep {
     Key(&'static str),
     /// Scroll the wheel by this many lines.
     Wheel(f32),
+    /// Click (pick) at this window position in pixels.
+    Click(f32, f32),
 }
 
 /// Parses one comma-separated item: a step and how many times it repeats.
@@ -47,6 +50,18 @@ pub fn parse_item(s: &str) -> Result<(ScriptStep, u32), String> {
             .find(|n| n.eq_ignore_ascii_case(k.trim()))
             .ok_or_else(|| format!("unknown key '{k}' (one of {})", KEYS.join(" ")))?;
         ScriptStep::Key(name)
+    } else if let Some(xy) = step.strip_prefix("click:") {
+        let (x, y) = xy
+            .split_once(':')
+            .ok_or_else(|| format!("'{step}' is not click:X:Y"))?;
+        let coord = |v: &str| {
+            v.trim()
+                .parse::<f32>()
+                .ok()
+                .filter(|v| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| format!("bad click position '{step}'"))
+        };
+        ScriptStep::Click(coord(x)?, coord(y)?)
     } else if let Some(n) = step.strip_prefix("wheel:") {
         let lines: f32 = n
             .trim()
@@ -94,12 +109,19 @@ mod tests {
 
     #[test]
     fn items_parse_and_expand() {
-        let items: Vec<_> = ["key:Down*3", "wheel:-1.5", "640x360*2", "0x0"]
-            .iter()
-            .map(|s| parse_item(s).unwrap())
-            .collect();
+        let items: Vec<_> = [
+            "key:Down*3",
+            "wheel:-1.5",
+            "640x360*2",
+            "0x0",
+            "click:10:20.5",
+        ]
+        .iter()
+        .map(|s| parse_item(s).unwrap())
+        .collect();
         let steps = expand(&items).unwrap();
-        assert_eq!(steps.len(), 7);
+        assert_eq!(steps.len(), 8);
+        assert_eq!(steps[7], ScriptStep::Click(10.0, 20.5));
         assert_eq!(steps[0], ScriptStep::Key("down"));
         assert_eq!(steps[3], ScriptStep::Wheel(-1.5));
         assert_eq!(steps[5], ScriptStep::Resize(640, 360));
@@ -112,6 +134,8 @@ mod tests {
             "640x360*0",
             "1x1*100001",
             "99999x1",
+            "click:5",
+            "click:-1:2",
         ] {
             assert!(parse_item(bad).is_err(), "{bad}");
         }

@@ -130,6 +130,13 @@ fn key_action(code: KeyCode) -> Option<KeyAction> {
 struct State {
     // Field order is drop order: the renderer (swapchain, surface) before the window.
     renderer: WindowRenderer,
+    /// Offscreen renderer of the same scene for reading the GPU's shadow verdict at a picked
+    /// pixel (created at the first pick).
+    #[cfg(feature = "reference")]
+    pick_renderer: Option<umbra::render::Renderer>,
+    /// Cursor position, and where the left button went down (a click picks, a drag orbits).
+    cursor: (f32, f32),
+    press_at: Option<(f32, f32)>,
     ctx: Arc<Context>,
     window: Arc<Window>,
     controller: Controller,
@@ -231,6 +238,10 @@ impl App {
         );
         Ok(State {
             renderer,
+            #[cfg(feature = "reference")]
+            pick_renderer: None,
+            cursor: (0.0, 0.0),
+            press_at: None,
             ctx,
             window,
             controller,
@@ -298,6 +309,7 @@ impl App {
                     }
                 }
                 ScriptStep::Wheel(lines) => self.wheel(lines),
+                ScriptStep::Click(x, y) => self.pick(x, y),
             }
         }
         let opts = &self.opts;
@@ -390,6 +402,55 @@ impl App {
             el.exit();
         }
         Ok(())
+    }
+
+    /// Picks at window position (`x`, `y`): prints what is there and highlights its primitive
+    /// (nothing there: clears the highlight).
+    #[cfg(feature = "reference")]
+    fn pick(&mut self, x: f32, y: f32) {
+        let Some(s) = self.state.as_mut() else { return };
+        let size = s.window.inner_size();
+        let (w, h) = (size.width, size.height);
+        if w == 0 || h == 0 || x >= w as f32 || y >= h as f32 {
+            println!("pick: ({x:.0}, {y:.0}) is outside the {w}x{h} window");
+            return;
+        }
+        let scene = &self.opts.scene;
+        let result = (|| -> anyhow::Result<String> {
+            if s.pick_renderer.is_none() {
+                s.pick_renderer = Some(umbra::render::Renderer::with_options(
+                    &s.ctx,
+                    scene,
+                    &self.opts.scene_options,
+                )?);
+            }
+            let r = s.pick_renderer.as_mut().expect("created above");
+            let mut v = s.view.clone();
+            v.mode = umbra::render::ViewMode::Shadow;
+            v.highlight = None;
+            let frame = r.render(&v, w, h)?;
+            let reference = umbra::reference::ReferenceScene::new(scene);
+            // Continuous window coordinates: pixel (i, j) spans [i, i + 1) × [j, j + 1).
+            let pick = reference.pick(&frame.plan, x, y, w, h);
+            let gpu = frame.image.get_pixel(x as u32, y as u32)[0] as f32 / 255.0;
+            s.view.highlight = pick.as_ref().map(|p| (p.instance, p.primitive));
+            Ok(super::pick::describe(
+                scene,
+                &frame.plan,
+                (x, y),
+                pick.as_ref(),
+                Some(gpu),
+            ))
+        })();
+        match result {
+            Ok(line) => println!("{line}"),
+            Err(e) => println!("pick: failed: {e:#}"),
+        }
+    }
+
+    #[cfg(not(feature = "reference"))]
+    fn pick(&mut self, x: f32, y: f32) {
+        println!("pick: ({x:.0}, {y:.0}): picking needs umbra built with the `reference` feature");
     }
 
     fn wheel(&mut self, lines: f32) {
@@ -494,6 +555,21 @@ impl ApplicationHandler for App {
                     MouseButton::Middle => Some(Button::Middle),
                     _ => None,
                 };
+                // A left click that does not move the cursor (3 px) picks.
+                let mut click = None;
+                if let (Some(Button::Left), Some(s)) = (b, self.state.as_mut()) {
+                    if state == ElementState::Pressed {
+                        s.press_at = Some(s.cursor);
+                    } else if let Some((px, py)) = s.press_at.take() {
+                        let (cx, cy) = s.cursor;
+                        if (cx - px).abs() <= 3.0 && (cy - py).abs() <= 3.0 {
+                            click = Some((cx, cy));
+                        }
+                    }
+                }
+                if let Some((x, y)) = click {
+                    self.pick(x, y);
+                }
                 if let (Some(b), Some(s)) = (b, self.state.as_mut()) {
                     if s.camera_index.take().is_some() {
                         s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
@@ -508,6 +584,7 @@ impl ApplicationHandler for App {
             }
             WindowEvent::CursorMoved { position, .. } => {
                 if let Some(s) = self.state.as_mut() {
+                    s.cursor = (position.x as f32, position.y as f32);
                     s.controller
                         .handle(Input::Cursor(position.x as f32, position.y as f32));
                 }

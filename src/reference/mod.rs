@@ -9,5 +9,5 @@ pub mod score;
 
 pub use bvh::{Bvh, Hit};
 pub use metrics::{classify, compare, summarise, Classified, Metrics, PixelClass};
-pub use raycast::{Probe, ReferenceFrame, ReferenceScene};
+pub use raycast::{Pick, Probe, ReferenceFrame, ReferenceScene};
 pub use score::{score, Scored};

@@ -71,6 +71,29 @@ pub struct Probe {
     pub visible: bool,
 }
 
+/// What a click on the image hits (`ReferenceScene::pick`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pick {
+    /// Index into `Scene::instances` (its `node` names the glTF node).
+    pub instance: usize,
+    /// Index into `Scene::meshes`.
+    pub mesh: usize,
+    /// Index into the mesh's primitives (as loaded).
+    pub primitive: usize,
+    /// Index into `Scene::materials`.
+    pub material: usize,
+    /// Triangle index within the primitive (its indices `3t..3t+3`).
+    pub triangle: usize,
+    /// World position of the hit (the scene's own coordinates).
+    pub position: Vec3,
+    /// Geometric normal, facing the camera.
+    pub normal: Vec3,
+    /// Distance from the eye.
+    pub distance: f32,
+    /// Per light of the plan: exactly lit there (facing it and unoccluded).
+    pub lights_visible: Vec<bool>,
+}
+
 /// The primary ray through image position (x, y) of the camera with clip → world `inv` at `eye`.
 fn primary_ray(inv: &glam::Mat4, eye: Vec3, x: f32, y: f32, w: u32, h: u32) -> Ray {
     let n = pixel_to_ndc(x, y, w, h);
@@ -242,13 +265,60 @@ impl<'a> ReferenceScene<'a> {
         if plan.shadow_light != Some(i) || !plan.shadows_on {
             return (true, dir, radiance);
         }
+        (!self.occluded(p, ng, dir, dist), dir, radiance)
+    }
+
+    /// Whether anything lies between surface point `p` (geometric normal `ng`) and a light
+    /// `dist` away along `dir`.
+    fn occluded(&self, p: Vec3, ng: Vec3, dir: Vec3, dist: f32) -> bool {
         // Start the shadow ray off the surface, on the light's side of the true face.
         let side = if ng.dot(dir) >= 0.0 { ng } else { -ng };
         let origin = p + side * self.eps;
-        let occluded = self
-            .bvh
-            .occluded(&Ray::new(origin, dir), self.eps, dist - self.eps);
-        (!occluded, dir, radiance)
+        self.bvh
+            .occluded(&Ray::new(origin, dir), self.eps, dist - self.eps)
+    }
+
+    /// What lies under image position (`x`, `y`) (pixel units, centres at +0.5) of `plan`'s
+    /// camera: the surface the primary ray hits first, with each of the plan's lights' exact
+    /// verdict there (facing it, and unoccluded whether or not the GPU shadows that light).
+    pub fn pick(&self, plan: &FramePlan, x: f32, y: f32, width: u32, height: u32) -> Option<Pick> {
+        debug_assert_eq!(
+            plan.origin, self.origin,
+            "plan and reference share an origin"
+        );
+        let inv = plan.clip_from_world.inverse();
+        let ray = primary_ray(&inv, plan.camera_position, x, y, width, height);
+        let h = self.bvh.intersect(&ray, 0.0, f32::INFINITY)?;
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let (ng, mut n_geo) = self.hit_normals(&h);
+        let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+        if flip {
+            n_geo = -n_geo;
+        }
+        let p = ray.at(h.t);
+        let lights = (0..plan.lights.len())
+            .map(|i| {
+                let (facing, dir, _) = self.visible(plan, i, p, ng, n_geo);
+                let l = &plan.lights[i];
+                let dist = match l.kind {
+                    LightKind::Directional => f32::INFINITY,
+                    _ => l.position.distance(p),
+                };
+                facing && !self.occluded(p, ng, dir, dist)
+            })
+            .collect();
+        Some(Pick {
+            instance: r.instance as usize,
+            mesh: r.mesh as usize,
+            primitive: r.primitive as usize,
+            material: prim.material,
+            triangle: r.first as usize / 3,
+            position: p + self.origin,
+            normal: ng,
+            distance: h.t,
+            lights_visible: lights,
+        })
     }
 
     /// Geometric and interpolated normals (world space, as stored: not yet turned to the viewer)

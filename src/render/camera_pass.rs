@@ -355,6 +355,10 @@ impl CameraPass {
                         );
                         bound_material = dr.material;
                     }
+                    let mut imm = dr.immediates;
+                    if cull.highlight == Some(dr.source) {
+                        imm.normal_y.w = 1.0;
+                    }
                     scene.record_draw(
                         d,
                         cmd,
@@ -362,7 +366,7 @@ impl CameraPass {
                         dr,
                         Some(cull.eye),
                         Viewpoint::Eye(cull.eye.0),
-                        bytemuck::bytes_of(&dr.immediates),
+                        bytemuck::bytes_of(&imm),
                     );
                 }
             }
@@ -411,6 +415,8 @@ pub struct CameraCull {
     pub frame_bits: usize,
     /// A debug view's entry (`Entry::Debug` or `Entry::Overdraw`); `None` for the lit image.
     pub debug_view: Option<Entry>,
+    /// The (instance, primitive) drawn tinted (`View::highlight`).
+    pub highlight: Option<(usize, usize)>,
 }
 
 /// Creates the scene pipeline of shader `variant` (in `module`) with fragment entry `entry`.

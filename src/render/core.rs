@@ -232,6 +232,7 @@ impl FrameCore {
             ),
             frame_bits: plan.shader_variant,
             debug_view: is_debug_view(view.mode),
+            highlight: view.highlight,
         };
         let camera_draws = self.camera.record(
             cmd,

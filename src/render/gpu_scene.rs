@@ -62,6 +62,8 @@ pub struct Draw {
     pub vertex_offset: i32,
     /// Material index (= descriptor set index).
     pub material: usize,
+    /// The scene instance and the primitive of its mesh this draws.
+    pub source: (usize, usize),
     /// Model → world.
     pub world_from_model: Mat4,
     /// World → model (for cluster culling in model space).
@@ -361,9 +363,9 @@ impl GpuScene {
         let mut draws = Vec::new();
         let mut triangles = 0;
         let mut bounds = Aabb::EMPTY;
-        for inst in &scene.instances {
+        for (ii, inst) in scene.instances.iter().enumerate() {
             let world_from_model = crate::scene::rebased(inst.world_from_model, origin);
-            for r in &ranges[inst.mesh] {
+            for (pi, r) in ranges[inst.mesh].iter().enumerate() {
                 let (index_count, material) = (r.index_count, r.material);
                 bounds = bounds.union(&r.bounds.transformed(&world_from_model));
                 if index_count == 0 {
@@ -376,6 +378,7 @@ impl GpuScene {
                     index_count,
                     vertex_offset: r.vertex_offset,
                     material,
+                    source: (ii, pi),
                     world_from_model,
                     model_from_world: world_from_model.inverse(),
                     clusters: r.clusters,

@@ -213,6 +213,8 @@ pub struct View {
     pub ambient: Vec3,
     /// Fit the light frustum to this camera instead of `camera` (for stability tests).
     pub shadow_fit_camera: Option<Camera>,
+    /// Tint this (instance, primitive) orange in the lit image (the viewer's picked primitive).
+    pub highlight: Option<(usize, usize)>,
 }
 
 impl View {
@@ -234,6 +236,7 @@ impl View {
             shadow: ShadowSettings::default(),
             ambient: Vec3::splat(0.12),
             shadow_fit_camera: None,
+            highlight: None,
         }
     }
 }

@@ -80,7 +80,7 @@ pub struct SceneImmediates {
     pub world_from_model: Mat4,
     /// Normal matrix column 0; w = sign of the determinant.
     pub normal_x: Vec4,
-    /// Normal matrix column 1.
+    /// Normal matrix column 1; w = 1 to tint the draw (the viewer's picked primitive).
     pub normal_y: Vec4,
     /// Normal matrix column 2.
     pub normal_z: Vec4,

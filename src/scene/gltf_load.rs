@@ -338,6 +338,10 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     }
 
     // Node hierarchy.
+    scene.node_names = gltf
+        .nodes()
+        .map(|n| n.name().unwrap_or_default().to_string())
+        .collect();
     let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(s) => s.nodes().collect(),
         None => {
@@ -372,6 +376,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             scene.instances.push(Instance {
                 mesh: m.index(),
                 world_from_model: world,
+                node: Some(node.index()),
             });
         }
         if let Some(c) = node.camera() {
@@ -444,6 +449,52 @@ fn decode_all(sources: &[ImageSource]) -> Vec<Decoded> {
     })
 }
 
+/// How far from 1 a stored normal's or tangent's length may be (glTF-Validator allows 4e-3;
+/// quantised normals land within it).
+const UNIT_TOLERANCE: f32 = 4e-3;
+
+/// Whether a stored vector's length is 1 within `UNIT_TOLERANCE` (NaN is not).
+fn unit_length(len: f32) -> bool {
+    (len - 1.0).abs() <= UNIT_TOLERANCE
+}
+
+/// Warns when a POSITION accessor's declared min/max (required by glTF) differ from its data.
+fn check_min_max(scene: &mut Scene, acc: &gltf::Accessor, positions: &[Vec3]) {
+    let declared = |v: Option<gltf::json::Value>| -> Option<Vec3> {
+        let a = v?
+            .as_array()?
+            .iter()
+            .map(|x| x.as_f64())
+            .collect::<Option<Vec<f64>>>()?;
+        (a.len() == 3).then(|| Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32))
+    };
+    let (Some(lo), Some(hi)) = (declared(acc.min()), declared(acc.max())) else {
+        return;
+    };
+    let finite = positions.iter().filter(|p| p.is_finite());
+    let (dlo, dhi) = finite.fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(a, b), p| (a.min(*p), b.max(*p)),
+    );
+    if dlo.x > dhi.x {
+        return;
+    }
+    // Declared values are decimal text: allow a relative 1e-5 of the extent.
+    let tol = ((dhi - dlo).max_element() * 1e-5).max(1e-6);
+    let off = (lo - dlo).abs().max((hi - dhi).abs()).max_element();
+    if off > tol {
+        scene.warn(
+            "ACCESSOR_MIN_MAX_MISMATCH",
+            format!("/accessors/{}", acc.index()),
+            format!(
+                "accessor {}: declared POSITION bounds [{lo}, {hi}] differ from the data's \
+                 [{dlo}, {dhi}] (by {off:.3e}); umbra uses the data",
+                acc.index()
+            ),
+        );
+    }
+}
+
 fn read_primitive(
     path: &Path,
     scene: &mut Scene,
@@ -467,6 +518,9 @@ fn read_primitive(
     };
     let positions: Vec<Vec3> = positions.map(Vec3::from_array).collect();
     let n = positions.len();
+    if let Some(acc) = prim.get(&gltf::Semantic::Positions) {
+        check_min_max(scene, &acc, &positions);
+    }
     if prim.attributes().any(|(_, a)| a.count() != n) {
         return Err(corrupt(path, format!("{label}: attribute counts differ")));
     }
@@ -530,9 +584,29 @@ fn read_primitive(
         );
     }
     let normals: Vec<Vec3> = match reader.read_normals() {
-        Some(it) => it
-            .map(|v| Vec3::from_array(v).try_normalize().unwrap_or(Vec3::Y))
-            .collect(),
+        Some(it) => {
+            let mut off_unit = 0usize;
+            let normals = it
+                .map(|v| {
+                    let v = Vec3::from_array(v);
+                    if !unit_length(v.length()) {
+                        off_unit += 1;
+                    }
+                    v.try_normalize().unwrap_or(Vec3::Y)
+                })
+                .collect();
+            if off_unit > 0 {
+                scene.warn(
+                    "MESH_NORMALS_NOT_UNIT",
+                    format!("{at}/attributes/NORMAL"),
+                    format!(
+                        "{label}: {off_unit} of {n} normals are not unit length (|n| off 1 by \
+                         more than {UNIT_TOLERANCE}); normalised"
+                    ),
+                );
+            }
+            normals
+        }
         None => {
             scene.warn(
                 "MESH_NORMALS_MISSING",
@@ -578,9 +652,12 @@ fn read_primitive(
     let wants_normal_map = scene.materials[material].normal_texture.is_some();
     match reader.read_tangents() {
         Some(it) => {
+            let (mut bad_w, mut off_unit) = (0usize, 0usize);
             p.tangents = it
                 .map(|t| {
                     let t = Vec4::from_array(t);
+                    bad_w += (t.w != 1.0 && t.w != -1.0) as usize;
+                    off_unit += !unit_length(t.truncate().length()) as usize;
                     if t.is_finite() && t.truncate().length_squared() > 1e-12 {
                         t.truncate()
                             .normalize()
@@ -589,7 +666,17 @@ fn read_primitive(
                         Vec4::new(1.0, 0.0, 0.0, 1.0)
                     }
                 })
-                .collect()
+                .collect();
+            if bad_w > 0 || off_unit > 0 {
+                scene.warn(
+                    "MESH_TANGENTS_INVALID",
+                    format!("{at}/attributes/TANGENT"),
+                    format!(
+                        "{label}: of {n} tangents, {bad_w} have w other than ±1 (the sign is \
+                         kept) and {off_unit} xyz not of unit length (normalised)"
+                    ),
+                );
+            }
         }
         None if wants_normal_map && has_uvs => {
             if !generate_mikktspace(&mut p) {

@@ -194,6 +194,7 @@ pub fn add_object(
     scene.instances.push(Instance {
         mesh: scene.meshes.len() - 1,
         world_from_model,
+        node: None,
     });
     scene.meshes.len() - 1
 }

@@ -265,6 +265,8 @@ pub struct Instance {
     pub mesh: usize,
     /// Model → world.
     pub world_from_model: Mat4,
+    /// The glTF node it comes from (`Scene::node_names`), if any.
+    pub node: Option<usize>,
 }
 
 /// A scene ready to render.
@@ -291,6 +293,8 @@ pub struct Scene {
     pub framing: Option<Aabb>,
     /// For a loaded glTF: each image's index into `textures` (`None` where it failed to load).
     pub image_textures: Vec<Option<usize>>,
+    /// For a loaded glTF: every node's name (empty where it has none), by node index.
+    pub node_names: Vec<String>,
 }
 
 impl Scene {

@@ -43,6 +43,21 @@ pub const FINDING_CODES: &[(&str, &str, &str)] = &[
     ),
     ("MESH_DEGENERATE_TRIANGLES", "info", "zero-area triangles"),
     (
+        "MESH_NORMALS_NOT_UNIT",
+        "warning",
+        "stored normals not of unit length were normalised",
+    ),
+    (
+        "MESH_TANGENTS_INVALID",
+        "warning",
+        "stored tangents with w other than ±1 or xyz not of unit length were repaired",
+    ),
+    (
+        "ACCESSOR_MIN_MAX_MISMATCH",
+        "warning",
+        "a POSITION accessor's declared min/max differ from its data",
+    ),
+    (
         "MESH_NO_POSITION",
         "warning",
         "a primitive without POSITION was skipped",

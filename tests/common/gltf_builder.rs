@@ -82,6 +82,11 @@ impl Builder {
         self.accessors.len() - 1
     }
 
+    /// The JSON of accessor `i`, to break on purpose.
+    pub fn accessor_mut(&mut self, i: usize) -> &mut Value {
+        &mut self.accessors[i]
+    }
+
     /// An index accessor of component type `ctype` (U8, U16 or U32).
     pub fn indices(&mut self, idx: &[u32], ctype: u32) -> usize {
         let bytes: Vec<u8> = match ctype {
