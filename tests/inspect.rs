@@ -90,6 +90,21 @@ fn schema() -> Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
+/// The (code, pointer) of every finding in an `inspect --json` report.
+fn findings(r: &Value) -> Vec<(String, String)> {
+    r["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            (
+                f["code"].as_str().unwrap().into(),
+                f["pointer"].as_str().unwrap().into(),
+            )
+        })
+        .collect()
+}
+
 #[test]
 fn known_defects_are_reported_with_codes_and_pointers() {
     let mut b = Builder::default();
@@ -123,17 +138,7 @@ fn known_defects_are_reported_with_codes_and_pointers() {
     let path = b.write(&dir, "defects", Container::External);
     let r = inspect_json(&path);
     validate(&r, &schema(), "").unwrap();
-    let found: Vec<(String, String)> = r["findings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| {
-            (
-                f["code"].as_str().unwrap().into(),
-                f["pointer"].as_str().unwrap().into(),
-            )
-        })
-        .collect();
+    let found = findings(&r);
     for (code, pointer) in [
         ("MESH_NORMALS_MISSING", "/meshes/0/primitives/0"),
         ("MESH_DEGENERATE_TRIANGLES", "/meshes/0/primitives/0"),
@@ -224,17 +229,7 @@ fn raw_accessor_defects_are_reported_with_codes_and_pointers() {
     let codes = |path: &Path| -> Vec<(String, String)> {
         let r = inspect_json(path);
         validate(&r, &schema(), "").unwrap();
-        r["findings"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|f| {
-                (
-                    f["code"].as_str().unwrap().into(),
-                    f["pointer"].as_str().unwrap().into(),
-                )
-            })
-            .collect()
+        findings(&r)
     };
     let found = codes(&write(true));
     for (code, pointer) in [

@@ -277,39 +277,6 @@ pub struct RenderArgs {
     pub repeat: usize,
 }
 
-/// What to show.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum ViewArg {
-    /// Shaded image.
-    Lit,
-    /// Sun visibility alone.
-    Shadow,
-    /// World normals after normal mapping.
-    Normals,
-    /// The shadow map.
-    ShadowMap,
-    /// Which cascade shades each pixel (red, green, blue, yellow), darker in shadow.
-    Cascades,
-    /// Texture coordinates 0 as a checker, 8 cells per unit.
-    UvChecker,
-    /// World tangents (t·0.5+0.5).
-    Tangents,
-    /// World bitangents (b·0.5+0.5).
-    Bitangents,
-    /// Base colour, unlit.
-    BaseColor,
-    /// Metallic as grey.
-    Metallic,
-    /// Roughness as grey.
-    Roughness,
-    /// Linear view depth, white near, black at the scene's far end.
-    Depth,
-    /// Screen pixels per shadow texel as a heat map (dark blue: wasted texels; white: blocky).
-    TexelDensity,
-    /// Fragments rasterised per pixel (each adds 1/16, no depth test).
-    Overdraw,
-}
-
 /// PCF kernels.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum PcfArg {
@@ -358,9 +325,9 @@ pub struct ViewArgs {
     /// Intensity of the sun (the first directional light, or the default sun).
     #[arg(long)]
     pub sun_intensity: Option<f32>,
-    /// Output: lit, shadow (visibility), normals, shadow-map.
+    /// Output: the lit image or a debug view.
     #[arg(long = "view", value_enum, default_value = "lit")]
-    pub mode: ViewArg,
+    pub mode: ViewMode,
     /// Shadow-map size in texels.
     #[arg(long, default_value_t = 2048)]
     pub shadow_map: u32,
@@ -603,22 +570,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         }
         i => i,
     };
-    v.mode = match a.mode {
-        ViewArg::Lit => ViewMode::Lit,
-        ViewArg::Shadow => ViewMode::Shadow,
-        ViewArg::Normals => ViewMode::Normals,
-        ViewArg::ShadowMap => ViewMode::ShadowMap,
-        ViewArg::Cascades => ViewMode::Cascades,
-        ViewArg::UvChecker => ViewMode::UvChecker,
-        ViewArg::Tangents => ViewMode::Tangents,
-        ViewArg::Bitangents => ViewMode::Bitangents,
-        ViewArg::BaseColor => ViewMode::BaseColor,
-        ViewArg::Metallic => ViewMode::Metallic,
-        ViewArg::Roughness => ViewMode::Roughness,
-        ViewArg::Depth => ViewMode::Depth,
-        ViewArg::TexelDensity => ViewMode::TexelDensity,
-        ViewArg::Overdraw => ViewMode::Overdraw,
-    };
+    v.mode = a.mode;
     if !(16..=16384).contains(&a.shadow_map) {
         bail!("--shadow-map {} must be within 16..16384", a.shadow_map);
     }

@@ -3,8 +3,9 @@
 use crate::scene::Camera;
 use glam::Vec3;
 
-/// What the camera pass writes.
+/// What the camera pass writes (the command line's `--view`, with the `cli` feature).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum ViewMode {
     /// The shaded image.
     #[default]
