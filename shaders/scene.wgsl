@@ -194,13 +194,27 @@ fn bilinear_compare(p: vec2<f32>, layer: i32, depth: f32, size: i32) -> f32 {
 // view depth; within the blend band at a cascade's end, the next cascade for a share of pixels
 // growing from 0 to 1 across the band (interleaved-gradient dither: no seam line, and every
 // lookup stays a single exact one, which llvmpipe, running both sides of every branch, pays once).
-fn shadow_view_index(p: vec3<f32>, pixel: vec2<f32>) -> i32 {
-    let d = dot(p - frame.shadow_light.xyz, frame.camera_forward.xyz);
+// View depth of world point `p` along the shadow-fitting camera's forward axis.
+fn view_depth(p: vec3<f32>) -> f32 {
+    return dot(p - frame.shadow_light.xyz, frame.camera_forward.xyz);
+}
+
+// The cascade holding world point `p` by view depth alone (no dither; the texel-density view
+// reads it directly).
+fn cascade_of(p: vec3<f32>) -> i32 {
+    let d = view_depth(p);
     let n = i32(frame.camera_forward.w);
     var c = 0;
     for (var k = 0; k < 3; k++) {
         c += select(0, 1, k + 1 < n && d > frame.cascade_far[k]);
     }
+    return c;
+}
+
+fn shadow_view_index(p: vec3<f32>, pixel: vec2<f32>) -> i32 {
+    let d = view_depth(p);
+    let n = i32(frame.camera_forward.w);
+    let c = cascade_of(p);
     let start = frame.cascade_blend[c];
     let t = clamp((d - start) / max(frame.cascade_far[c] - start, 1e-20), 0.0, 1.0);
     let noise = fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
@@ -310,17 +324,6 @@ fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(
         discard;
     }
     return vec4<f32>(highlight(shade(in, front_facing, base).color), 1.0);
-}
-
-// The cascade holding world point `p` by view depth alone (no dither), for the texel-density view.
-fn cascade_of(p: vec3<f32>) -> i32 {
-    let d = dot(p - frame.shadow_light.xyz, frame.camera_forward.xyz);
-    let n = i32(frame.camera_forward.w);
-    var c = 0;
-    for (var k = 0; k < 3; k++) {
-        c += select(0, 1, k + 1 < n && d > frame.cascade_far[k]);
-    }
-    return c;
 }
 
 // A colour ramp of rising brightness: dark blue, teal, yellow, white over t in [0, 1].

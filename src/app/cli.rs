@@ -375,7 +375,8 @@ pub struct ViewArgs {
     pub ground: bool,
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+/// `WxH`, each side 1..=`MAX_SIDE`.
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not WxH"))?;

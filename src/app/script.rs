@@ -72,20 +72,12 @@ pub fn parse_item(s: &str) -> Result<(ScriptStep, u32), String> {
         }
         ScriptStep::Wheel(lines)
     } else {
-        let (w, h) = step
-            .split_once(['x', 'X'])
-            .ok_or_else(|| format!("'{step}' is not WxH, key:NAME or wheel:N"))?;
-        let side = |v: &str| {
-            v.trim()
-                .parse::<u32>()
-                .ok()
-                .filter(|&v| v <= umbra::render::MAX_SIDE)
-                .ok_or_else(|| format!("bad size '{step}'"))
+        let (w, h) = if step == "0x0" {
+            (0, 0)
+        } else {
+            super::cli::parse_size(step)
+                .map_err(|e| format!("{e} (a step is WxH, 0x0, key:NAME, wheel:N or click:X:Y)"))?
         };
-        let (w, h) = (side(w)?, side(h)?);
-        if (w == 0) != (h == 0) {
-            return Err(format!("size '{step}' must be 0x0 or at least 1x1"));
-        }
         ScriptStep::Resize(w, h)
     };
     Ok((parsed, times))

@@ -71,6 +71,31 @@ pub struct Probe {
     pub visible: bool,
 }
 
+/// Light `l` seen from point `p`: unit direction towards it, distance (∞ for a directional
+/// light) and radiance arriving (inverse square and the spot cone applied).
+fn light_at(l: &crate::scene::Light, p: Vec3) -> (Vec3, f32, Vec3) {
+    match l.kind {
+        LightKind::Directional => (
+            -l.direction.normalize_or(Vec3::NEG_Y),
+            f32::INFINITY,
+            l.color * l.intensity,
+        ),
+        _ => {
+            let d = l.position - p;
+            let r2 = d.length_squared().max(1e-8);
+            let dir = d / r2.sqrt();
+            let mut rad = l.color * l.intensity / r2;
+            if let LightKind::Spot { inner, outer } = l.kind {
+                let cd = (-dir).dot(l.direction.normalize_or(Vec3::NEG_Y));
+                let (lo, hi) = (outer.cos(), inner.cos());
+                let t = ((cd - lo) / (hi - lo)).clamp(0.0, 1.0);
+                rad *= t * t * (3.0 - 2.0 * t);
+            }
+            (dir, r2.sqrt(), rad)
+        }
+    }
+}
+
 /// What a click on the image hits (`ReferenceScene::pick`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pick {
@@ -237,27 +262,7 @@ impl<'a> ReferenceScene<'a> {
         ng: Vec3,
         n_facing: Vec3,
     ) -> (bool, Vec3, Vec3) {
-        let l = &plan.lights[i];
-        let (dir, dist, radiance) = match l.kind {
-            LightKind::Directional => (
-                -l.direction.normalize_or(Vec3::NEG_Y),
-                f32::INFINITY,
-                l.color * l.intensity,
-            ),
-            _ => {
-                let d = l.position - p;
-                let r2 = d.length_squared().max(1e-8);
-                let dir = d / r2.sqrt();
-                let mut rad = l.color * l.intensity / r2;
-                if let LightKind::Spot { inner, outer } = l.kind {
-                    let cd = (-dir).dot(l.direction.normalize_or(Vec3::NEG_Y));
-                    let (lo, hi) = (outer.cos(), inner.cos());
-                    let t = ((cd - lo) / (hi - lo)).clamp(0.0, 1.0);
-                    rad *= t * t * (3.0 - 2.0 * t);
-                }
-                (dir, r2.sqrt(), rad)
-            }
-        };
+        let (dir, dist, radiance) = light_at(&plan.lights[i], p);
         let facing = n_facing.dot(dir) > 0.0;
         if !facing {
             return (false, dir, radiance);
@@ -297,15 +302,12 @@ impl<'a> ReferenceScene<'a> {
             n_geo = -n_geo;
         }
         let p = ray.at(h.t);
-        let lights = (0..plan.lights.len())
-            .map(|i| {
-                let (facing, dir, _) = self.visible(plan, i, p, ng, n_geo);
-                let l = &plan.lights[i];
-                let dist = match l.kind {
-                    LightKind::Directional => f32::INFINITY,
-                    _ => l.position.distance(p),
-                };
-                facing && !self.occluded(p, ng, dir, dist)
+        let lights = plan
+            .lights
+            .iter()
+            .map(|l| {
+                let (dir, dist, _) = light_at(l, p);
+                n_geo.dot(dir) > 0.0 && !self.occluded(p, ng, dir, dist)
             })
             .collect();
         Some(Pick {

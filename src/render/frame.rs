@@ -480,27 +480,10 @@ fn far_view_depth(camera: &Camera, bounds: &Aabb) -> f32 {
         return camera.near * 2.0;
     }
     let m = camera.view_from_world();
-    let far = (0..8)
-        .map(|i| {
-            let c = Vec3::new(
-                if i & 1 == 0 {
-                    bounds.min.x
-                } else {
-                    bounds.max.x
-                },
-                if i & 2 == 0 {
-                    bounds.min.y
-                } else {
-                    bounds.max.y
-                },
-                if i & 4 == 0 {
-                    bounds.min.z
-                } else {
-                    bounds.max.z
-                },
-            );
-            -m.transform_point3(c).z
-        })
+    let far = bounds
+        .corners()
+        .iter()
+        .map(|c| -m.transform_point3(*c).z)
         .fold(0.0f32, f32::max);
     far.max(camera.near * 2.0)
 }

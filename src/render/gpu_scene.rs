@@ -367,7 +367,8 @@ impl GpuScene {
             let world_from_model = crate::scene::rebased(inst.world_from_model, origin);
             for (pi, r) in ranges[inst.mesh].iter().enumerate() {
                 let (index_count, material) = (r.index_count, r.material);
-                bounds = bounds.union(&r.bounds.transformed(&world_from_model));
+                let world_bounds = r.bounds.transformed(&world_from_model);
+                bounds = bounds.union(&world_bounds);
                 if index_count == 0 {
                     continue;
                 }
@@ -383,7 +384,7 @@ impl GpuScene {
                     model_from_world: world_from_model.inverse(),
                     clusters: r.clusters,
                     immediates: SceneImmediates::new(world_from_model),
-                    world_bounds: r.bounds.transformed(&world_from_model),
+                    world_bounds,
                     world_plane: r.plane.and_then(|pl| world_plane(pl, &world_from_model)),
                     double_sided: mat.is_some_and(|m| m.double_sided),
                     mirrored: glam::Mat3::from_mat4(world_from_model).determinant() < 0.0,

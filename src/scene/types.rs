@@ -162,10 +162,8 @@ pub struct Light {
 impl Light {
     /// The same light in coordinates relative to `origin` (see [`Scene::render_origin`]).
     pub fn rebased(&self, origin: Vec3) -> Self {
-        let p = self.position;
-        let rel = |a: f32, o: f32| (a as f64 - o as f64) as f32;
         Self {
-            position: Vec3::new(rel(p.x, origin.x), rel(p.y, origin.y), rel(p.z, origin.z)),
+            position: rebased_point(self.position, origin),
             ..*self
         }
     }
@@ -246,16 +244,15 @@ pub fn rebased(world_from_model: Mat4, origin: Vec3) -> Mat4 {
     if origin == Vec3::ZERO {
         return world_from_model;
     }
-    let t = world_from_model.w_axis;
-    let rel = |a: f32, o: f32| (a as f64 - o as f64) as f32;
     let mut m = world_from_model;
-    m.w_axis = glam::Vec4::new(
-        rel(t.x, origin.x),
-        rel(t.y, origin.y),
-        rel(t.z, origin.z),
-        t.w,
-    );
+    let t = m.w_axis;
+    m.w_axis = rebased_point(t.truncate(), origin).extend(t.w);
     m
+}
+
+/// `p − origin`, subtracted in f64 (see [`rebased`]).
+pub fn rebased_point(p: Vec3, origin: Vec3) -> Vec3 {
+    (p.as_dvec3() - origin.as_dvec3()).as_vec3()
 }
 
 /// A placed mesh.
