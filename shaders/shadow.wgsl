@@ -1,5 +1,10 @@
 // Light-space depth pass: position-only vertex stream, no fragment shader output.
 // Depth is reversed-z (near the light -> 1, far -> 0); see src/math/projection.rs.
+//
+// Alpha-masked casters (glTF alphaMode MASK) have their own pipeline: vs_masked passes
+// TEXCOORD_0 on and fs_masked discards where the base colour's alpha (factor x texture) is below
+// the cutoff, exactly the test of the camera pass's fs_masked. Opaque casters keep the depth-only
+// pipeline (no fragment shader at all).
 
 struct ShadowImmediates {
     light_clip_from_world: mat4x4<f32>,
@@ -8,7 +13,42 @@ struct ShadowImmediates {
 
 var<immediate> pc: ShadowImmediates;
 
+// The camera pass's material block (shaders/scene.wgsl, group 1): the masked pipeline binds the
+// same descriptor set, at set 0 of its layout.
+struct Material {
+    base_color: vec4<f32>,
+    emissive: vec4<f32>,
+    params: vec4<f32>,
+    // x: alpha cutoff
+    extra: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> material: Material;
+@group(0) @binding(1) var base_color_tex: texture_2d<f32>;
+@group(0) @binding(5) var material_sampler: sampler;
+
 @vertex
 fn vs_main(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
     return pc.light_clip_from_world * (pc.world_from_model * vec4<f32>(position, 1.0));
+}
+
+struct MaskedOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+}
+
+@vertex
+fn vs_masked(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> MaskedOut {
+    var out: MaskedOut;
+    out.clip = pc.light_clip_from_world * (pc.world_from_model * vec4<f32>(position, 1.0));
+    out.uv = uv;
+    return out;
+}
+
+@fragment
+fn fs_masked(in: MaskedOut) {
+    let alpha = material.base_color.a * textureSample(base_color_tex, material_sampler, in.uv).a;
+    if alpha < material.extra.x {
+        discard;
+    }
 }

@@ -173,5 +173,20 @@ mod tests {
         for b in scene::BINDINGS {
             assert!(seen.insert((b.group, b.binding)), "{}", b.name);
         }
+        // The shadow pass's masked pipeline binds the camera pass's material set at set 0: each
+        // binding it declares is the scene's group-1 binding of the same number and kind.
+        for b in shadow::BINDINGS {
+            let twin = scene::BINDINGS
+                .iter()
+                .find(|s| s.group == 1 && s.binding == b.binding)
+                .unwrap_or_else(|| panic!("{} has no material twin", b.name));
+            assert_eq!(
+                (b.group, b.kind, b.size),
+                (0, twin.kind, twin.size),
+                "{}",
+                b.name
+            );
+            assert_eq!(b.name, twin.name);
+        }
     }
 }

@@ -196,15 +196,46 @@ impl Bvh {
 
     /// The nearest hit with t in (t_min, t_max).
     pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
-        self.traverse(ray, t_min, t_max, false)
+        self.traverse(ray, t_min, t_max, false, &|_: &Hit| true)
     }
 
     /// True when anything is hit with t in (t_min, t_max) (shadow rays).
     pub fn occluded(&self, ray: &Ray, t_min: f32, t_max: f32) -> bool {
-        self.traverse(ray, t_min, t_max, true).is_some()
+        self.traverse(ray, t_min, t_max, true, &|_: &Hit| true)
+            .is_some()
     }
 
-    fn traverse(&self, ray: &Ray, t_min: f32, mut t_max: f32, any: bool) -> Option<Hit> {
+    /// The nearest hit with t in (t_min, t_max) that `accept` keeps (an any-hit filter: an
+    /// alpha-masked texel lets the ray through).
+    pub fn intersect_where(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+        accept: &impl Fn(&Hit) -> bool,
+    ) -> Option<Hit> {
+        self.traverse(ray, t_min, t_max, false, accept)
+    }
+
+    /// True when a hit that `accept` keeps lies in (t_min, t_max).
+    pub fn occluded_where(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+        accept: &impl Fn(&Hit) -> bool,
+    ) -> bool {
+        self.traverse(ray, t_min, t_max, true, accept).is_some()
+    }
+
+    fn traverse(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        mut t_max: f32,
+        any: bool,
+        accept: &impl Fn(&Hit) -> bool,
+    ) -> Option<Hit> {
         if self.tris.is_empty() {
             return None;
         }
@@ -225,6 +256,7 @@ impl Bvh {
                     &mut t_max,
                     any,
                     &mut best,
+                    accept,
                 ) {
                     return best;
                 }
@@ -238,7 +270,7 @@ impl Bvh {
                 (Some(a), Some(b)) => {
                     let (near, far) = if a <= b { (l, r) } else { (r, l) };
                     if sp + 2 > stack.len() {
-                        return self.brute(ray, t_min, t_max, any).or(best);
+                        return self.brute(ray, t_min, t_max, any, accept).or(best);
                     }
                     stack[sp] = far;
                     stack[sp + 1] = near;
@@ -246,7 +278,7 @@ impl Bvh {
                 }
                 (Some(_), None) | (None, Some(_)) => {
                     if sp + 1 > stack.len() {
-                        return self.brute(ray, t_min, t_max, any).or(best);
+                        return self.brute(ray, t_min, t_max, any, accept).or(best);
                     }
                     stack[sp] = if tl.is_some() { l } else { r };
                     sp += 1;
@@ -257,14 +289,30 @@ impl Bvh {
         best
     }
 
-    fn brute(&self, ray: &Ray, t_min: f32, mut t_max: f32, any: bool) -> Option<Hit> {
+    fn brute(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        mut t_max: f32,
+        any: bool,
+        accept: &impl Fn(&Hit) -> bool,
+    ) -> Option<Hit> {
         let mut best = None;
-        self.test_range(0..self.tris.len(), ray, t_min, &mut t_max, any, &mut best);
+        self.test_range(
+            0..self.tris.len(),
+            ray,
+            t_min,
+            &mut t_max,
+            any,
+            &mut best,
+            accept,
+        );
         best
     }
 
-    /// Tests triangles `range` (in BVH order), keeping the nearest hit in `best` and shrinking
-    /// `t_max`; returns true when `any` is set and something was hit.
+    /// Tests triangles `range` (in BVH order), keeping the nearest hit that `accept` keeps in
+    /// `best` and shrinking `t_max`; returns true when `any` is set and something was hit.
+    #[allow(clippy::too_many_arguments)]
     fn test_range(
         &self,
         range: std::ops::Range<usize>,
@@ -273,19 +321,24 @@ impl Bvh {
         t_max: &mut f32,
         any: bool,
         best: &mut Option<Hit>,
+        accept: &impl Fn(&Hit) -> bool,
     ) -> bool {
         let len = ray.dir.length();
         for k in range {
             let t = &self.tris[k];
             if let Some(h) = ray_triangle_edges(ray, t.a, t.e1, t.e2, t.scale * len, t_min, *t_max)
             {
-                *t_max = h.t;
-                *best = Some(Hit {
+                let hit = Hit {
                     t: h.t,
                     triangle: self.ids[k],
                     u: h.u,
                     v: h.v,
-                });
+                };
+                if !accept(&hit) {
+                    continue;
+                }
+                *t_max = h.t;
+                *best = Some(hit);
                 if any {
                     return true;
                 }
@@ -296,7 +349,7 @@ impl Bvh {
 
     /// Brute force over every triangle (for testing the hierarchy).
     pub fn intersect_brute_force(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
-        self.brute(ray, t_min, t_max, false)
+        self.brute(ray, t_min, t_max, false, &|_: &Hit| true)
     }
 }
 

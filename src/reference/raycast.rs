@@ -6,7 +6,7 @@ use crate::math::interp::perturb_normal;
 use crate::math::projection::pixel_to_ndc;
 use crate::math::ray::Ray;
 use crate::render::frame::FramePlan;
-use crate::scene::{blinn_phong_params, shade_blinn_phong, LightKind, Scene, Texture};
+use crate::scene::{blinn_phong_params, shade_blinn_phong, AlphaMode, LightKind, Scene, Texture};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
@@ -279,8 +279,40 @@ impl<'a> ReferenceScene<'a> {
         // Start the shadow ray off the surface, on the light's side of the true face.
         let side = if ng.dot(dir) >= 0.0 { ng } else { -ng };
         let origin = p + side * self.eps;
+        self.bvh.occluded_where(
+            &Ray::new(origin, dir),
+            self.eps,
+            dist - self.eps,
+            &|h: &Hit| self.opaque_at(h),
+        )
+    }
+
+    /// The nearest surface along a primary ray (alpha-masked texels let it through).
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.bvh
-            .occluded(&Ray::new(origin, dir), self.eps, dist - self.eps)
+            .intersect_where(ray, 0.0, f32::INFINITY, &|h: &Hit| self.opaque_at(h))
+    }
+
+    /// Whether a hit stops rays: always, except on an alpha-masked material where the base
+    /// colour's alpha (factor × texture, bilinear on mip 0 as everywhere here) is below the
+    /// cutoff, which is where the GPU's masked pipelines discard (camera and shadow pass alike).
+    fn opaque_at(&self, h: &Hit) -> bool {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let Some(mat) = self.scene.materials.get(prim.material) else {
+            return true;
+        };
+        let AlphaMode::Mask(cutoff) = mat.alpha_mode else {
+            return true;
+        };
+        let i = |k: u32| prim.indices[(r.first + k) as usize] as usize;
+        let uv = if prim.uvs.is_empty() {
+            Vec2::ZERO
+        } else {
+            prim.uvs[i(0)] * (1.0 - h.u - h.v) + prim.uvs[i(1)] * h.u + prim.uvs[i(2)] * h.v
+        };
+        let tex = mat.base_color_texture.map(|t| t.texture);
+        mat.base_color.w * self.sample(tex, uv, true, Vec4::ONE).w >= cutoff
     }
 
     /// What lies under image position (`x`, `y`) (pixel units, centres at +0.5) of `plan`'s
@@ -293,7 +325,7 @@ impl<'a> ReferenceScene<'a> {
         );
         let inv = plan.clip_from_world.inverse();
         let ray = primary_ray(&inv, plan.camera_position, x, y, width, height);
-        let h = self.bvh.intersect(&ray, 0.0, f32::INFINITY)?;
+        let h = self.intersect(&ray)?;
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
         let (ng, mut n_geo) = self.hit_normals(&h);
@@ -363,7 +395,7 @@ impl<'a> ReferenceScene<'a> {
             .par_iter()
             .map(|&(x, y)| {
                 let ray = primary_ray(&inv, eye, x, y, width, height);
-                let h = self.bvh.intersect(&ray, 0.0, f32::INFINITY)?;
+                let h = self.intersect(&ray)?;
                 // The same normals, flips and facing test as `shade`.
                 let (ng, mut n_geo) = self.hit_normals(&h);
                 let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
@@ -410,7 +442,7 @@ impl<'a> ReferenceScene<'a> {
                     (i as u32 / width) as f32 + 0.5,
                 );
                 let ray = primary_ray(&inv, eye, x, y, width, height);
-                match self.bvh.intersect(&ray, 0.0, f32::INFINITY) {
+                match self.intersect(&ray) {
                     None => (None, f32::INFINITY, background, false),
                     Some(h) => {
                         let (vis, rgb) = self.shade(plan, &ray, &h, ambient);

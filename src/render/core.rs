@@ -137,6 +137,7 @@ impl FrameCore {
         let layers = plan.shadow_views.len().max(1) as u32;
         self.shadow
             .ensure_map(map_size, view.shadow.format, layers)?;
+        self.shadow.ensure_masked(&self.gpu, view.shadow.format)?;
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         self.camera.bind_shadow_map(slot, map_view, hw);
         if plan.shadows_on {

@@ -2,7 +2,7 @@
 //! depth bias pushing casters away from the light (negative factors under reversed-z).
 
 use super::core::Attachment;
-use super::gpu_scene::{flat_hides_nothing, GpuScene, Viewpoint};
+use super::gpu_scene::{flat_hides_nothing, GpuScene, VertexAttributes, Viewpoint};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
@@ -156,6 +156,82 @@ pub fn plan_casters(
     plan
 }
 
+/// The pipeline of alpha-masked casters: it samples the material's base colour, so its layout
+/// holds the scene's material set layout (set 0), and it is made for one scene.
+struct MaskedPipeline {
+    /// The scene's material set layout it was made with.
+    material_layout: vk::DescriptorSetLayout,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    format: vk::Format,
+}
+
+/// Creates a depth-only pipeline of the shadow pass: `masked` takes TEXCOORD_0 from the
+/// attribute stream (binding 1) and runs `fs_masked`; otherwise positions only, no fragment stage.
+fn depth_pipeline(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    module: vk::ShaderModule,
+    masked: bool,
+    format: vk::Format,
+) -> Result<vk::Pipeline, GpuError> {
+    let bindings = [
+        vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: 12,
+            input_rate: vk::VertexInputRate::VERTEX,
+        },
+        vk::VertexInputBindingDescription {
+            binding: 1,
+            stride: std::mem::size_of::<VertexAttributes>() as u32,
+            input_rate: vk::VertexInputRate::VERTEX,
+        },
+    ];
+    let attributes = [
+        vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 0,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 1,
+            format: vk::Format::R32G32_SFLOAT,
+            offset: std::mem::offset_of!(VertexAttributes, uv) as u32,
+        },
+    ];
+    let n = if masked { 2 } else { 1 };
+    create_pipeline(
+        ctx,
+        &PipelineDesc {
+            name: if masked {
+                "shadow depth pipeline, alpha-masked"
+            } else {
+                "shadow depth pipeline"
+            },
+            layout,
+            vertex: (
+                module,
+                if masked {
+                    sh::ENTRY_VS_MASKED
+                } else {
+                    sh::ENTRY_VS_MAIN
+                },
+            ),
+            fragment: masked.then_some((module, sh::ENTRY_FS_MASKED)),
+            bindings: &bindings[..n],
+            attributes: &attributes[..n],
+            color_format: None,
+            depth_format: format,
+            depth_clamp: true,
+            depth_bias: true,
+            depth_test: true,
+            additive: false,
+        },
+    )
+}
+
 /// The shadow depth pass and its map.
 pub struct ShadowPass {
     ctx: Arc<Context>,
@@ -163,6 +239,7 @@ pub struct ShadowPass {
     module: vk::ShaderModule,
     pipeline: vk::Pipeline,
     pipeline_format: vk::Format,
+    masked: Option<MaskedPipeline>,
     /// The shadow map (None before the first `ensure_map`).
     pub map: Option<Image>,
     /// The map's attachment state (set with the map).
@@ -180,6 +257,7 @@ impl ShadowPass {
             module,
             pipeline: vk::Pipeline::null(),
             pipeline_format: vk::Format::UNDEFINED,
+            masked: None,
             map: None,
             map_at: None,
         })
@@ -197,34 +275,7 @@ impl ShadowPass {
         if self.pipeline_format != fmt {
             unsafe { self.ctx.device.destroy_pipeline(self.pipeline, None) };
             self.pipeline = vk::Pipeline::null();
-            let bindings = [vk::VertexInputBindingDescription {
-                binding: 0,
-                stride: 12,
-                input_rate: vk::VertexInputRate::VERTEX,
-            }];
-            let attributes = [vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            }];
-            self.pipeline = create_pipeline(
-                &self.ctx,
-                &PipelineDesc {
-                    name: "shadow depth pipeline",
-                    layout: self.layout,
-                    vertex: (self.module, sh::ENTRY_VS_MAIN),
-                    fragment: None,
-                    bindings: &bindings,
-                    attributes: &attributes,
-                    color_format: None,
-                    depth_format: fmt,
-                    depth_clamp: true,
-                    depth_bias: true,
-                    depth_test: true,
-                    additive: false,
-                },
-            )?;
+            self.pipeline = depth_pipeline(&self.ctx, self.layout, self.module, false, fmt)?;
             self.pipeline_format = fmt;
         }
         let size = size.clamp(1, 16384);
@@ -253,6 +304,56 @@ impl ShadowPass {
         )?);
         self.map_at = self.map.as_ref().map(Attachment::of);
         Ok(true)
+    }
+
+    /// Makes sure alpha-masked casters of `scene` have their pipeline (made once per scene and
+    /// map format, only for scenes with such materials).
+    pub fn ensure_masked(
+        &mut self,
+        scene: &GpuScene,
+        format: ShadowFormat,
+    ) -> Result<(), GpuError> {
+        let fmt = vk_format(format);
+        if !scene.draws.iter().any(|d| d.masked)
+            || self
+                .masked
+                .as_ref()
+                .is_some_and(|m| m.material_layout == scene.material_layout && m.format == fmt)
+        {
+            return Ok(());
+        }
+        self.drop_masked();
+        let layout = create_layout(
+            &self.ctx,
+            &[scene.material_layout],
+            sh::IMMEDIATE_SIZE,
+            "shadow pipeline layout, alpha-masked",
+        )?;
+        let pipeline = match depth_pipeline(&self.ctx, layout, self.module, true, fmt) {
+            Ok(p) => p,
+            Err(e) => {
+                unsafe { self.ctx.device.destroy_pipeline_layout(layout, None) };
+                return Err(e);
+            }
+        };
+        self.masked = Some(MaskedPipeline {
+            material_layout: scene.material_layout,
+            layout,
+            pipeline,
+            format: fmt,
+        });
+        Ok(())
+    }
+
+    fn drop_masked(&mut self) {
+        if let Some(m) = self.masked.take() {
+            unsafe {
+                let d = &self.ctx.device;
+                let _ = d.device_wait_idle();
+                d.destroy_pipeline(m.pipeline, None);
+                d.destroy_pipeline_layout(m.layout, None);
+            }
+        }
     }
 
     /// Whether `format` supports hardware linear filtering of comparisons.
@@ -302,22 +403,52 @@ impl ShadowPass {
             unsafe {
                 d.cmd_begin_rendering(cmd, &rendering);
                 if !casters.draws.is_empty() {
-                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
                     set_viewport(&self.ctx, cmd, map.extent);
                     d.cmd_set_scissor(cmd, 0, &[area]);
-                    // Reversed-z: "away from the light" is towards smaller depth, so the factor
-                    // is negated. The constant bias is applied on the receiver side, in texels.
-                    d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
-                    d.cmd_bind_vertex_buffers(cmd, 0, &[scene.positions.raw], &[0]);
                     d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-                    for dr in casters.draws.iter().map(|&i| &scene.draws[i]) {
-                        let pc = ShadowImmediates {
-                            light_clip_from_world: *light_clip_from_world,
-                            world_from_model: dr.world_from_model,
+                    // Opaque casters first, with the depth-only pipeline; then the alpha-masked
+                    // ones, whose pipeline samples the base colour and discards.
+                    for masked in [false, true] {
+                        let (pipeline, layout) = match (&self.masked, masked) {
+                            (_, false) => (self.pipeline, self.layout),
+                            (Some(m), true) => (m.pipeline, m.layout),
+                            // No masked pipeline: no masked draws (`ensure_masked`).
+                            (None, true) => break,
                         };
-                        let pc = bytemuck::bytes_of(&pc);
-                        scene.record_draw(d, cmd, self.layout, dr, eye, from, pc);
-                        drawn += 1;
+                        let mut bound = false;
+                        for dr in casters.draws.iter().map(|&i| &scene.draws[i]) {
+                            if dr.masked != masked {
+                                continue;
+                            }
+                            if !bound {
+                                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                                // Reversed-z: "away from the light" is towards smaller depth, so
+                                // the factor is negated. The constant bias is applied on the
+                                // receiver side, in texels.
+                                d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
+                                let buffers = [scene.positions.raw, scene.attributes.raw];
+                                let n = if masked { 2 } else { 1 };
+                                d.cmd_bind_vertex_buffers(cmd, 0, &buffers[..n], &[0, 0][..n]);
+                                bound = true;
+                            }
+                            if masked {
+                                d.cmd_bind_descriptor_sets(
+                                    cmd,
+                                    vk::PipelineBindPoint::GRAPHICS,
+                                    layout,
+                                    0,
+                                    &[scene.material_sets[dr.material]],
+                                    &[],
+                                );
+                            }
+                            let pc = ShadowImmediates {
+                                light_clip_from_world: *light_clip_from_world,
+                                world_from_model: dr.world_from_model,
+                            };
+                            let pc = bytemuck::bytes_of(&pc);
+                            scene.record_draw(d, cmd, layout, dr, eye, from, pc);
+                            drawn += 1;
+                        }
                     }
                 }
                 d.cmd_end_rendering(cmd);
@@ -331,6 +462,7 @@ impl ShadowPass {
 
 impl Drop for ShadowPass {
     fn drop(&mut self) {
+        self.drop_masked();
         unsafe {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
