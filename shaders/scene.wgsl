@@ -132,7 +132,11 @@ struct Immediates {
 @group(1) @binding(2) var normal_tex: texture_2d<f32>;
 @group(1) @binding(3) var metal_rough_tex: texture_2d<f32>;
 @group(1) @binding(4) var emissive_tex: texture_2d<f32>;
-@group(1) @binding(5) var material_sampler: sampler;
+// One sampler per texture slot: the glTF texture's own filters and wrap modes.
+@group(1) @binding(5) var base_color_sampler: sampler;
+@group(1) @binding(6) var normal_sampler: sampler;
+@group(1) @binding(7) var metal_rough_sampler: sampler;
+@group(1) @binding(8) var emissive_sampler: sampler;
 
 var<immediate> pc: Immediates;
 
@@ -296,7 +300,7 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
 fn base_color(uv: vec2<f32>) -> vec4<f32> {
     var base = material.base_color;
     if HAS_BASE_TEX {
-        base *= textureSample(base_color_tex, material_sampler, uv);
+        base *= textureSample(base_color_tex, base_color_sampler, uv);
     }
     return base;
 }
@@ -371,7 +375,7 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
     if mode == VIEW_METALLIC || mode == VIEW_ROUGHNESS {
         var mr = vec4<f32>(1.0);
         if HAS_OTHER_TEX {
-            mr = textureSample(metal_rough_tex, material_sampler, in.uv);
+            mr = textureSample(metal_rough_tex, metal_rough_sampler, in.uv);
         }
         let v = select(material.params.y * mr.g, material.params.x * mr.b, mode == VIEW_METALLIC);
         return vec4<f32>(srgb_to_linear(vec3<f32>(clamp(v, 0.0, 1.0))), 1.0);
@@ -436,7 +440,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     var n_geo = normalize(in.normal);
     var n = n_geo;
     if HAS_NORMAL_MAP {
-        let normal_sample = textureSample(normal_tex, material_sampler, in.uv).xyz;
+        let normal_sample = textureSample(normal_tex, normal_sampler, in.uv).xyz;
         let t_raw = in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz);
         if dot(t_raw, t_raw) > 1e-12 {
             let t = normalize(t_raw);
@@ -452,7 +456,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     }
     var mr = vec4<f32>(1.0);
     if HAS_OTHER_TEX {
-        mr = textureSample(metal_rough_tex, material_sampler, in.uv);
+        mr = textureSample(metal_rough_tex, metal_rough_sampler, in.uv);
     }
     let metallic = clamp(material.params.x * mr.b, 0.0, 1.0);
     let roughness = clamp(material.params.y * mr.g, 0.03, 1.0);
@@ -464,7 +468,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     let ka = base.rgb;
     var emissive = material.emissive.rgb;
     if HAS_OTHER_TEX {
-        emissive *= textureSample(emissive_tex, material_sampler, in.uv).rgb;
+        emissive *= textureSample(emissive_tex, emissive_sampler, in.uv).rgb;
     }
 
     let p = in.world_position;

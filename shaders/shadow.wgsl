@@ -25,7 +25,7 @@ struct Material {
 
 @group(0) @binding(0) var<uniform> material: Material;
 @group(0) @binding(1) var base_color_tex: texture_2d<f32>;
-@group(0) @binding(5) var material_sampler: sampler;
+@group(0) @binding(5) var base_color_sampler: sampler;
 
 @vertex
 fn vs_main(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
@@ -47,7 +47,7 @@ fn vs_masked(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> Ma
 
 @fragment
 fn fs_masked(in: MaskedOut) {
-    let alpha = material.base_color.a * textureSample(base_color_tex, material_sampler, in.uv).a;
+    let alpha = material.base_color.a * textureSample(base_color_tex, base_color_sampler, in.uv).a;
     if alpha < material.extra.x {
         discard;
     }

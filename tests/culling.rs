@@ -129,7 +129,7 @@ fn masked_and_opaque_materials_draw_in_their_pipelines() {
     );
     let masked = Material {
         base_color: glam::Vec4::new(1.0, 0.0, 0.0, 1.0),
-        base_color_texture: Some(TextureRef { texture: tex }),
+        base_color_texture: Some(TextureRef::new(tex)),
         alpha_mode: AlphaMode::Mask(0.5),
         unlit: true,
         ..Default::default()

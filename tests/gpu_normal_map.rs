@@ -26,7 +26,7 @@ fn panel_scene_lit(mut p: Primitive, light: Vec3) -> Scene {
     };
     let tex = add_texture(&mut s, bump_normal_map(256, BUMPS, 1.5));
     let m = Material {
-        normal_texture: Some(TextureRef { texture: tex }),
+        normal_texture: Some(TextureRef::new(tex)),
         roughness: 1.0,
         ..Default::default()
     };

@@ -52,7 +52,7 @@ fn fence_scene(mode: AlphaMode) -> Scene {
     let card = Material {
         name: "fence".into(),
         base_color: Vec4::ONE,
-        base_color_texture: Some(TextureRef { texture: tex }),
+        base_color_texture: Some(TextureRef::new(tex)),
         alpha_mode: mode,
         double_sided: true,
         ..Default::default()

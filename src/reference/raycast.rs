@@ -6,7 +6,10 @@ use crate::math::interp::perturb_normal;
 use crate::math::projection::pixel_to_ndc;
 use crate::math::ray::Ray;
 use crate::render::frame::FramePlan;
-use crate::scene::{blinn_phong_params, shade_blinn_phong, AlphaMode, LightKind, Scene, Texture};
+use crate::scene::{
+    blinn_phong_params, shade_blinn_phong, AlphaMode, Filter, LightKind, Sampler, Scene, Texture,
+    TextureRef,
+};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
@@ -217,9 +220,9 @@ impl<'a> ReferenceScene<'a> {
         }
     }
 
-    fn texel(&self, t: &Texture, x: i64, y: i64, srgb: bool) -> Vec4 {
+    fn texel(&self, t: &Texture, s: &Sampler, x: i64, y: i64, srgb: bool) -> Vec4 {
         let (w, h) = (t.width as i64, t.height as i64);
-        let (x, y) = (x.rem_euclid(w), y.rem_euclid(h));
+        let (x, y) = (s.wrap_u.texel(x, w), s.wrap_v.texel(y, h));
         let i = ((y * w + x) * 4) as usize;
         let px = &t.rgba[i..i + 4];
         if srgb {
@@ -234,22 +237,29 @@ impl<'a> ReferenceScene<'a> {
         }
     }
 
-    /// Bilinear sample of mip 0 with repeat wrapping (decoded from sRGB when `srgb`).
-    fn sample(&self, tex: Option<usize>, uv: Vec2, srgb: bool, default: Vec4) -> Vec4 {
-        let Some(t) = tex.and_then(|i| self.scene.textures.get(i)) else {
+    /// Sample of mip 0 with the texture's sampler: its magnification filter (nearest or
+    /// bilinear) and wrap modes (decoded from sRGB when `srgb`). Mip 0 only: the reference has
+    /// no pixel footprint, so minification filters and mipmaps are not modelled.
+    fn sample(&self, tex: Option<TextureRef>, uv: Vec2, srgb: bool, default: Vec4) -> Vec4 {
+        let Some((t, s)) = tex.and_then(|r| Some((self.scene.textures.get(r.texture)?, r.sampler)))
+        else {
             return default;
         };
-        let x = uv.x * t.width as f32 - 0.5;
-        let y = uv.y * t.height as f32 - 0.5;
+        let x = uv.x * t.width as f32;
+        let y = uv.y * t.height as f32;
+        if s.mag == Filter::Nearest {
+            return self.texel(t, &s, x.floor() as i64, y.floor() as i64, srgb);
+        }
+        let (x, y) = (x - 0.5, y - 0.5);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
         let a = self
-            .texel(t, x0, y0, srgb)
-            .lerp(self.texel(t, x0 + 1, y0, srgb), fx);
+            .texel(t, &s, x0, y0, srgb)
+            .lerp(self.texel(t, &s, x0 + 1, y0, srgb), fx);
         let b = self
-            .texel(t, x0, y0 + 1, srgb)
-            .lerp(self.texel(t, x0 + 1, y0 + 1, srgb), fx);
+            .texel(t, &s, x0, y0 + 1, srgb)
+            .lerp(self.texel(t, &s, x0 + 1, y0 + 1, srgb), fx);
         a.lerp(b, fy)
     }
 
@@ -311,7 +321,7 @@ impl<'a> ReferenceScene<'a> {
         } else {
             prim.uvs[i(0)] * (1.0 - h.u - h.v) + prim.uvs[i(1)] * h.u + prim.uvs[i(2)] * h.v
         };
-        let tex = mat.base_color_texture.map(|t| t.texture);
+        let tex = mat.base_color_texture;
         mat.base_color.w * self.sample(tex, uv, true, Vec4::ONE).w >= cutoff
     }
 
@@ -490,13 +500,7 @@ impl<'a> ReferenceScene<'a> {
         let (ng, mut n_geo) = self.hit_normals(h);
         let uv = prim.uvs[idx[0]] * w.x + prim.uvs[idx[1]] * w.y + prim.uvs[idx[2]] * w.z;
         let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];
-        let base = mat.base_color
-            * self.sample(
-                mat.base_color_texture.map(|t| t.texture),
-                uv,
-                true,
-                Vec4::ONE,
-            );
+        let base = mat.base_color * self.sample(mat.base_color_texture, uv, true, Vec4::ONE);
         let mut n = n_geo;
         if mat.normal_texture.is_some() && !prim.tangents.is_empty() {
             let t4 = prim.tangents[idx[0]] * w.x
@@ -504,12 +508,7 @@ impl<'a> ReferenceScene<'a> {
                 + prim.tangents[idx[2]] * w.z;
             // A mirroring transform flips the bitangent, as in the vertex shader.
             let det_sign = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
-            let s = self.sample(
-                mat.normal_texture.map(|t| t.texture),
-                uv,
-                false,
-                Vec4::new(0.5, 0.5, 1.0, 1.0),
-            );
+            let s = self.sample(mat.normal_texture, uv, false, Vec4::new(0.5, 0.5, 1.0, 1.0));
             let tn = s.truncate() * 2.0 - Vec3::ONE;
             let tn = Vec3::new(tn.x * mat.normal_scale, tn.y * mat.normal_scale, tn.z);
             n = perturb_normal(
@@ -525,16 +524,11 @@ impl<'a> ReferenceScene<'a> {
             n_geo = -n_geo;
             n = -n;
         }
-        let mr = self.sample(
-            mat.metallic_roughness_texture.map(|t| t.texture),
-            uv,
-            false,
-            Vec4::ONE,
-        );
+        let mr = self.sample(mat.metallic_roughness_texture, uv, false, Vec4::ONE);
         let bp = blinn_phong_params(base.truncate(), mat.metallic * mr.z, mat.roughness * mr.y);
         let emissive = mat.emissive
             * self
-                .sample(mat.emissive_texture.map(|t| t.texture), uv, true, Vec4::ONE)
+                .sample(mat.emissive_texture, uv, true, Vec4::ONE)
                 .truncate();
         let v = -ray.dir;
         let mut color = bp.ka * ambient + emissive;

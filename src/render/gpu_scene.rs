@@ -1,9 +1,10 @@
 //! A scene uploaded to the GPU: one position stream (shared by the shadow pass), one attribute
 //! stream, one index buffer, textures with mipmaps, and a descriptor set per material.
 
+use super::samplers::SamplerCache;
 use super::settings::SceneOptions;
 use super::uniforms::{MaterialUniform, SceneImmediates};
-use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
 use crate::gpu::{Buffer, Image};
 use crate::math::Aabb;
@@ -208,7 +209,8 @@ pub struct GpuScene {
     /// pipelines the scene needs per frame variant.
     pub pipeline_keys: Vec<(usize, bool)>,
     pool: vk::DescriptorPool,
-    sampler: vk::Sampler,
+    /// Destroyed after the pool (fields drop after `Drop::drop`).
+    _samplers: SamplerCache,
     _material_buffers: Vec<Buffer>,
     _textures: Vec<Image>,
 }
@@ -445,19 +447,7 @@ impl GpuScene {
         let material_layout = set_layout(ctx, sh::BINDINGS, 1, "material set layout")?;
         let (pool, sets) =
             allocate_sets(ctx, sh::BINDINGS, 1, material_layout, scene.materials.len())?;
-        let sampler_info = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::LINEAR)
-            .min_filter(vk::Filter::LINEAR)
-            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-            .address_mode_u(vk::SamplerAddressMode::REPEAT)
-            .address_mode_v(vk::SamplerAddressMode::REPEAT)
-            .address_mode_w(vk::SamplerAddressMode::REPEAT)
-            .anisotropy_enable(anisotropy > 1.0)
-            .max_anisotropy(anisotropy)
-            .max_lod(vk::LOD_CLAMP_NONE);
-        let sampler =
-            unsafe { ctx.device.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
-        ctx.set_name(sampler, "material sampler");
+        let mut samplers = SamplerCache::new(ctx, anisotropy);
 
         let mut material_buffers = Vec::new();
         for (i, m) in scene.materials.iter().enumerate() {
@@ -501,11 +491,17 @@ impl GpuScene {
                 }]
             };
             let (i_base, i_normal, i_mr, i_em) = (img(base), img(normal), img(mr), img(emissive));
-            let samp = [vk::DescriptorImageInfo {
-                sampler,
-                image_view: vk::ImageView::null(),
-                image_layout: vk::ImageLayout::UNDEFINED,
-            }];
+            let mut samp = |t: Option<crate::scene::TextureRef>| -> Result<_, GpuError> {
+                Ok([vk::DescriptorImageInfo {
+                    sampler: samplers.get(t.map(|t| t.sampler).unwrap_or_default())?,
+                    image_view: vk::ImageView::null(),
+                    image_layout: vk::ImageLayout::UNDEFINED,
+                }])
+            };
+            let s_base = samp(m.base_color_texture)?;
+            let s_normal = samp(m.normal_texture)?;
+            let s_mr = samp(m.metallic_roughness_texture)?;
+            let s_em = samp(m.emissive_texture)?;
             let set = sets[i];
             let w = |b: &crate::gpu::shaders::ReflectedBinding| {
                 vk::WriteDescriptorSet::default()
@@ -519,7 +515,10 @@ impl GpuScene {
                 w(&sh::NORMAL_TEX).image_info(&i_normal),
                 w(&sh::METAL_ROUGH_TEX).image_info(&i_mr),
                 w(&sh::EMISSIVE_TEX).image_info(&i_em),
-                w(&sh::MATERIAL_SAMPLER).image_info(&samp),
+                w(&sh::BASE_COLOR_SAMPLER).image_info(&s_base),
+                w(&sh::NORMAL_SAMPLER).image_info(&s_normal),
+                w(&sh::METAL_ROUGH_SAMPLER).image_info(&s_mr),
+                w(&sh::EMISSIVE_SAMPLER).image_info(&s_em),
             ];
             unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
             material_buffers.push(buf);
@@ -538,7 +537,7 @@ impl GpuScene {
             frustum_culling: options.culling,
             pipeline_keys,
             pool,
-            sampler,
+            _samplers: samplers,
             _material_buffers: material_buffers,
             _textures: textures,
         })
@@ -551,7 +550,6 @@ impl Drop for GpuScene {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
             d.destroy_descriptor_pool(self.pool, None);
-            d.destroy_sampler(self.sampler, None);
             d.destroy_descriptor_set_layout(self.material_layout, None);
         }
     }

@@ -8,6 +8,7 @@ pub(crate) mod gpu_scene;
 pub(crate) mod pipeline;
 pub(crate) mod renderer;
 pub mod report;
+pub(crate) mod samplers;
 pub(crate) mod settings;
 pub(crate) mod shadow_pass;
 #[cfg(feature = "viewer")]

@@ -74,9 +74,7 @@ pub fn demo_scene() -> Scene {
     );
     let ground = Material {
         name: "ground".into(),
-        base_color_texture: Some(TextureRef {
-            texture: ground_tex,
-        }),
+        base_color_texture: Some(TextureRef::new(ground_tex)),
         roughness: 0.9,
         ..Default::default()
     };
@@ -130,12 +128,8 @@ pub fn demo_scene() -> Scene {
     let panel_normal = add_texture(&mut s, bump_normal_map(256, 6, 1.2));
     let panel = Material {
         name: "panel".into(),
-        base_color_texture: Some(TextureRef {
-            texture: panel_base,
-        }),
-        normal_texture: Some(TextureRef {
-            texture: panel_normal,
-        }),
+        base_color_texture: Some(TextureRef::new(panel_base)),
+        normal_texture: Some(TextureRef::new(panel_normal)),
         roughness: 0.45,
         double_sided: true,
         ..Default::default()

@@ -11,8 +11,8 @@ use super::tangents::{
     compute_smooth_normals, count_degenerate, fallback_tangent, generate_mikktspace,
 };
 use super::{
-    AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Primitive, Scene, Texture,
-    TextureRef,
+    AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Primitive, Sampler, Scene,
+    Texture, TextureRef,
 };
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -260,7 +260,10 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             .get(t.source().index())
             .copied()
             .flatten()
-            .map(|texture| TextureRef { texture })
+            .map(|texture| TextureRef {
+                texture,
+                sampler: Sampler::from_gltf(&t.sampler()),
+            })
     };
 
     // Materials (index = glTF index; the default material goes last).

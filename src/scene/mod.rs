@@ -7,6 +7,7 @@ mod gltf_input;
 pub mod gltf_load;
 pub mod inspect;
 pub mod material;
+pub mod sampler;
 pub mod shapes;
 pub mod synthetic;
 pub mod tangents;
@@ -16,5 +17,6 @@ pub mod warning;
 
 pub use gltf_load::{load_gltf, LoadError};
 pub use material::{blinn_phong_params, shade_blinn_phong, BlinnPhong};
+pub use sampler::{Filter, Sampler, Wrap};
 pub use types::*;
 pub use warning::Warning;

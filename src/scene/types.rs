@@ -55,11 +55,23 @@ pub enum AlphaMode {
     Blend,
 }
 
-/// A reference to a texture and how it is used.
+/// A reference to a texture and how it is sampled.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureRef {
     /// Index into `Scene::textures`.
     pub texture: usize,
+    /// Filters and wrap modes (the glTF texture's sampler).
+    pub sampler: super::Sampler,
+}
+
+impl TextureRef {
+    /// Texture `texture` with the default sampler (linear, mipmapped, repeating).
+    pub fn new(texture: usize) -> Self {
+        Self {
+            texture,
+            sampler: super::Sampler::default(),
+        }
+    }
 }
 
 /// glTF metallic-roughness material (the renderer maps it to Blinn-Phong: see `material.rs`).
