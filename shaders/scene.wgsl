@@ -111,7 +111,15 @@ struct Material {
     // x: metallic, y: roughness, z: unused (normal mapping is a shader variant), w: 1 if unlit
     params: vec4<f32>,
     // x: alpha cutoff (masked materials; 0 = opaque)
-    extra: vec4<f32>,
+    extra: vec4<f32>,    // KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
+    // u' = dot(uv[2i].xyz, (u, v, 1)), v' = dot(uv[2i + 1].xyz, (u, v, 1)).
+    uv: array<vec4<f32>, 8>,
+}
+
+// Texture coordinates of slot i (0 base colour, 1 normal, 2 metallic-roughness, 3 emissive).
+fn slot_uv(i: u32, uv: vec2<f32>) -> vec2<f32> {
+    let p = vec3<f32>(uv, 1.0);
+    return vec2<f32>(dot(material.uv[2u * i].xyz, p), dot(material.uv[2u * i + 1u].xyz, p));
 }
 
 struct Immediates {
@@ -300,7 +308,7 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
 fn base_color(uv: vec2<f32>) -> vec4<f32> {
     var base = material.base_color;
     if HAS_BASE_TEX {
-        base *= textureSample(base_color_tex, base_color_sampler, uv);
+        base *= textureSample(base_color_tex, base_color_sampler, slot_uv(0u, uv));
     }
     return base;
 }
@@ -375,7 +383,7 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
     if mode == VIEW_METALLIC || mode == VIEW_ROUGHNESS {
         var mr = vec4<f32>(1.0);
         if HAS_OTHER_TEX {
-            mr = textureSample(metal_rough_tex, metal_rough_sampler, in.uv);
+            mr = textureSample(metal_rough_tex, metal_rough_sampler, slot_uv(2u, in.uv));
         }
         let v = select(material.params.y * mr.g, material.params.x * mr.b, mode == VIEW_METALLIC);
         return vec4<f32>(srgb_to_linear(vec3<f32>(clamp(v, 0.0, 1.0))), 1.0);
@@ -440,7 +448,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     var n_geo = normalize(in.normal);
     var n = n_geo;
     if HAS_NORMAL_MAP {
-        let normal_sample = textureSample(normal_tex, normal_sampler, in.uv).xyz;
+        let normal_sample = textureSample(normal_tex, normal_sampler, slot_uv(1u, in.uv)).xyz;
         let t_raw = in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz);
         if dot(t_raw, t_raw) > 1e-12 {
             let t = normalize(t_raw);
@@ -456,7 +464,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     }
     var mr = vec4<f32>(1.0);
     if HAS_OTHER_TEX {
-        mr = textureSample(metal_rough_tex, metal_rough_sampler, in.uv);
+        mr = textureSample(metal_rough_tex, metal_rough_sampler, slot_uv(2u, in.uv));
     }
     let metallic = clamp(material.params.x * mr.b, 0.0, 1.0);
     let roughness = clamp(material.params.y * mr.g, 0.03, 1.0);
@@ -468,7 +476,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     let ka = base.rgb;
     var emissive = material.emissive.rgb;
     if HAS_OTHER_TEX {
-        emissive *= textureSample(emissive_tex, emissive_sampler, in.uv).rgb;
+        emissive *= textureSample(emissive_tex, emissive_sampler, slot_uv(3u, in.uv)).rgb;
     }
 
     let p = in.world_position;

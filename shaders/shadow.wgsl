@@ -20,7 +20,15 @@ struct Material {
     emissive: vec4<f32>,
     params: vec4<f32>,
     // x: alpha cutoff
-    extra: vec4<f32>,
+    extra: vec4<f32>,    // KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
+    // u' = dot(uv[2i].xyz, (u, v, 1)), v' = dot(uv[2i + 1].xyz, (u, v, 1)).
+    uv: array<vec4<f32>, 8>,
+}
+
+// Texture coordinates of slot i (0 base colour, 1 normal, 2 metallic-roughness, 3 emissive).
+fn slot_uv(i: u32, uv: vec2<f32>) -> vec2<f32> {
+    let p = vec3<f32>(uv, 1.0);
+    return vec2<f32>(dot(material.uv[2u * i].xyz, p), dot(material.uv[2u * i + 1u].xyz, p));
 }
 
 @group(0) @binding(0) var<uniform> material: Material;
@@ -47,7 +55,7 @@ fn vs_masked(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> Ma
 
 @fragment
 fn fs_masked(in: MaskedOut) {
-    let alpha = material.base_color.a * textureSample(base_color_tex, base_color_sampler, in.uv).a;
+    let alpha = material.base_color.a * textureSample(base_color_tex, base_color_sampler, slot_uv(0u, in.uv)).a;
     if alpha < material.extra.x {
         discard;
     }

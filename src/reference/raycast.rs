@@ -237,12 +237,17 @@ impl<'a> ReferenceScene<'a> {
         }
     }
 
-    /// Sample of mip 0 with the texture's sampler: its magnification filter (nearest or
+    /// Sample of mip 0 at `uv` after the slot's texture transform, with the texture's sampler: its magnification filter (nearest or
     /// bilinear) and wrap modes (decoded from sRGB when `srgb`). Mip 0 only: the reference has
     /// no pixel footprint, so minification filters and mipmaps are not modelled.
     fn sample(&self, tex: Option<TextureRef>, uv: Vec2, srgb: bool, default: Vec4) -> Vec4 {
-        let Some((t, s)) = tex.and_then(|r| Some((self.scene.textures.get(r.texture)?, r.sampler)))
-        else {
+        let Some((t, s, uv)) = tex.and_then(|r| {
+            Some((
+                self.scene.textures.get(r.texture)?,
+                r.sampler,
+                r.transform.apply(uv),
+            ))
+        }) else {
             return default;
         };
         let x = uv.x * t.width as f32;

@@ -30,6 +30,17 @@ pub struct VertexAttributes {
     pub tangent: [f32; 4],
 }
 
+/// The texture-transform rows of a material's four slots (identity for an empty slot).
+fn uv_rows(slots: [Option<crate::scene::TextureRef>; 4]) -> [Vec4; 8] {
+    let mut rows = [Vec4::ZERO; 8];
+    for (i, t) in slots.iter().enumerate() {
+        let (r0, r1) = t.map(|t| t.transform).unwrap_or_default().rows();
+        rows[2 * i] = r0.extend(0.0);
+        rows[2 * i + 1] = r1.extend(0.0);
+    }
+    rows
+}
+
 /// What the load-time analysis found about a primitive's shape.
 struct PrimitiveShape {
     closed: bool,
@@ -465,6 +476,12 @@ impl GpuScene {
                     0.0,
                     0.0,
                 ),
+                uv: uv_rows([
+                    m.base_color_texture,
+                    m.normal_texture,
+                    m.metallic_roughness_texture,
+                    m.emissive_texture,
+                ]),
             };
             let mut buf = Buffer::new(
                 ctx,

@@ -60,7 +60,7 @@ pub struct FrameUniform {
 
 /// Material constants (`Material` in scene.wgsl).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct MaterialUniform {
     /// Base colour factor.
     pub base_color: Vec4,
@@ -68,8 +68,11 @@ pub struct MaterialUniform {
     pub emissive: Vec4,
     /// x metallic, y roughness, z unused (normal mapping is a shader variant), w unlit.
     pub params: Vec4,
-    /// x alpha cutoff, y texture slots present (`gpu_scene::texture_flags`).
+    /// x alpha cutoff.
     pub extra: Vec4,
+    /// KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
+    /// u' = uv[2i].xyz · (u, v, 1), v' = uv[2i+1].xyz · (u, v, 1).
+    pub uv: [Vec4; 8],
 }
 
 /// Per-draw immediates of the camera pass.

@@ -12,7 +12,7 @@ use super::tangents::{
 };
 use super::{
     AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Primitive, Sampler, Scene,
-    Texture, TextureRef,
+    Texture, TextureRef, UvTransform,
 };
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -255,7 +255,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         }
     }
     scene.image_textures = image_slots.clone();
-    let tex_ref = |t: gltf::Texture| {
+    let tex_ref = |t: gltf::Texture, transform: UvTransform| {
         image_slots
             .get(t.source().index())
             .copied()
@@ -263,26 +263,44 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             .map(|texture| TextureRef {
                 texture,
                 sampler: Sampler::from_gltf(&t.sampler()),
+                transform,
             })
+    };
+    // A textureInfo's KHR_texture_transform (identity without one).
+    let info_ref = |i: gltf::texture::Info| {
+        let transform = i
+            .texture_transform()
+            .map(|x| UvTransform {
+                offset: Vec2::from_array(x.offset()),
+                rotation: x.rotation(),
+                scale: Vec2::from_array(x.scale()),
+            })
+            .filter(|x| x.offset.is_finite() && x.rotation.is_finite() && x.scale.is_finite())
+            .unwrap_or_default();
+        tex_ref(i.texture(), transform)
     };
 
     // Materials (index = glTF index; the default material goes last).
-    let mut uses_transform = false;
     for m in gltf.materials() {
         let pbr = m.pbr_metallic_roughness();
         let mut mat = Material {
             name: m.name().unwrap_or("").to_string(),
             base_color: Vec4::from_array(pbr.base_color_factor()),
-            base_color_texture: pbr.base_color_texture().and_then(|t| tex_ref(t.texture())),
+            base_color_texture: pbr.base_color_texture().and_then(info_ref),
             metallic: pbr.metallic_factor(),
             roughness: pbr.roughness_factor(),
-            metallic_roughness_texture: pbr
-                .metallic_roughness_texture()
-                .and_then(|t| tex_ref(t.texture())),
-            normal_texture: m.normal_texture().and_then(|t| tex_ref(t.texture())),
+            metallic_roughness_texture: pbr.metallic_roughness_texture().and_then(info_ref),
+            // gltf 1.4 types the extension on textureInfo only: a normalTextureInfo's comes as JSON.
+            normal_texture: m.normal_texture().and_then(|t| {
+                let transform = t
+                    .extension_value("KHR_texture_transform")
+                    .map(UvTransform::from_json)
+                    .unwrap_or_default();
+                tex_ref(t.texture(), transform)
+            }),
             normal_scale: m.normal_texture().map(|t| t.scale()).unwrap_or(1.0),
             emissive: Vec3::from_array(m.emissive_factor()),
-            emissive_texture: m.emissive_texture().and_then(|t| tex_ref(t.texture())),
+            emissive_texture: m.emissive_texture().and_then(info_ref),
             alpha_mode: match m.alpha_mode() {
                 gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
                 gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
@@ -303,23 +321,10 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 ),
             );
         }
-        if pbr
-            .base_color_texture()
-            .is_some_and(|t| t.texture_transform().is_some())
-        {
-            uses_transform = true;
-        }
         if !mat.base_color.is_finite() {
             mat.base_color = Vec4::ONE;
         }
         scene.materials.push(mat);
-    }
-    if uses_transform {
-        scene.warn(
-            "TEXTURE_TRANSFORM_IGNORED",
-            "/extensionsUsed",
-            "KHR_texture_transform is ignored (not supported yet)",
-        );
     }
     let default_material = scene.materials.len();
     scene.materials.push(Material::default());

@@ -17,6 +17,6 @@ pub mod warning;
 
 pub use gltf_load::{load_gltf, LoadError};
 pub use material::{blinn_phong_params, shade_blinn_phong, BlinnPhong};
-pub use sampler::{Filter, Sampler, Wrap};
+pub use sampler::{Filter, Sampler, UvTransform, Wrap};
 pub use types::*;
 pub use warning::Warning;

@@ -62,6 +62,8 @@ pub struct TextureRef {
     pub texture: usize,
     /// Filters and wrap modes (the glTF texture's sampler).
     pub sampler: super::Sampler,
+    /// KHR_texture_transform of this slot (identity without one).
+    pub transform: super::UvTransform,
 }
 
 impl TextureRef {
@@ -70,6 +72,7 @@ impl TextureRef {
         Self {
             texture,
             sampler: super::Sampler::default(),
+            transform: super::UvTransform::default(),
         }
     }
 }

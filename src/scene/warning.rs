@@ -83,11 +83,6 @@ pub const FINDING_CODES: &[(&str, &str, &str)] = &[
         "alpha blending is drawn opaque",
     ),
     (
-        "TEXTURE_TRANSFORM_IGNORED",
-        "warning",
-        "KHR_texture_transform is ignored",
-    ),
-    (
         "IMAGE_NOT_LOADED",
         "warning",
         "an image could not be read or decoded; its slots use defaults",

@@ -289,6 +289,8 @@ fn hierarchy_and_scale(dir: &Path) -> PathBuf {
 /// texture slot (base colour, metallic-roughness, normal, occlusion, emissive), in a .glb.
 fn normal_mapped(dir: &Path) -> PathBuf {
     let mut b = Builder::default();
+    // Texture transforms that keep the clamped coordinates inside [0, 1].
+    b.use_extension("KHR_texture_transform");
     let smp = b.sampler(9729, 9986, 33071, 33071);
     let base = b.image(png(&checker(
         64,
@@ -312,9 +314,11 @@ fn normal_mapped(dir: &Path) -> PathBuf {
         .collect();
     let mat = b.material(json!({
         "name": "every_slot",
-        "pbrMetallicRoughness": {"baseColorTexture": {"index": t[0]}, "metallicRoughnessTexture": {"index": t[2]},
+        "pbrMetallicRoughness": {"baseColorTexture": {"index": t[0], "extensions": {"KHR_texture_transform":
+                                     {"offset": [0.25, 0.25], "rotation": 0.3, "scale": [0.5, 0.5]}}},
+                                 "metallicRoughnessTexture": {"index": t[2]},
                                  "metallicFactor": 0.5, "roughnessFactor": 0.8},
-        "normalTexture": {"index": t[1], "scale": 1.0},
+        "normalTexture": {"index": t[1], "scale": 1.0, "extensions": {"KHR_texture_transform": {"offset": [0.25, 0.25], "scale": [0.5, 0.5]}}},
         "occlusionTexture": {"index": t[3], "strength": 0.8},
         "emissiveTexture": {"index": t[4]}, "emissiveFactor": [1.0, 1.0, 1.0]
     }));
