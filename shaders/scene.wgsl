@@ -21,7 +21,7 @@ const LIGHT_SPOT: f32 = 2.0;
 // 3 or 5 bilinear taps per side (none, 2x2, 3x3, 5x5); HW_COMPARE uses hardware filtering.
 override HAS_BASE_TEX: bool = true;
 override HAS_NORMAL_MAP: bool = true;
-override HAS_OTHER_TEX: bool = true; // metallic-roughness or emissive
+override HAS_OTHER_TEX: bool = true; // metallic-roughness, emissive or occlusion
 override SINGLE_LIGHT: bool = false;
 override SHADOWS: bool = true;
 override HW_COMPARE: bool = false; // requires SHADOWS
@@ -108,7 +108,9 @@ struct Material {
     base_color: vec4<f32>,
     // rgb: emissive factor; w: normal-map scale
     emissive: vec4<f32>,
-    // x: metallic, y: roughness, z: unused (normal mapping is a shader variant), w: 1 if unlit
+    // x: metallic, y: roughness, z: occlusion strength (0 without an occlusion texture; the
+    // occlusion is the red channel of the metallic-roughness texture, packed at upload as glTF's
+    // ORM layout), w: 1 if unlit
     params: vec4<f32>,
     // x: alpha cutoff (masked materials; 0 = opaque)
     extra: vec4<f32>,    // KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
@@ -481,7 +483,9 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
 
     let p = in.world_position;
     let v = normalize(frame.camera_position.xyz - p);
-    var color = ka * frame.ambient.rgb + emissive;
+    // Occlusion (mr.r) scales the ambient term only: 1 + strength * (occlusion - 1).
+    let occlusion = 1.0 + material.params.z * (mr.r - 1.0);
+    var color = ka * frame.ambient.rgb * occlusion + emissive;
     var shadow_term = 1.0;
     var cascade = -1;
     // One light: a constant trip count the driver unrolls (a uniform count costs a real loop).

@@ -536,7 +536,13 @@ impl<'a> ReferenceScene<'a> {
                 .sample(mat.emissive_texture, uv, true, Vec4::ONE)
                 .truncate();
         let v = -ray.dir;
-        let mut color = bp.ka * ambient + emissive;
+        let occ = self.sample(mat.occlusion_texture, uv, false, Vec4::ONE).x;
+        let occlusion = if mat.occlusion_texture.is_some() {
+            1.0 + mat.occlusion_strength * (occ - 1.0)
+        } else {
+            1.0
+        };
+        let mut color = bp.ka * ambient * occlusion + emissive;
         let mut shadow_vis = true;
         for i in 0..plan.lights.len() {
             let (vis, l, radiance) = self.visible(plan, i, p, ng, n_geo);

@@ -41,6 +41,52 @@ fn uv_rows(slots: [Option<crate::scene::TextureRef>; 4]) -> [Vec4; 8] {
     rows
 }
 
+/// The metallic-roughness slot of material `m` with its occlusion texture folded into the red
+/// channel (glTF's ORM layout; the loader keeps an occlusion texture only where its sampler and
+/// transform are the metallic-roughness texture's and its size too): the reference to sample, and
+/// the (metallic-roughness, occlusion) image pair to merge when they are different images.
+#[allow(clippy::type_complexity)]
+fn orm_slot(
+    m: &crate::scene::Material,
+    textures: usize,
+) -> (
+    Option<crate::scene::TextureRef>,
+    Option<(Option<usize>, usize)>,
+) {
+    let mr = m
+        .metallic_roughness_texture
+        .filter(|t| t.texture < textures);
+    match (mr, m.occlusion_texture.filter(|t| t.texture < textures)) {
+        (mr, None) => (mr, None),
+        (Some(mr), Some(o)) if mr.texture == o.texture => (Some(mr), None),
+        (mr, Some(o)) => (
+            Some(mr.unwrap_or(o)),
+            Some((mr.map(|t| t.texture), o.texture)),
+        ),
+    }
+}
+
+/// An RGBA image with the red channel of `occlusion` and the green and blue channels of
+/// `metallic_roughness` (white without one; the loader guarantees equal sizes).
+fn packed_occlusion(
+    occlusion: &crate::scene::Texture,
+    metallic_roughness: Option<&crate::scene::Texture>,
+) -> crate::scene::Texture {
+    let mut rgba = match metallic_roughness {
+        Some(t) if t.width == occlusion.width && t.height == occlusion.height => t.rgba.clone(),
+        _ => vec![255; occlusion.rgba.len()],
+    };
+    for (d, s) in rgba.chunks_exact_mut(4).zip(occlusion.rgba.chunks_exact(4)) {
+        d[0] = s[0];
+    }
+    crate::scene::Texture {
+        name: format!("{} (occlusion packed)", occlusion.name),
+        width: occlusion.width,
+        height: occlusion.height,
+        rgba,
+    }
+}
+
 /// What the load-time analysis found about a primitive's shape.
 struct PrimitiveShape {
     closed: bool,
@@ -146,7 +192,9 @@ pub fn material_variant_bits(m: &crate::scene::Material) -> usize {
         (m.base_color_texture.is_some(), sh::BIT_HAS_BASE_TEX),
         (m.normal_texture.is_some(), sh::BIT_HAS_NORMAL_MAP),
         (
-            m.metallic_roughness_texture.is_some() || m.emissive_texture.is_some(),
+            m.metallic_roughness_texture.is_some()
+                || m.emissive_texture.is_some()
+                || m.occlusion_texture.is_some(),
             sh::BIT_HAS_OTHER_TEX,
         ),
     ] {
@@ -461,11 +509,23 @@ impl GpuScene {
         let mut samplers = SamplerCache::new(ctx, anisotropy);
 
         let mut material_buffers = Vec::new();
+        // Occlusion packed with metallic-roughness, per (metallic-roughness, occlusion) image.
+        let mut orm_index: HashMap<(Option<usize>, usize), usize> = HashMap::new();
         for (i, m) in scene.materials.iter().enumerate() {
+            let (orm_ref, orm_merged) = orm_slot(m, scene.textures.len());
             let u = MaterialUniform {
                 base_color: m.base_color,
                 emissive: m.emissive.extend(m.normal_scale),
-                params: Vec4::new(m.metallic, m.roughness, 0.0, m.unlit as u32 as f32),
+                params: Vec4::new(
+                    m.metallic,
+                    m.roughness,
+                    if m.occlusion_texture.is_some() {
+                        m.occlusion_strength
+                    } else {
+                        0.0
+                    },
+                    m.unlit as u32 as f32,
+                ),
                 extra: Vec4::new(
                     if let AlphaMode::Mask(c) = m.alpha_mode {
                         c.max(1e-6)
@@ -479,7 +539,7 @@ impl GpuScene {
                 uv: uv_rows([
                     m.base_color_texture,
                     m.normal_texture,
-                    m.metallic_roughness_texture,
+                    orm_ref,
                     m.emissive_texture,
                 ]),
             };
@@ -493,7 +553,20 @@ impl GpuScene {
             buf.write(0, bytemuck::bytes_of(&u))?;
             let base = get_tex(m.base_color_texture, true, 0, &mut textures)?;
             let normal = get_tex(m.normal_texture, false, 2, &mut textures)?;
-            let mr = get_tex(m.metallic_roughness_texture, false, 1, &mut textures)?;
+            let mr = if let Some(t) = orm_merged {
+                if let Some(&i) = orm_index.get(&t) {
+                    textures[i].view
+                } else {
+                    let o = packed_occlusion(&scene.textures[t.1], t.0.map(|i| &scene.textures[i]));
+                    textures.push(Image::texture_rgba8(
+                        ctx, &o.name, o.width, o.height, &o.rgba, false,
+                    )?);
+                    orm_index.insert(t, textures.len() - 1);
+                    textures[textures.len() - 1].view
+                }
+            } else {
+                get_tex(orm_ref, false, 1, &mut textures)?
+            };
             let emissive = get_tex(m.emissive_texture, true, 0, &mut textures)?;
             let buf_info = [vk::DescriptorBufferInfo {
                 buffer: buf.raw,
@@ -517,7 +590,7 @@ impl GpuScene {
             };
             let s_base = samp(m.base_color_texture)?;
             let s_normal = samp(m.normal_texture)?;
-            let s_mr = samp(m.metallic_roughness_texture)?;
+            let s_mr = samp(orm_ref)?;
             let s_em = samp(m.emissive_texture)?;
             let set = sets[i];
             let w = |b: &crate::gpu::shaders::ReflectedBinding| {

@@ -66,7 +66,8 @@ pub struct MaterialUniform {
     pub base_color: Vec4,
     /// rgb emissive, w normal scale.
     pub emissive: Vec4,
-    /// x metallic, y roughness, z unused (normal mapping is a shader variant), w unlit.
+    /// x metallic, y roughness, z occlusion strength (0 without an occlusion texture; it is
+    /// packed into the metallic-roughness texture's red channel), w unlit.
     pub params: Vec4,
     /// x alpha cutoff.
     pub extra: Vec4,

@@ -301,6 +301,19 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             normal_scale: m.normal_texture().map(|t| t.scale()).unwrap_or(1.0),
             emissive: Vec3::from_array(m.emissive_factor()),
             emissive_texture: m.emissive_texture().and_then(info_ref),
+            occlusion_texture: m.occlusion_texture().and_then(|t| {
+                let transform = t
+                    .extension_value("KHR_texture_transform")
+                    .map(UvTransform::from_json)
+                    .unwrap_or_default();
+                tex_ref(t.texture(), transform)
+            }),
+            occlusion_strength: m
+                .occlusion_texture()
+                .map(|t| t.strength())
+                .filter(|s| s.is_finite())
+                .unwrap_or(1.0)
+                .clamp(0.0, 1.0),
             alpha_mode: match m.alpha_mode() {
                 gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
                 gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
@@ -323,6 +336,27 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         }
         if !mat.base_color.is_finite() {
             mat.base_color = Vec4::ONE;
+        }
+        // Occlusion is drawn from the metallic-roughness texture's red channel (glTF's ORM
+        // packing; a separate image is packed in at upload), so it must be sampled alike.
+        if let (Some(o), Some(mr)) = (mat.occlusion_texture, mat.metallic_roughness_texture) {
+            let size = |t: usize| scene.textures.get(t).map(|t| (t.width, t.height));
+            if o.sampler != mr.sampler
+                || o.transform != mr.transform
+                || size(o.texture) != size(mr.texture)
+            {
+                let i = m.index().unwrap_or(0);
+                scene.warn(
+                    "MATERIAL_OCCLUSION_IGNORED",
+                    format!("/materials/{i}/occlusionTexture"),
+                    format!(
+                        "material {i} '{}': occlusion texture differs from metallic-roughness in \
+                         size, sampler or transform; ignored",
+                        mat.name
+                    ),
+                );
+                mat.occlusion_texture = None;
+            }
         }
         scene.materials.push(mat);
     }

@@ -100,6 +100,10 @@ pub struct Material {
     pub emissive: Vec3,
     /// sRGB emissive texture.
     pub emissive_texture: Option<TextureRef>,
+    /// Linear occlusion texture (red channel), scaling the ambient term.
+    pub occlusion_texture: Option<TextureRef>,
+    /// glTF `occlusionTexture.strength`: ambient × (1 + strength · (occlusion − 1)).
+    pub occlusion_strength: f32,
     /// Alpha handling.
     pub alpha_mode: AlphaMode,
     /// Render both faces (and cast from both).
@@ -121,6 +125,8 @@ impl Default for Material {
             normal_scale: 1.0,
             emissive: Vec3::ZERO,
             emissive_texture: None,
+            occlusion_texture: None,
+            occlusion_strength: 1.0,
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
             unlit: false,

@@ -83,6 +83,11 @@ pub const FINDING_CODES: &[(&str, &str, &str)] = &[
         "alpha blending is drawn opaque",
     ),
     (
+        "MATERIAL_OCCLUSION_IGNORED",
+        "warning",
+        "an occlusion texture not packable with metallic-roughness (size, sampler, transform) is ignored",
+    ),
+    (
         "IMAGE_NOT_LOADED",
         "warning",
         "an image could not be read or decoded; its slots use defaults",
