@@ -13,8 +13,9 @@ struct ShadowImmediates {
 
 var<immediate> pc: ShadowImmediates;
 
-// The camera pass's material block (shaders/scene.wgsl, group 1): the masked pipeline binds the
-// same descriptor set, at set 0 of its layout.
+// The camera pass's material block (shaders/scene.wgsl, group 1; WGSL has no includes, so it is
+// repeated here): the masked pipeline binds the same descriptor set, at set 0 of its layout, and
+// a unit test (src/gpu/shaders.rs) checks every binding here against its twin there.
 struct Material {
     base_color: vec4<f32>,
     emissive: vec4<f32>,
@@ -46,7 +47,7 @@ struct MaskedOut {
 }
 
 @vertex
-fn vs_masked(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> MaskedOut {
+fn vs_masked(@location(0) position: vec3<f32>, @location(2) uv: vec2<f32>) -> MaskedOut {
     var out: MaskedOut;
     out.clip = pc.light_clip_from_world * (pc.world_from_model * vec4<f32>(position, 1.0));
     out.uv = uv;

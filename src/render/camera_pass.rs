@@ -1,7 +1,7 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
-use super::gpu_scene::{flat_hides_nothing, Draw, GpuScene, VertexAttributes, Viewpoint};
+use super::gpu_scene::{flat_hides_nothing, vertex_layout, Draw, GpuScene, Viewpoint};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
@@ -42,39 +42,6 @@ pub struct CameraPass {
     slots: Vec<Slot>,
     linear_sampler: vk::Sampler,
     nearest_sampler: vk::Sampler,
-}
-
-/// Vertex streams of the camera pass: positions (binding 0), attributes (binding 1).
-fn vertex_layout() -> (
-    [vk::VertexInputBindingDescription; 2],
-    [vk::VertexInputAttributeDescription; 4],
-) {
-    let f = |location, binding, format, offset| vk::VertexInputAttributeDescription {
-        location,
-        binding,
-        format,
-        offset,
-    };
-    (
-        [
-            vk::VertexInputBindingDescription {
-                binding: 0,
-                stride: 12,
-                input_rate: vk::VertexInputRate::VERTEX,
-            },
-            vk::VertexInputBindingDescription {
-                binding: 1,
-                stride: std::mem::size_of::<VertexAttributes>() as u32,
-                input_rate: vk::VertexInputRate::VERTEX,
-            },
-        ],
-        [
-            f(0, 0, vk::Format::R32G32B32_SFLOAT, 0),
-            f(1, 1, vk::Format::R32G32B32_SFLOAT, 0),
-            f(2, 1, vk::Format::R32G32_SFLOAT, 12),
-            f(3, 1, vk::Format::R32G32B32A32_SFLOAT, 20),
-        ],
-    )
 }
 
 impl CameraPass {

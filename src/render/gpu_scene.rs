@@ -87,6 +87,40 @@ fn packed_occlusion(
     }
 }
 
+/// The vertex streams: positions (binding 0; the shadow pass reads only this one) and the
+/// interleaved attributes (binding 1): locations 0 position, 1 normal, 2 uv, 3 tangent.
+pub fn vertex_layout() -> (
+    [vk::VertexInputBindingDescription; 2],
+    [vk::VertexInputAttributeDescription; 4],
+) {
+    let f = |location, binding, format, offset| vk::VertexInputAttributeDescription {
+        location,
+        binding,
+        format,
+        offset,
+    };
+    (
+        [
+            vk::VertexInputBindingDescription {
+                binding: 0,
+                stride: 12,
+                input_rate: vk::VertexInputRate::VERTEX,
+            },
+            vk::VertexInputBindingDescription {
+                binding: 1,
+                stride: std::mem::size_of::<VertexAttributes>() as u32,
+                input_rate: vk::VertexInputRate::VERTEX,
+            },
+        ],
+        [
+            f(0, 0, vk::Format::R32G32B32_SFLOAT, 0),
+            f(1, 1, vk::Format::R32G32B32_SFLOAT, 0),
+            f(2, 1, vk::Format::R32G32_SFLOAT, 12),
+            f(3, 1, vk::Format::R32G32B32A32_SFLOAT, 20),
+        ],
+    )
+}
+
 /// What the load-time analysis found about a primitive's shape.
 struct PrimitiveShape {
     closed: bool,

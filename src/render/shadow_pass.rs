@@ -2,7 +2,7 @@
 //! depth bias pushing casters away from the light (negative factors under reversed-z).
 
 use super::core::Attachment;
-use super::gpu_scene::{flat_hides_nothing, GpuScene, VertexAttributes, Viewpoint};
+use super::gpu_scene::{flat_hides_nothing, vertex_layout, GpuScene, Viewpoint};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
 };
@@ -167,7 +167,7 @@ struct MaskedPipeline {
 }
 
 /// Creates a depth-only pipeline of the shadow pass: `masked` takes TEXCOORD_0 from the
-/// attribute stream (binding 1) and runs `fs_masked`; otherwise positions only, no fragment stage.
+/// attribute stream (binding 1, location 2, as in the camera pass) and runs `fs_masked`; otherwise positions only, no fragment stage.
 fn depth_pipeline(
     ctx: &Context,
     layout: vk::PipelineLayout,
@@ -175,32 +175,9 @@ fn depth_pipeline(
     masked: bool,
     format: vk::Format,
 ) -> Result<vk::Pipeline, GpuError> {
-    let bindings = [
-        vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: 12,
-            input_rate: vk::VertexInputRate::VERTEX,
-        },
-        vk::VertexInputBindingDescription {
-            binding: 1,
-            stride: std::mem::size_of::<VertexAttributes>() as u32,
-            input_rate: vk::VertexInputRate::VERTEX,
-        },
-    ];
-    let attributes = [
-        vk::VertexInputAttributeDescription {
-            location: 0,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: 0,
-        },
-        vk::VertexInputAttributeDescription {
-            location: 1,
-            binding: 1,
-            format: vk::Format::R32G32_SFLOAT,
-            offset: std::mem::offset_of!(VertexAttributes, uv) as u32,
-        },
-    ];
+    // Positions only, or positions and the attribute stream for TEXCOORD_0 (location 2).
+    let (bindings, all) = vertex_layout();
+    let attributes = [all[0], all[2]];
     let n = if masked { 2 } else { 1 };
     create_pipeline(
         ctx,

@@ -266,6 +266,9 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 transform,
             })
     };
+    const EXT_TRANSFORM: &str = "KHR_texture_transform";
+    let json_transform =
+        |v: Option<&serde_json::Value>| v.map(UvTransform::from_json).unwrap_or_default();
     // A textureInfo's KHR_texture_transform (identity without one).
     let info_ref = |i: gltf::texture::Info| {
         let transform = i
@@ -290,23 +293,22 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             metallic: pbr.metallic_factor(),
             roughness: pbr.roughness_factor(),
             metallic_roughness_texture: pbr.metallic_roughness_texture().and_then(info_ref),
-            // gltf 1.4 types the extension on textureInfo only: a normalTextureInfo's comes as JSON.
+            // gltf 1.4 types the extension on textureInfo only: normal and occlusion textureInfos
+            // carry it as JSON.
             normal_texture: m.normal_texture().and_then(|t| {
-                let transform = t
-                    .extension_value("KHR_texture_transform")
-                    .map(UvTransform::from_json)
-                    .unwrap_or_default();
-                tex_ref(t.texture(), transform)
+                tex_ref(
+                    t.texture(),
+                    json_transform(t.extension_value(EXT_TRANSFORM)),
+                )
             }),
             normal_scale: m.normal_texture().map(|t| t.scale()).unwrap_or(1.0),
             emissive: Vec3::from_array(m.emissive_factor()),
             emissive_texture: m.emissive_texture().and_then(info_ref),
             occlusion_texture: m.occlusion_texture().and_then(|t| {
-                let transform = t
-                    .extension_value("KHR_texture_transform")
-                    .map(UvTransform::from_json)
-                    .unwrap_or_default();
-                tex_ref(t.texture(), transform)
+                tex_ref(
+                    t.texture(),
+                    json_transform(t.extension_value(EXT_TRANSFORM)),
+                )
             }),
             occlusion_strength: m
                 .occlusion_texture()
