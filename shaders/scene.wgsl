@@ -1,14 +1,15 @@
 // Camera pass: Blinn-Phong with tangent-space normal mapping and shadow-map visibility.
 //
-// L = ka*Ia + vis * sum_i [ kd*(I/r^2)*max(0,n.l) + ks*(I/r^2)*max(0,n.h)^p ]
-// where vis is 1 for lights without a shadow map, and for the shadowed light the filtered
-// shadow-map comparison times (geometric n.l > 0). `--view shadow` writes exactly `vis`.
+// L = ka*Ia + sum_i vis_i * [ kd*(I/r^2)*max(0,n.l) + ks*(I/r^2)*max(0,n.h)^p ]
+// where vis_i is (geometric n.l > 0) times, for a light with shadow views, the filtered shadow-map
+// comparison in its view. `--view shadow` writes exactly one light's vis_i (the shown light).
 //
 // Reversed-z everywhere: the shadow map stores the largest depth (closest to the light); a receiver
 // is lit where its light-space depth >= the stored depth (compare op GREATER_OR_EQUAL).
 // Y convention: clip space is Y-up, naga flips Y for Vulkan (build.rs); shadow UV v = 0.5 - 0.5*y.
 
 const MAX_LIGHTS: u32 = 8u;
+const MAX_SHADOW_VIEWS: i32 = 16;
 const LIGHT_DIRECTIONAL: f32 = 0.0;
 const LIGHT_POINT: f32 = 1.0;
 const LIGHT_SPOT: f32 = 2.0;
@@ -27,9 +28,9 @@ override SHADOWS: bool = true;
 override HW_COMPARE: bool = false; // requires SHADOWS
 override PCF_BIT0: bool = true; // requires SHADOWS
 override PCF_BIT1: bool = false; // requires SHADOWS
-// More than one shadow view (cascades): the view is chosen per pixel; without, view 0 is read
-// with constant indices.
-override CASCADED: bool = true; // requires SHADOWS
+// More than one shadow view (cascades, several shadowed lights, a point light's cube faces): each
+// light reads its own views, chosen per pixel; without, the one shadowed light reads view 0.
+override MANY_VIEWS: bool = true; // requires SHADOWS
 
 // Bilinear taps per side of the PCF kernel (0 = one nearest comparison).
 fn pcf_taps() -> i32 {
@@ -67,13 +68,25 @@ struct Light {
     color: vec4<f32>,
     // x: cos(inner cone), y: cos(outer cone)
     cone: vec4<f32>,
+    // x: first shadow view (-1: casts none), y: its view count (cascades near to far; 6 cube
+    // faces +x, -x, +y, -y, +z, -z for a point light)
+    shadow: vec4<f32>,
+}
+
+// One layer of the shadow map.
+struct ShadowView {
+    // World -> light clip.
+    clip: mat4x4<f32>,
+    // Texel rectangle (x0, y0, x1, y1) outside which a lookup's footprint meets no caster: lit
+    // there, without reading the map (the shadow pass clears only what it draws).
+    rect: vec4<f32>,
+    // x: view depth where this cascade ends, y: where blending into the next one starts,
+    // z: world size of one texel (directional) or per unit distance (spot, point face).
+    cascade: vec4<f32>,
 }
 
 struct Frame {
     clip_from_world: mat4x4<f32>,
-    // World -> light clip of each shadow view (cascades near to far; one for a single map or a
-    // spot light); layer i of the shadow map belongs to view i.
-    shadow_clip: array<mat4x4<f32>, 4>,
     // xyz: camera position in world
     camera_position: vec4<f32>,
     // rgb: ambient intensity Ia
@@ -81,27 +94,21 @@ struct Frame {
     // x: shadow-map size in texels, y: normal-offset bias in texels,
     // z: view depth that the depth view draws black (the scene's far end), w: 1 if shadows on
     shadow: vec4<f32>,
-    // w: index of the shadowed light (MAX_LIGHTS + 1 when none); xyz: the eye the cascades are
-    // split from (the shadow-fitting camera)
+    // w: index of the light whose visibility `--view shadow` writes (MAX_LIGHTS + 1 when none);
+    // xyz: the eye the cascades are split from (the shadow-fitting camera)
     shadow_light: vec4<f32>,
-    // x: constant bias in shadow texels, applied towards the light
+    // x: constant bias in shadow texels, applied towards the light; y: the shown light's first
+    // shadow view
     bias: vec4<f32>,
-    // Per view: texel rectangle (x0, y0, x1, y1) of its layer outside which a lookup's footprint
-    // meets no caster: lit there, without reading the map (the shadow pass clears only what it
-    // draws).
-    shadow_rect: array<vec4<f32>, 4>,
-    // Per cascade: view depth where it ends, and where blending into the next one starts.
-    cascade_far: vec4<f32>,
-    cascade_blend: vec4<f32>,
-    // Per cascade: world size of one texel (directional) or per unit distance (spot).
-    cascade_texel: vec4<f32>,
     // xyz: the shadow-fitting camera's forward (view depth = dot(p - shadow_light.xyz, forward));
-    // w: number of shadow views.
+    // w: the shown light's number of shadow views.
     camera_forward: vec4<f32>,
     // x: view mode, y: PCF kernel width in bilinear taps (0 = single nearest compare),
     // z: 1 if hardware linear comparison filtering is used, w: number of lights
     modes: vec4<u32>,
     lights: array<Light, 8>,
+    // Layer i of the shadow map belongs to view i.
+    views: array<ShadowView, 16>,
 }
 
 struct Material {
@@ -202,42 +209,62 @@ fn bilinear_compare(p: vec2<f32>, layer: i32, depth: f32, size: i32) -> f32 {
     return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
 }
 
-// Filtered shadow-map visibility of world point `p` with geometric normal `ng`, for the shadowed
-// light `light` whose direction at `p` is `l` (call only when shadows are on).
-// The shadow view (cascade) for world point `p` seen at pixel `pixel`: the cascade holding its
-// view depth; within the blend band at a cascade's end, the next cascade for a share of pixels
-// growing from 0 to 1 across the band (interleaved-gradient dither: no seam line, and every
-// lookup stays a single exact one, which llvmpipe, running both sides of every branch, pays once).
 // View depth of world point `p` along the shadow-fitting camera's forward axis.
 fn view_depth(p: vec3<f32>) -> f32 {
     return dot(p - frame.shadow_light.xyz, frame.camera_forward.xyz);
 }
 
-// The cascade holding world point `p` by view depth alone (no dither; the texel-density view
-// reads it directly).
-fn cascade_of(p: vec3<f32>) -> i32 {
+// The cascade (of the `n` views from `first`) holding world point `p` by view depth alone (no
+// dither; the texel-density view reads it directly); relative to `first`.
+fn cascade_of(p: vec3<f32>, first: i32, n: i32) -> i32 {
     let d = view_depth(p);
-    let n = i32(frame.camera_forward.w);
     var c = 0;
     for (var k = 0; k < 3; k++) {
-        c += select(0, 1, k + 1 < n && d > frame.cascade_far[k]);
+        c += select(0, 1, k + 1 < n && d > frame.views[min(first + k, MAX_SHADOW_VIEWS - 1)].cascade.x);
     }
     return c;
 }
 
-fn shadow_view_index(p: vec3<f32>, pixel: vec2<f32>) -> i32 {
+// The cascade (relative to `first`) for world point `p` seen at pixel `pixel`: the cascade holding
+// its view depth; within the blend band at a cascade's end, the next cascade for a share of pixels
+// growing from 0 to 1 across the band (interleaved-gradient dither: no seam line, and every
+// lookup stays a single exact one, which llvmpipe, running both sides of every branch, pays once).
+fn cascade_index(p: vec3<f32>, pixel: vec2<f32>, first: i32, n: i32) -> i32 {
     let d = view_depth(p);
-    let n = i32(frame.camera_forward.w);
-    let c = cascade_of(p);
-    let start = frame.cascade_blend[c];
-    let t = clamp((d - start) / max(frame.cascade_far[c] - start, 1e-20), 0.0, 1.0);
+    let c = cascade_of(p, first, n);
+    let v = frame.views[min(first + c, MAX_SHADOW_VIEWS - 1)].cascade;
+    let start = v.y;
+    let t = clamp((d - start) / max(v.x - start, 1e-20), 0.0, 1.0);
     let noise = fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
     return select(c, c + 1, c + 1 < n && noise < t);
 }
 
+// The cube face of direction `d` from a point light (+x, -x, +y, -y, +z, -z): its major axis.
+fn cube_face(d: vec3<f32>) -> i32 {
+    let a = abs(d);
+    if a.x >= a.y && a.x >= a.z {
+        return select(1, 0, d.x >= 0.0);
+    }
+    if a.y >= a.z {
+        return select(3, 2, d.y >= 0.0);
+    }
+    return select(5, 4, d.z >= 0.0);
+}
+
+// The shadow view of `light` (first view `first`, `n` views) for world point `p` at `pixel`.
+fn light_view(light: Light, p: vec3<f32>, pixel: vec2<f32>, first: i32, n: i32) -> i32 {
+    if light.position.w == LIGHT_POINT {
+        return first + cube_face(p - light.position.xyz);
+    }
+    return first + cascade_index(p, pixel, first, n);
+}
+
+// Filtered shadow-map visibility of world point `p` with geometric normal `ng`, in shadow view
+// `layer` of light `light` whose direction at `p` is `l` (call only when shadows are on).
 fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, layer: i32) -> f32 {
-    var texel_world = frame.cascade_texel[layer];
-    if light.position.w == LIGHT_SPOT {
+    let view = frame.views[layer];
+    var texel_world = view.cascade.z;
+    if light.position.w != LIGHT_DIRECTIONAL {
         texel_world = texel_world * distance(light.position.xyz, p);
     }
     // Normal offset: move the lookup point off the surface by a number of shadow texels, more at
@@ -246,7 +273,7 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, la
     let sin_theta = sqrt(1.0 - cos_theta * cos_theta);
     // Constant bias: towards the light by a number of texels (so it scales with texel size).
     let offset = ng * (frame.shadow.y * texel_world * sin_theta) + l * (frame.bias.x * texel_world);
-    let lc = frame.shadow_clip[layer] * vec4<f32>(p + offset, 1.0);
+    let lc = view.clip * vec4<f32>(p + offset, 1.0);
     if lc.w <= 0.0 {
         return 1.0;
     }
@@ -254,7 +281,7 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, la
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     let p_texel = uv * frame.shadow.x;
     // Outside the casters' rectangle (which lies inside the map) nothing is in shadow.
-    let rect = frame.shadow_rect[layer];
+    let rect = view.rect;
     if any(p_texel < rect.xy) || any(p_texel > rect.zw) {
         return 1.0;
     }
@@ -363,9 +390,16 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
         discard;
     }
     let mode = frame.modes.x;
-    // Shadow-map texels per screen pixel (derivatives first: uniform control flow).
-    let layer = cascade_of(in.world_position);
-    let lc = frame.shadow_clip[layer] * vec4<f32>(in.world_position, 1.0);
+    // Shadow-map texels per screen pixel (derivatives first: uniform control flow), in the shown
+    // light's cascade (or face).
+    let first = i32(frame.bias.y);
+    let n = i32(frame.camera_forward.w);
+    var layer = first + cascade_of(in.world_position, first, n);
+    let shown = frame.lights[min(u32(frame.shadow_light.w), MAX_LIGHTS - 1u)];
+    if shown.position.w == LIGHT_POINT {
+        layer = first + cube_face(in.world_position - shown.position.xyz);
+    }
+    let lc = frame.views[clamp(layer, 0, MAX_SHADOW_VIEWS - 1)].clip * vec4<f32>(in.world_position, 1.0);
     let st = vec2<f32>(lc.x, -lc.y) / max(abs(lc.w), 1e-20) * (0.5 * frame.shadow.x);
     let jx = dpdx(st);
     let jy = dpdy(st);
@@ -439,9 +473,10 @@ struct Shaded {
     color: vec3<f32>,
     // The shading normal (after normal mapping, facing the viewer).
     normal: vec3<f32>,
-    // The shadowed light's visibility (1 without one).
+    // The shown light's visibility (1 without one).
     shadow_term: f32,
-    // The shadow view (cascade) read, -1 for none.
+    // The shown light's shadow view (cascade or cube face) read, relative to its first; -1 for
+    // none.
     cascade: i32,
 }
 
@@ -507,14 +542,25 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
             }
         }
         var vis = select(0.0, 1.0, dot(n_geo, l) > 0.0);
-        if u32(frame.shadow_light.w) == i {
-            if SHADOWS && frame.shadow.w > 0.5 {
-                cascade = 0;
-                if CASCADED {
-                    cascade = shadow_view_index(p, in.clip.xy);
+        let shown = u32(frame.shadow_light.w) == i;
+        if SHADOWS && frame.shadow.w > 0.5 {
+            if MANY_VIEWS {
+                // Each light its own views.
+                let first = i32(light.shadow.x);
+                if first >= 0 {
+                    let view = light_view(light, p, in.clip.xy, first, i32(light.shadow.y));
+                    vis *= shadow_visibility(p, n_geo, l, light, view);
+                    if shown {
+                        cascade = view - first;
+                    }
                 }
-                vis *= shadow_visibility(p, n_geo, l, light, cascade);
+            } else if shown {
+                // The one shadowed light, view 0.
+                vis *= shadow_visibility(p, n_geo, l, light, 0);
+                cascade = 0;
             }
+        }
+        if shown {
             shadow_term = vis;
         }
         let h = normalize(l + v);

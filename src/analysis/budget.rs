@@ -162,7 +162,8 @@ pub fn features(probe: &ViewProbe, plan: &FramePlan, view: &View) -> Features {
     let Some(light) = plan.shadow_light.map(|i| plan.lights[i]) else {
         return Features::default();
     };
-    if plan.shadow_views.is_empty() {
+    let views = plan.primary_views();
+    if views.is_empty() {
         return Features::default();
     }
     let eye = view.camera.position();
@@ -175,12 +176,11 @@ pub fn features(probe: &ViewProbe, plan: &FramePlan, view: &View) -> Features {
     let pixel_angle = 2.0 * (view.camera.fov_y * 0.5).tan() / probe.height.max(1) as f32;
     let rho = |p: &Probe| -> f64 {
         let depth = (p.position - eye).dot(forward);
-        let k = plan
-            .shadow_views
+        let k = views
             .iter()
             .position(|v| depth <= v.far)
-            .unwrap_or(plan.shadow_views.len() - 1);
-        let tw = plan.shadow_views[k].texel_world;
+            .unwrap_or(views.len() - 1);
+        let tw = views[k].texel_world;
         let texel = match light.kind {
             LightKind::Directional => tw,
             _ => tw * (p.position - light.position).length(),

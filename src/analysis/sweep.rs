@@ -194,7 +194,7 @@ fn run_batch(
             exact,
         )?;
         let (m, lit) = (s.metrics, s.lit);
-        scored.push((m, lit.plan.shadow_views.len().max(1) as u32));
+        scored.push((m, lit.plan.primary_views().len().max(1) as u32));
         tick();
     }
     // Time, in interleaved rounds.

@@ -1,7 +1,7 @@
 //! Viewer key actions on the view settings, as pure logic; each returns the line to print.
 
 use glam::Vec3;
-use umbra::render::{Pcf, View, ViewMode};
+use umbra::render::{Pcf, View, ViewMode, MAX_CASCADES};
 use umbra::scene::Light;
 
 /// What a key does.
@@ -29,6 +29,8 @@ pub enum Action {
     CycleView,
     /// Toggle shadows (`H`).
     ToggleShadows,
+    /// Next cascade count: automatic, 1, 2, 3, 4 (`N`).
+    CycleCascades,
 }
 
 /// The sun as elevation/azimuth in degrees.
@@ -135,6 +137,24 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
             s.enabled = !s.enabled;
             format!("shadows: {}", if s.enabled { "on" } else { "off" })
         }
+        Action::CycleCascades => {
+            s.cascades = (s.cascades + 1) % (MAX_CASCADES + 1);
+            match s.cascades {
+                0 => "cascades: automatic (1, 2 or 4 by texel size)".into(),
+                n => format!("cascades: {n}"),
+            }
+        }
+    }
+}
+
+/// The next light whose visibility the shadow view shows (`L`), of a frame with `lights` lights
+/// (the plan falls back to the first shadowed light where that light has no views).
+pub fn next_shadow_light(view: &mut View, lights: usize) -> String {
+    let next = view.shown_light.map_or(0, |i| i + 1);
+    view.shown_light = (next < lights).then_some(next);
+    match view.shown_light {
+        Some(i) => format!("shadow view: light {i} (the first shadowed light if it casts none)"),
+        None => "shadow view: the first shadowed light".into(),
     }
 }
 
@@ -212,5 +232,21 @@ mod tests {
         distinct.dedup();
         assert_eq!(distinct.len(), 14, "every view once");
         assert!(apply(Action::ToggleShadows, &mut v, &mut sun).contains("off"));
+        // N: automatic, 1, 2, 3, 4, automatic.
+        let counts: Vec<u32> = (0..5)
+            .map(|_| {
+                apply(Action::CycleCascades, &mut v, &mut sun);
+                v.shadow.cascades
+            })
+            .collect();
+        assert_eq!(counts, [1, 2, 3, 4, 0]);
+        // L: lights 0, 1, then back to the default.
+        let shown: Vec<Option<usize>> = (0..3)
+            .map(|_| {
+                next_shadow_light(&mut v, 2);
+                v.shown_light
+            })
+            .collect();
+        assert_eq!(shown, [Some(0), Some(1), None]);
     }
 }

@@ -364,6 +364,10 @@ pub struct ViewArgs {
     /// choice and its prediction; overrides --shadow-map, --pcf, --cascades, --fit).
     #[arg(long, value_parser = parse_budget)]
     pub shadow_budget: Option<f64>,
+    /// Which light's shadow visibility `--view shadow` (and `cascades`, `texel-density`) shows,
+    /// by index in the scene's lights; default: the first light with shadow views.
+    #[arg(long)]
+    pub shadow_light: Option<usize>,
     /// Disable shadows.
     #[arg(long)]
     pub no_shadows: bool,
@@ -572,6 +576,13 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         i => i,
     };
     v.mode = a.mode;
+    if let Some(i) = a.shadow_light {
+        let n = umbra::render::effective_lights(&scene.lights, &v).len();
+        if i >= n {
+            bail!("--shadow-light {i}: the scene has {n} light(s) (0..{n})");
+        }
+    }
+    v.shown_light = a.shadow_light;
     if !(16..=16384).contains(&a.shadow_map) {
         bail!("--shadow-map {} must be within 16..16384", a.shadow_map);
     }

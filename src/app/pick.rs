@@ -69,7 +69,9 @@ pub fn describe(
             LightKind::Spot { .. } => "spot",
         };
         let verdict = |lit: bool| if lit { "lit" } else { "shadowed" };
-        let gpu = if plan.shadows_on && plan.shadow_light == Some(i) {
+        let gpu = if plan.is_shadowed(i) && plan.shadow_light != Some(i) {
+            "GPU shadows it too (the shadow view reads the shown light only)".into()
+        } else if plan.is_shadowed(i) {
             match gpu_visibility {
                 Some(v) => format!(
                     "GPU {} (visibility {v:.2}){}",

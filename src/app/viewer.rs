@@ -7,7 +7,7 @@
 //! `[`/`]` shadow-map size, `K` PCF kernel, `+`/`-` bias, `V` debug view, `H` shadows on/off,
 //! `P` screenshot, `Esc` quit.
 
-use super::actions::{apply, Action, SunAngles};
+use super::actions::{apply, next_shadow_light, Action, SunAngles};
 use super::controller::{Button, Controller, Input, MoveKey};
 use super::script::ScriptStep;
 use anyhow::{anyhow, Context as _};
@@ -67,6 +67,7 @@ fn resident_bytes() -> Option<u64> {
 /// What a key does in the viewer.
 enum KeyAction {
     Setting(Action),
+    ShadowLight,
     Move(MoveKey),
     Frame,
     ToggleFly,
@@ -89,6 +90,8 @@ fn script_key(name: &str) -> Option<KeyCode> {
         "-" => KeyCode::Minus,
         "v" => KeyCode::KeyV,
         "h" => KeyCode::KeyH,
+        "n" => KeyCode::KeyN,
+        "l" => KeyCode::KeyL,
         "f" => KeyCode::KeyF,
         "tab" => KeyCode::Tab,
         "c" => KeyCode::KeyC,
@@ -111,6 +114,8 @@ fn key_action(code: KeyCode) -> Option<KeyAction> {
         KeyCode::Minus | KeyCode::NumpadSubtract => Setting(Action::BiasDown),
         KeyCode::KeyV => Setting(Action::CycleView),
         KeyCode::KeyH => Setting(Action::ToggleShadows),
+        KeyCode::KeyN => Setting(Action::CycleCascades),
+        KeyCode::KeyL => ShadowLight,
         KeyCode::KeyW => Move(MoveKey::W),
         KeyCode::KeyA => Move(MoveKey::A),
         KeyCode::KeyS => Move(MoveKey::S),
@@ -470,6 +475,10 @@ impl App {
             KeyAction::Move(k) => s.controller.handle(Input::Key(k, pressed)),
             _ if !pressed => {}
             KeyAction::Setting(a) => println!("{}", apply(a, &mut s.view, &mut s.sun)),
+            KeyAction::ShadowLight => {
+                let n = effective_lights(&opts.scene.lights, &s.view).len();
+                println!("{}", next_shadow_light(&mut s.view, n));
+            }
             KeyAction::Frame => {
                 s.camera_index = None;
                 let size = s.window.inner_size();

@@ -316,6 +316,35 @@ pub fn fit_spot(
     (proj * view, half.tan())
 }
 
+/// The six cube-face views of a point light at `position` (faces +x, −x, +y, −y, +z, −z, the
+/// order the camera pass picks them in by the major axis), each reaching `margin_texels` of a
+/// `size`² layer past 90° so that a lookup's filter near a face's edge stays on that face;
+/// returns the views and the tangent of their half angle.
+pub fn fit_point_faces(
+    position: Vec3,
+    scene_bounds: &Aabb,
+    size: u32,
+    margin_texels: f32,
+) -> ([Mat4; 6], f32) {
+    // A point on the face's edge (at 45°) projects to 1/t of the half-width: t = 1/(1 − 2m/size)
+    // leaves m texels beyond it. At most a quarter of the face.
+    let m = (2.0 * margin_texels.max(0.0) / size.max(1) as f32).min(0.25);
+    let tan_half = 1.0 / (1.0 - m);
+    let proj = perspective_infinite_reversed(2.0 * tan_half.atan(), 1.0, spot_near(scene_bounds));
+    let faces = [
+        (Vec3::X, Vec3::Y),
+        (Vec3::NEG_X, Vec3::Y),
+        (Vec3::Y, Vec3::Z),
+        (Vec3::NEG_Y, Vec3::Z),
+        (Vec3::Z, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::Y),
+    ];
+    (
+        faces.map(|(d, up)| proj * Mat4::look_to_rh(position, d, up)),
+        tan_half,
+    )
+}
+
 /// Near-plane distance of a spot light's shadow projection over `scene_bounds`.
 pub fn spot_near(scene_bounds: &Aabb) -> f32 {
     (scene_bounds.diagonal() * 1e-3).max(1e-3)

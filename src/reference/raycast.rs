@@ -282,7 +282,7 @@ impl<'a> ReferenceScene<'a> {
         if !facing {
             return (false, dir, radiance);
         }
-        if plan.shadow_light != Some(i) || !plan.shadows_on {
+        if !plan.is_shadowed(i) {
             return (true, dir, radiance);
         }
         (!self.occluded(p, ng, dir, dist), dir, radiance)

@@ -5,7 +5,6 @@
 use super::camera_pass::{CameraCull, CameraPass};
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
-use super::gpu_scene::Viewpoint;
 use super::settings::{SceneOptions, View, ViewMode};
 use super::shadow_pass::{plan_casters, ShadowPass};
 use crate::gpu::barrier::{image_barrier, Access};
@@ -141,9 +140,6 @@ impl FrameCore {
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         self.camera.bind_shadow_map(slot, map_view, hw);
         if plan.shadows_on {
-            let source = plan
-                .shadow_source()
-                .unwrap_or(Viewpoint::Along(glam::Vec3::NEG_Y));
             plan.casters = plan
                 .shadow_views
                 .iter()
@@ -151,7 +147,7 @@ impl FrameCore {
                     plan_casters(
                         &self.gpu,
                         &sv.light_clip_from_world,
-                        source,
+                        plan.light_source(sv.light),
                         map_size,
                         view.shadow.pcf.lookup_reach(),
                         view.mode == ViewMode::ShadowMap,
@@ -160,7 +156,7 @@ impl FrameCore {
                 .collect();
         }
         for (c, cp) in plan.casters.iter().enumerate() {
-            plan.uniform.shadow_rect[c] = cp.lookup;
+            plan.uniform.views[c].rect = cp.lookup;
         }
         self.camera.write_frame(slot, &plan.uniform)?;
         self.camera
@@ -196,21 +192,18 @@ impl FrameCore {
                 );
             }
         }
-        // The shadowed light's eye: none for a directional light (outside everything); a spot
-        // light's position with its projection's near distance.
-        let light_eye = match plan.shadow_source() {
-            Some(Viewpoint::Eye(p)) => Some((p, spot_near(&self.gpu.bounds))),
-            _ => None,
-        };
         let views: Vec<_> = plan
             .shadow_views
             .iter()
             .map(|v| v.light_clip_from_world)
             .zip(&plan.casters)
             .collect();
+        // How far from a point or spot light its projection's near plane reaches (near
+        // distance × √(1 + 2·tan²) for the widest point face, tan ≤ 4/3).
+        let near = 2.2 * spot_near(&self.gpu.bounds);
         let casters = self
             .shadow
-            .record(cmd, &self.gpu, &view.shadow, &views, light_eye);
+            .record(cmd, &self.gpu, &view.shadow, &views, near);
         unsafe {
             if timestamps {
                 d.cmd_write_timestamp2(

@@ -1,13 +1,17 @@
-//! Per-frame planning on the CPU: which lights shade, which one gets the shadow map, the fitted
-//! light projection, the camera projection, and the frame uniform block.
+//! Per-frame planning on the CPU: which lights shade, the shadow views of each shadow-casting
+//! light (cascades, a spot's frustum, a point light's six cube faces) as layers of one shadow
+//! map, the camera projection, and the frame uniform block.
 
+use super::gpu_scene::Viewpoint;
 use super::settings::{Pcf, ShadowFit, View, MAX_CASCADES};
 use super::shadow_pass::CasterPlan;
-use super::uniforms::{FrameUniform, LightUniform, MAX_LIGHTS};
+use super::uniforms::{
+    FrameUniform, LightUniform, ShadowViewUniform, MAX_LIGHTS, MAX_SHADOW_VIEWS,
+};
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
 use crate::math::shadow_fit::{
-    cascade_splits, fit_directional, fit_spot, frustum_box_intersection, CameraFrustum,
-    DirectionalFit, DirectionalFitInput,
+    cascade_splits, fit_directional, fit_point_faces, fit_spot, frustum_box_intersection,
+    CameraFrustum, DirectionalFit, DirectionalFitInput,
 };
 use crate::math::Aabb;
 use crate::scene::{Camera, Light, LightKind};
@@ -83,17 +87,20 @@ pub const CASCADE_SPLIT_LAMBDA: f32 = 0.9;
 /// The last fraction of each cascade (but the last) over which lookups move to the next one.
 pub const CASCADE_BLEND: f32 = 0.1;
 
-/// One view of the shadowed light: a cascade, the single map, or a spot light's.
+/// One shadow view (one layer of the shadow map): a cascade or the single map of a directional
+/// light, a spot light's frustum, or one cube face of a point light.
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowView {
     /// World → light clip.
     pub light_clip_from_world: Mat4,
-    /// World size of a texel (directional) or per unit distance (spot).
+    /// World size of a texel (directional) or per unit distance (spot, point face).
     pub texel_world: f32,
     /// View depth where this view stops being used (+inf for the last).
     pub far: f32,
     /// View depth where lookups start moving to the next view (= `far` for the last).
     pub blend: f32,
+    /// The light (index into `FramePlan::lights`) it belongs to.
+    pub light: usize,
 }
 
 impl ShadowView {
@@ -104,6 +111,7 @@ impl ShadowView {
             texel_world,
             far: f32::INFINITY,
             blend: f32::INFINITY,
+            light: 0,
         }
     }
 }
@@ -216,11 +224,17 @@ pub struct FramePlan {
     pub(crate) shader_variant: usize,
     /// Lights shading this frame.
     pub lights: Vec<Light>,
-    /// Index of the light with the shadow map, if any.
+    /// The shadowed light whose visibility `--view shadow` writes (and whose views the shadow
+    /// reports describe): `View::shown_light` when that light has views, else the first light
+    /// with views; None without one.
     pub shadow_light: Option<usize>,
-    /// Every view of the shadowed light (cascades near to far; one for a single map or a spot;
-    /// none without a shadowed light).
+    /// Every shadow view, grouped by light in light order (a light's views are consecutive:
+    /// cascades near to far, one for a spot, six cube faces for a point light); view i is layer
+    /// i of the shadow map. Empty without a shadowed light.
     pub shadow_views: Vec<ShadowView>,
+    /// Shadow-casting lights left without views because the frame's views were used up
+    /// (`MAX_SHADOW_VIEWS`); they light without shadows.
+    pub unshadowed: Vec<usize>,
     /// The camera's world → clip.
     pub clip_from_world: Mat4,
     /// The shadow pass's casters and area per shadow view (set by `FrameCore::prepare`).
@@ -243,21 +257,48 @@ impl FramePlan {
         }
     }
 
-    /// World size of a texel of the first (nearest) shadow view (directional), or per unit
-    /// distance (spot); 0 without a shadow map.
-    pub fn texel_world(&self) -> f32 {
-        self.shadow_views.first().map_or(0.0, |v| v.texel_world)
+    /// The views of light `i` (empty when it casts no shadow this frame).
+    pub fn light_views(&self, i: usize) -> &[ShadowView] {
+        let first = self.shadow_views.iter().position(|v| v.light == i);
+        let Some(first) = first else {
+            return &[];
+        };
+        let n = self.shadow_views[first..]
+            .iter()
+            .take_while(|v| v.light == i)
+            .count();
+        &self.shadow_views[first..first + n]
     }
 
-    /// The light source the shadow views look from: a spot light's position, or the direction
-    /// a directional light travels; None without a shadowed light.
-    pub fn shadow_source(&self) -> Option<super::gpu_scene::Viewpoint> {
-        use super::gpu_scene::Viewpoint;
-        let l = &self.lights[self.shadow_light?];
-        Some(match l.kind {
+    /// The shown light's views (`shadow_light`; empty without one).
+    pub fn primary_views(&self) -> &[ShadowView] {
+        self.shadow_light.map_or(&[][..], |i| self.light_views(i))
+    }
+
+    /// Whether light `i` is shadowed by the map this frame (shadows on and it has views).
+    pub fn is_shadowed(&self, i: usize) -> bool {
+        self.shadows_on && self.shadow_views.iter().any(|v| v.light == i)
+    }
+
+    /// World size of a texel of the shown light's first (nearest) view (directional), or per
+    /// unit distance (spot, point); 0 without a shadow map.
+    pub fn texel_world(&self) -> f32 {
+        self.primary_views().first().map_or(0.0, |v| v.texel_world)
+    }
+
+    /// Where light `i` is seen from: a point or spot light's position, or the direction a
+    /// directional light travels.
+    pub fn light_source(&self, i: usize) -> Viewpoint {
+        let l = &self.lights[i];
+        match l.kind {
             LightKind::Directional => Viewpoint::Along(l.direction),
             _ => Viewpoint::Eye(l.position),
-        })
+        }
+    }
+
+    /// The shown light's source (`light_source`); None without a shadowed light.
+    pub fn shadow_source(&self) -> Option<Viewpoint> {
+        Some(self.light_source(self.shadow_light?))
     }
 }
 
@@ -325,77 +366,52 @@ pub fn plan_frame(
     let fit_camera = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
     let proj = camera_projection(&view.camera, aspect);
     let clip_from_world = proj * view.camera.view_from_world();
-    let shadow_light = lights
-        .iter()
-        .position(|l| l.casts_shadows && l.kind != LightKind::Point && l.intensity > 0.0);
-    let mut views: Vec<ShadowView> = Vec::new();
     let size = view.shadow.map_size.max(1);
-    if let Some(i) = shadow_light {
-        let l = &lights[i];
-        match l.kind {
-            LightKind::Directional => {
-                let fit_cam = fit_camera;
-                let fit = |camera| {
-                    fit_directional(&DirectionalFitInput {
-                        direction: l.direction,
-                        scene_bounds: *bounds,
-                        camera,
-                        map_size: size,
-                        snap: view.shadow.snap,
-                    })
-                };
-                match view.shadow.fit {
-                    ShadowFit::Camera => {
-                        let frustum = fitting_frustum(fit_cam, aspect, bounds);
-                        // Split the depths where the view meets the scene, not the whole
-                        // frustum: a camera high above a compact scene sees nothing near.
-                        // (Per frame, so only when the count is not fixed at one map.)
-                        let (near, far) = match view.shadow.cascades {
-                            1 => (frustum.near, frustum.far),
-                            _ if view.shadow.snap => {
-                                let (n, f) = receiver_depths(&frustum, bounds, receivers);
-                                quantise_depth_range(n, f, (frustum.near, frustum.far))
-                            }
-                            _ => receiver_depths(&frustum, bounds, receivers),
-                        };
-                        // The automatic count fits one map first; when it stays at one, that is
-                        // the frame's map.
-                        let mut single = None;
-                        let n = match view.shadow.cascades {
-                            0 => {
-                                let f = fit(Some(frustum));
-                                let pixel = 2.0 * near * (fit_cam.fov_y * 0.5).tan()
-                                    / height_px.max(1) as f32;
-                                single = Some(f);
-                                auto_cascades(f.texel_world / pixel.max(f32::MIN_POSITIVE))
-                            }
-                            c => c.clamp(1, MAX_CASCADES) as usize,
-                        };
-                        if n == 1 {
-                            let f = single.unwrap_or_else(|| fit(Some(frustum)));
-                            views.push(ShadowView::whole(f.light_clip_from_world, f.texel_world));
-                        } else {
-                            views = cascade_views(&frustum, (near, far), n, fit);
-                        }
-                    }
-                    ShadowFit::Scene => {
-                        let f = fit(None);
-                        views.push(ShadowView::whole(f.light_clip_from_world, f.texel_world));
-                    }
-                }
-            }
+    // Every shadow-casting light gets its views, in light order, while the frame's views last.
+    let mut views: Vec<ShadowView> = Vec::new();
+    let mut unshadowed = Vec::new();
+    for (i, l) in lights.iter().enumerate() {
+        if !(l.casts_shadows && l.intensity > 0.0) {
+            continue;
+        }
+        let room = MAX_SHADOW_VIEWS - views.len();
+        let mut own = match l.kind {
+            // Fewer cascades where the views run short.
+            LightKind::Directional if room > 0 => directional_views(
+                l, bounds, receivers, view, fit_camera, aspect, height_px, room,
+            ),
+            LightKind::Directional => Vec::new(),
             LightKind::Spot { outer, .. } => {
                 let (m, tan_half) = fit_spot(l.position, l.direction, outer, bounds);
-                views.push(ShadowView::whole(m, 2.0 * tan_half / size as f32));
+                vec![ShadowView::whole(m, 2.0 * tan_half / size as f32)]
             }
-            LightKind::Point => {}
+            LightKind::Point => {
+                let (faces, tan_half) =
+                    fit_point_faces(l.position, bounds, size, point_face_margin(view));
+                let texel = 2.0 * tan_half / size as f32;
+                faces.iter().map(|&m| ShadowView::whole(m, texel)).collect()
+            }
+        };
+        // A light whose views do not fit casts no shadow.
+        if own.is_empty() || own.len() > room {
+            unshadowed.push(i);
+            continue;
         }
+        for v in &mut own {
+            v.light = i;
+        }
+        views.extend(own);
     }
+    let has_views = |i: usize| views.iter().any(|v| v.light == i);
+    let shadow_light = view
+        .shown_light
+        .filter(|&i| has_views(i))
+        .or_else(|| views.first().map(|v| v.light));
     let shadows_on = view.shadow.enabled && shadow_light.is_some();
+    let first_shown = shadow_light.and_then(|i| views.iter().position(|v| v.light == i));
+    let shown_count = shadow_light.map_or(0, |i| views.iter().filter(|v| v.light == i).count());
     let mut u = FrameUniform {
         clip_from_world,
-        // Set per view below; slots past the views are never read.
-        shadow_clip: [Mat4::IDENTITY; 4],
         camera_position: view.camera.position().extend(1.0),
         ambient: view.ambient.extend(0.0),
         shadow: Vec4::new(
@@ -404,24 +420,24 @@ pub fn plan_frame(
             far_view_depth(&view.camera, bounds),
             if shadows_on { 1.0 } else { 0.0 },
         ),
-        // No shadowed light: an index the shader's light loop never reaches. xyz: the eye the
+        // No shown light: an index the shader's light loop never reaches. xyz: the eye the
         // cascades were split from (the fitting camera, which is the view's unless a test or
         // the stability suite fits the shadows to another camera).
         shadow_light: fit_camera
             .position()
             .extend(shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32)),
-        bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
-        // Set with the casters (`shadow_pass::plan_casters`); until then every lookup is lit.
-        shadow_rect: [Vec4::new(1.0, 1.0, -1.0, -1.0); 4],
-        cascade_far: Vec4::splat(f32::MAX),
-        cascade_blend: Vec4::splat(f32::MAX),
-        cascade_texel: Vec4::ZERO,
+        bias: Vec4::new(
+            view.shadow.constant_bias,
+            first_shown.unwrap_or(0) as f32,
+            0.0,
+            0.0,
+        ),
         camera_forward: (fit_camera
             .view_from_world()
             .inverse()
             .transform_vector3(Vec3::NEG_Z))
         .normalize_or(Vec3::NEG_Z)
-        .extend(views.len().max(1) as f32),
+        .extend(shown_count.max(1) as f32),
         modes: [
             view.mode.shader_value(),
             view.shadow.pcf.taps(),
@@ -429,13 +445,19 @@ pub fn plan_frame(
             lights.len() as u32,
         ],
         lights: [LightUniform::default(); MAX_LIGHTS],
+        // Set per view below (rectangles with the casters, `shadow_pass::plan_casters`; until
+        // then every lookup is lit); slots past the views are never read.
+        views: [ShadowViewUniform::default(); MAX_SHADOW_VIEWS],
     };
     for (c, v) in views.iter().enumerate() {
-        u.shadow_clip[c] = v.light_clip_from_world;
-        u.cascade_texel[c] = v.texel_world;
         // f32::MAX rather than infinity: the shader compares and subtracts these.
-        u.cascade_far[c] = v.far.min(f32::MAX);
-        u.cascade_blend[c] = v.blend.min(f32::MAX);
+        u.views[c].clip = v.light_clip_from_world;
+        u.views[c].cascade = Vec4::new(
+            v.far.min(f32::MAX),
+            v.blend.min(f32::MAX),
+            v.texel_world,
+            0.0,
+        );
     }
     for (i, l) in lights.iter().enumerate() {
         let (kind, cone) = match l.kind {
@@ -445,11 +467,14 @@ pub fn plan_frame(
                 (2.0, Vec4::new(inner.cos(), outer.cos(), 0.0, 0.0))
             }
         };
+        let first = views.iter().position(|v| v.light == i);
+        let count = views.iter().filter(|v| v.light == i).count();
         u.lights[i] = LightUniform {
             position: l.position.extend(kind),
             direction: l.direction.normalize_or(Vec3::NEG_Y).extend(0.0),
             color: (l.color * l.intensity).extend(0.0),
             cone,
+            shadow: Vec4::new(first.map_or(-1.0, |f| f as f32), count as f32, 0.0, 0.0),
         };
     }
     FramePlan {
@@ -467,9 +492,84 @@ pub fn plan_frame(
         lights,
         shadow_light,
         shadow_views: views,
+        unshadowed,
         clip_from_world,
         casters: Vec::new(),
         origin: Vec3::ZERO,
+    }
+}
+
+/// How many texels a point light's cube face reaches past its 90° (so that the filter and the
+/// normal offset of a lookup on one face stay inside that face's layer): PCF reach, normal
+/// offset, constant bias, and two of slack.
+fn point_face_margin(view: &View) -> f32 {
+    let s = &view.shadow;
+    s.pcf.lookup_reach() as f32
+        + s.normal_offset.max(0.0).ceil()
+        + s.constant_bias.max(0.0).ceil()
+        + 2.0
+}
+
+/// The views of directional light `l`: one map, or cascades when fitted to the camera (count
+/// from the settings, or automatic; at most `max`).
+#[allow(clippy::too_many_arguments)]
+fn directional_views(
+    l: &Light,
+    bounds: &Aabb,
+    receivers: &[Aabb],
+    view: &View,
+    fit_cam: &Camera,
+    aspect: f32,
+    height_px: u32,
+    max: usize,
+) -> Vec<ShadowView> {
+    let size = view.shadow.map_size.max(1);
+    let fit = |camera| {
+        fit_directional(&DirectionalFitInput {
+            direction: l.direction,
+            scene_bounds: *bounds,
+            camera,
+            map_size: size,
+            snap: view.shadow.snap,
+        })
+    };
+    match view.shadow.fit {
+        ShadowFit::Camera => {
+            let frustum = fitting_frustum(fit_cam, aspect, bounds);
+            // Split the depths where the view meets the scene, not the whole frustum: a camera
+            // high above a compact scene sees nothing near. (Per frame, so only when the count
+            // is not fixed at one map.)
+            let (near, far) = match view.shadow.cascades {
+                1 => (frustum.near, frustum.far),
+                _ if view.shadow.snap => {
+                    let (n, f) = receiver_depths(&frustum, bounds, receivers);
+                    quantise_depth_range(n, f, (frustum.near, frustum.far))
+                }
+                _ => receiver_depths(&frustum, bounds, receivers),
+            };
+            // The automatic count fits one map first; when it stays at one, that is the map.
+            let mut single = None;
+            let n = match view.shadow.cascades {
+                0 => {
+                    let f = fit(Some(frustum));
+                    let pixel = 2.0 * near * (fit_cam.fov_y * 0.5).tan() / height_px.max(1) as f32;
+                    single = Some(f);
+                    auto_cascades(f.texel_world / pixel.max(f32::MIN_POSITIVE))
+                }
+                c => c.clamp(1, MAX_CASCADES) as usize,
+            }
+            .min(max);
+            if n == 1 {
+                let f = single.unwrap_or_else(|| fit(Some(frustum)));
+                vec![ShadowView::whole(f.light_clip_from_world, f.texel_world)]
+            } else {
+                cascade_views(&frustum, (near, far), n, fit)
+            }
+        }
+        ShadowFit::Scene => {
+            let f = fit(None);
+            vec![ShadowView::whole(f.light_clip_from_world, f.texel_world)]
+        }
     }
 }
 
@@ -515,7 +615,7 @@ fn frame_variant_bits(
         };
     for (on, bit) in [
         (hw_compare, sh::BIT_HW_COMPARE),
-        (views > 1, sh::BIT_CASCADED),
+        (views > 1, sh::BIT_MANY_VIEWS),
     ] {
         if on {
             bits |= bit;
@@ -551,7 +651,7 @@ mod tests {
         // Cascades: four views, nearest first, each ending where the next blends in.
         v.shadow.cascades = 4;
         let p = plan_frame(&s.lights, &s.bounds(), &[], &v, 1.5, 720, false);
-        assert_eq!(p.shader_variant, want | sh::BIT_CASCADED);
+        assert_eq!(p.shader_variant, want | sh::BIT_MANY_VIEWS);
         assert_eq!(p.shadow_views.len(), 4);
         for w in p.shadow_views.windows(2) {
             assert!(w[0].blend < w[0].far && w[0].far < w[1].far, "{w:?}");
@@ -562,5 +662,78 @@ mod tests {
         v.shadow.enabled = false;
         let p = plan_frame(&s.lights, &s.bounds(), &[], &v, 1.5, 720, false);
         assert_eq!(p.shader_variant, sh::BIT_SINGLE_LIGHT);
+    }
+    #[test]
+    fn every_casting_light_gets_views_while_they_last() {
+        let s = demo_scene();
+        let point = |x: f32| Light {
+            kind: LightKind::Point,
+            position: Vec3::new(x, 3.0, 0.0),
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            intensity: 5.0,
+            casts_shadows: true,
+        };
+        let spot = Light {
+            kind: LightKind::Spot {
+                inner: 0.3,
+                outer: 0.5,
+            },
+            ..point(1.0)
+        };
+        let mut dark = point(0.0);
+        dark.casts_shadows = false;
+        let sun = Light::sun(Vec3::new(0.3, -1.0, 0.2), 1.0);
+        let lights = vec![sun, point(-2.0), dark, spot, point(2.0), point(4.0)];
+        let mut v = View::new(s.default_camera(1.5));
+        v.shadow.cascades = 4;
+        let p = plan_frame(&lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        // Sun 4 cascades, point 6 faces, spot 1: 11 of 16; the next two point lights need 6
+        // each, more than the 5 left, and the light that casts none gets none.
+        let per_light: Vec<usize> = (0..lights.len()).map(|i| p.light_views(i).len()).collect();
+        assert_eq!(per_light, [4, 6, 0, 1, 0, 0]);
+        assert_eq!(p.unshadowed, [4, 5]);
+        assert_eq!(p.shadow_views.len(), 11);
+        assert!(p.is_shadowed(3) && !p.is_shadowed(2) && !p.is_shadowed(4));
+        // Layer order: grouped by light; the uniform says where each light's views start.
+        let firsts: Vec<f32> = p.uniform.lights[..6].iter().map(|l| l.shadow.x).collect();
+        assert_eq!(firsts, [0.0, 4.0, -1.0, 10.0, -1.0, -1.0]);
+        assert_eq!(
+            p.shader_variant & crate::gpu::shaders::scene::BIT_MANY_VIEWS,
+            crate::gpu::shaders::scene::BIT_MANY_VIEWS
+        );
+        // The shown light: the first shadowed one, or the one asked for if it has views.
+        assert_eq!(p.shadow_light, Some(0));
+        v.shown_light = Some(3);
+        let p = plan_frame(&lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        assert_eq!(
+            (p.shadow_light, p.uniform.bias.y, p.uniform.camera_forward.w),
+            (Some(3), 10.0, 1.0)
+        );
+        v.shown_light = Some(4);
+        let p = plan_frame(&lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        assert_eq!(p.shadow_light, Some(0));
+        // A point light's faces look along ±x, ±y, ±z: each face's centre direction lands in the
+        // middle of its own layer.
+        let faces = p.light_views(1);
+        let at = lights[1].position;
+        for (k, d) in [
+            Vec3::X,
+            Vec3::NEG_X,
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
+        ]
+        .iter()
+        .enumerate()
+        {
+            let c = faces[k].light_clip_from_world * (at + *d).extend(1.0);
+            let ndc = c.truncate() / c.w;
+            assert!(
+                ndc.x.abs() < 1e-4 && ndc.y.abs() < 1e-4 && c.w > 0.0,
+                "face {k}: {ndc}"
+            );
+        }
     }
 }

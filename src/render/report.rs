@@ -46,7 +46,7 @@ pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
     let size = view.shadow.map_size as u64;
     let mut near = view.camera.near;
     let views: Vec<Value> = plan
-        .shadow_views
+        .primary_views()
         .iter()
         .map(|v| {
             let casters = draws
@@ -64,10 +64,13 @@ pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
         "light_type": kind,
         "map_texels": size,
         "format": match view.shadow.format { ShadowFormat::D16 => "D16", ShadowFormat::D32 => "D32" },
-        "cascades": plan.shadow_views.len(),
+        "cascades": plan.primary_views().len(),
         "views": views,
-        "texel_world_nearest": plan.shadow_views.first().map(|v| v.texel_world),
-        "texel_world_farthest": plan.shadow_views.last().map(|v| v.texel_world),
+        "texel_world_nearest": plan.primary_views().first().map(|v| v.texel_world),
+        "texel_world_farthest": plan.primary_views().last().map(|v| v.texel_world),
+        "shadowed_lights": (0..plan.lights.len()).filter(|&i| plan.is_shadowed(i)).collect::<Vec<_>>(),
+        "unshadowed_lights": plan.unshadowed,
+        "layers": plan.shadow_views.len(),
         "gpu_bytes": size * size * bytes_per_texel * plan.shadow_views.len().max(1) as u64,
         "image": [w, h],
     })

@@ -216,6 +216,9 @@ pub struct View {
     pub shadow_fit_camera: Option<Camera>,
     /// Tint this (instance, primitive) orange in the lit image (the viewer's picked primitive).
     pub highlight: Option<(usize, usize)>,
+    /// The light whose shadow visibility the shadow view shows (index into the frame's lights);
+    /// None or a light without shadow views: the first shadowed light.
+    pub shown_light: Option<usize>,
 }
 
 impl View {
@@ -238,6 +241,7 @@ impl View {
             ambient: Vec3::splat(0.12),
             shadow_fit_camera: None,
             highlight: None,
+            shown_light: None,
         }
     }
 }

@@ -56,7 +56,7 @@ pub struct CasterPlan {
     /// Texel rectangle `(x0, y0, x1, y1)` outside which a lookup's footprint meets no caster
     /// texel (the casters' rectangle grown by the reach): such lookups are lit without a read.
     pub lookup: Vec4,
-    /// The shadowed light (clusters facing away from it are not drawn).
+    /// The view's light (clusters facing away from it are not drawn).
     pub light: Viewpoint,
 }
 
@@ -347,7 +347,7 @@ impl ShadowPass {
         scene: &GpuScene,
         s: &ShadowSettings,
         views: &[(Mat4, &CasterPlan)],
-        eye: Option<(glam::Vec3, f32)>,
+        eye_near: f32,
     ) -> usize {
         let (Some(map), Some(at)) = (&self.map, self.map_at.as_mut()) else {
             return 0;
@@ -370,6 +370,12 @@ impl ShadowPass {
                 break;
             };
             let from = casters.light;
+            // A point or spot light's eye and its projection's near distance (clusters wholly
+            // nearer are not drawn); none for a directional light (outside everything).
+            let eye = match from {
+                Viewpoint::Eye(p) => Some((p, eye_near)),
+                Viewpoint::Along(_) => None,
+            };
             let depth_attachment = depth_clear_attachment(layer_view);
             // Only the casters' area is cleared and drawn: lookups elsewhere never read the map.
             let area = casters.area;

@@ -7,6 +7,9 @@ use glam::{Mat4, Vec4};
 
 /// Most lights the camera pass shades.
 pub const MAX_LIGHTS: usize = 8;
+/// Most shadow views (layers of the shadow map) in one frame: a directional light takes one per
+/// cascade, a spot light one, a point light six (cube faces).
+pub const MAX_SHADOW_VIEWS: usize = 16;
 
 /// One light as the shader sees it.
 #[repr(C)]
@@ -20,6 +23,34 @@ pub struct LightUniform {
     pub color: Vec4,
     /// x cos(inner), y cos(outer).
     pub cone: Vec4,
+    /// x first shadow view (−1: casts none), y its view count (cascades; 6 cube faces for a
+    /// point light).
+    pub shadow: Vec4,
+}
+
+/// One shadow view (one layer of the shadow map) as the shader sees it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ShadowViewUniform {
+    /// World → light clip.
+    pub clip: Mat4,
+    /// Texel rectangle (x0, y0, x1, y1) of its layer outside which a lookup's footprint meets no
+    /// caster (lit without reading the map; the texels there are not cleared).
+    pub rect: Vec4,
+    /// x view depth where the cascade ends (the last: f32::MAX), y where blending into the next
+    /// starts, z world size of a texel (directional) or per unit distance (spot, point face).
+    pub cascade: Vec4,
+}
+
+impl Default for ShadowViewUniform {
+    /// Never read: every lookup lit.
+    fn default() -> Self {
+        Self {
+            clip: Mat4::IDENTITY,
+            rect: Vec4::new(1.0, 1.0, -1.0, -1.0),
+            cascade: Vec4::new(f32::MAX, f32::MAX, 0.0, 0.0),
+        }
+    }
 }
 
 /// Per-frame constants of the camera pass (`Frame` in scene.wgsl).
@@ -28,34 +59,26 @@ pub struct LightUniform {
 pub struct FrameUniform {
     /// World → clip (camera).
     pub clip_from_world: Mat4,
-    /// World → clip of each shadow view (cascade; one for a spot light or a single map).
-    pub shadow_clip: [Mat4; 4],
     /// Camera position.
     pub camera_position: Vec4,
     /// Ambient intensity Ia.
     pub ambient: Vec4,
-    /// x map size, y normal offset (texels), z unused (texel sizes: `cascade_texel`), w enabled.
+    /// x map size, y normal offset (texels), z the depth view's far end, w enabled.
     pub shadow: Vec4,
-    /// w: index of the shadowed light (`MAX_LIGHTS + 1` when none); xyz: the eye cascades are
-    /// split from (the shadow-fitting camera's position; view depth = dot(p − eye, forward)).
+    /// w: index of the light whose visibility the shadow view shows (`MAX_LIGHTS + 1` when
+    /// none); xyz: the eye cascades are split from (the shadow-fitting camera's position; view
+    /// depth = dot(p − eye, forward)).
     pub shadow_light: Vec4,
-    /// x constant bias in shadow texels (towards the light).
+    /// x constant bias in shadow texels (towards the light); y the shown light's first view.
     pub bias: Vec4,
-    /// Per shadow view: texel rectangle (x0, y0, x1, y1) of its layer outside which a lookup's
-    /// footprint meets no caster (lit without reading the map; the texels there are not cleared).
-    pub shadow_rect: [Vec4; 4],
-    /// Per cascade: the view depth where it ends (the last: +inf).
-    pub cascade_far: Vec4,
-    /// Per cascade: the view depth where blending into the next one starts.
-    pub cascade_blend: Vec4,
-    /// Per cascade: world size of one texel (directional), or per unit distance (spot).
-    pub cascade_texel: Vec4,
-    /// xyz: the shadow-fitting camera's forward direction; w: cascade count.
+    /// xyz: the shadow-fitting camera's forward direction; w: the shown light's view count.
     pub camera_forward: Vec4,
     /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
     pub modes: [u32; 4],
     /// Lights.
     pub lights: [LightUniform; MAX_LIGHTS],
+    /// Shadow views; layer i of the shadow map belongs to view i.
+    pub views: [ShadowViewUniform; MAX_SHADOW_VIEWS],
 }
 
 /// Material constants (`Material` in scene.wgsl).

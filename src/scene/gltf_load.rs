@@ -467,7 +467,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 direction: dir,
                 color: Vec3::from_array(l.color()),
                 intensity: l.intensity().max(0.0),
-                casts_shadows: kind != LightKind::Point,
+                casts_shadows: true,
             });
         }
         for c in node.children() {

@@ -176,7 +176,8 @@ pub struct Light {
     pub color: Vec3,
     /// Intensity I (multiplies colour; 1/r² applies to point and spot).
     pub intensity: f32,
-    /// Whether it casts shadows (the first casting directional or spot light gets the shadow map).
+    /// Whether it casts shadows (each casting light gets shadow views while the frame has them:
+    /// `render::MAX_SHADOW_VIEWS`).
     pub casts_shadows: bool,
 }
 

@@ -194,7 +194,7 @@ fn cases(scene: &Scene, view: &View, quick: bool) -> Vec<Case> {
 
 fn finite_plan(f: &crate::render::RenderedFrame) -> bool {
     let u = &f.plan.uniform;
-    let mats = std::iter::once(&u.clip_from_world).chain(u.shadow_clip.iter());
+    let mats = std::iter::once(&u.clip_from_world).chain(u.views.iter().map(|v| &v.clip));
     mats.flat_map(|m| m.to_cols_array()).all(f32::is_finite)
         && f.depth
             .as_deref()

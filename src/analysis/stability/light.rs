@@ -183,12 +183,8 @@ pub fn contact_gaps(
             .transform_vector3(Vec3::NEG_Z)
             .normalize();
         let depth = (base - eye).dot(fwd);
-        let Some(sv) = plan
-            .shadow_views
-            .iter()
-            .find(|s| depth <= s.far)
-            .or(plan.shadow_views.last())
-        else {
+        let views = plan.primary_views();
+        let Some(sv) = views.iter().find(|s| depth <= s.far).or(views.last()) else {
             continue;
         };
         let texel = sv.texel_world as f64;

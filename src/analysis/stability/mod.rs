@@ -208,10 +208,10 @@ pub fn classify_scene(
     Ok((c, f, renderer))
 }
 
-/// The world size of one texel of the plan's finest shadow view (0 without one).
+/// The world size of one texel of the shown light's finest shadow view (0 without one).
 pub fn finest_texel(f: &RenderedFrame) -> f64 {
     f.plan
-        .shadow_views
+        .primary_views()
         .iter()
         .map(|v| v.texel_world as f64)
         .reduce(f64::min)
