@@ -81,7 +81,8 @@ struct ShadowView {
     // there, without reading the map (the shadow pass clears only what it draws).
     rect: vec4<f32>,
     // x: view depth where this cascade ends, y: where blending into the next one starts,
-    // z: world size of one texel (directional) or per unit distance (spot, point face).
+    // z: world size of one texel (directional) or per unit distance (spot, point face),
+    // w: its side in texels (it fills that square at the layer's origin; <= the map size).
     cascade: vec4<f32>,
 }
 
@@ -194,10 +195,11 @@ fn compare_texel(c: vec2<i32>, layer: i32, depth: f32, size: i32) -> f32 {
     return select(0.0, 1.0, depth >= stored);
 }
 
-// Bilinearly weighted 2x2 comparison at a position given in texel units (texel centres at +0.5).
+// Bilinearly weighted 2x2 comparison at a position given in texel units (texel centres at +0.5)
+// of a view `size` texels wide.
 fn bilinear_compare(p: vec2<f32>, layer: i32, depth: f32, size: i32) -> f32 {
     if HW_COMPARE {
-        return textureSampleCompareLevel(shadow_map, shadow_sampler, p / f32(size), layer, depth);
+        return textureSampleCompareLevel(shadow_map, shadow_sampler, p / frame.shadow.x, layer, depth);
     }
     let t = p - vec2<f32>(0.5);
     let i = vec2<i32>(floor(t));
@@ -279,7 +281,7 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, la
     }
     let ndc = lc.xyz / lc.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
-    let p_texel = uv * frame.shadow.x;
+    let p_texel = uv * view.cascade.w;
     // Outside the casters' rectangle (which lies inside the map) nothing is in shadow.
     let rect = view.rect;
     if any(p_texel < rect.xy) || any(p_texel > rect.zw) {
@@ -287,7 +289,7 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, la
     }
     // Depth clamp is on in the shadow pass, so receivers are clamped the same way.
     let depth = clamp(ndc.z, 0.0, 1.0);
-    let size = i32(frame.shadow.x);
+    let size = i32(view.cascade.w);
     let kernel = pcf_taps();
     if kernel == 0 {
         return compare_texel(vec2<i32>(floor(p_texel)), layer, depth, size);
@@ -400,7 +402,8 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
         layer = first + cube_face(in.world_position - shown.position.xyz);
     }
     let lc = frame.views[clamp(layer, 0, MAX_SHADOW_VIEWS - 1)].clip * vec4<f32>(in.world_position, 1.0);
-    let st = vec2<f32>(lc.x, -lc.y) / max(abs(lc.w), 1e-20) * (0.5 * frame.shadow.x);
+    let res = frame.views[clamp(layer, 0, MAX_SHADOW_VIEWS - 1)].cascade.w;
+    let st = vec2<f32>(lc.x, -lc.y) / max(abs(lc.w), 1e-20) * (0.5 * res);
     let jx = dpdx(st);
     let jy = dpdy(st);
     let texels_per_pixel = sqrt(abs(jx.x * jy.y - jx.y * jy.x));

@@ -181,6 +181,11 @@ struct Score {
 
 /// Renders light `light`'s shadow view of `scene` and judges it against the reference.
 fn judge(scene: &Scene, base: &View, light: usize, name: &str) -> Score {
+    judge_with(scene, base, light, name, 0)
+}
+
+/// `judge` with point-light cube faces of `cube_face` texels (0: the default).
+fn judge_with(scene: &Scene, base: &View, light: usize, name: &str, cube_face: u32) -> Score {
     let ctx = context();
     let mut r = Renderer::new(&ctx, scene).unwrap();
     r.set_read_depth(true);
@@ -188,6 +193,7 @@ fn judge(scene: &Scene, base: &View, light: usize, name: &str) -> Score {
     v.mode = ViewMode::Shadow;
     v.shadow.map_size = 2048;
     v.shown_light = Some(light);
+    v.shadow.cube_face = cube_face;
     let f = r.render(&v, W, H).unwrap();
     assert_eq!(f.plan.shadow_light, Some(light), "light {light} has views");
     save(&f.image, &format!("{name}_light{light}.png"));
@@ -259,8 +265,12 @@ fn check(s: &Score, min_shadow: f64) {
 #[test]
 fn a_point_light_shadows_a_closed_room_on_every_face() {
     let scene = room();
-    let s = judge(&scene, &room_view(), 0, "room_point");
+    // 2048² faces (the figure), and the default (half the 2048² map: 1024²).
+    let s = judge_with(&scene, &room_view(), 0, "room_point_2048", 2048);
     // Measured: 0 of 71,007 wrong; 4.8 % in exact shadow.
+    check(&s, 0.04);
+    let s = judge(&scene, &room_view(), 0, "room_point");
+    // Measured: 0 of 71,007 wrong (128² faces: 28, 0.039 %).
     check(&s, 0.04);
     // Shadow lies in at least four faces (measured: +x 1,352, −x 208, +y 182, −y 1,614 px).
     let faces = s.by_face.iter().filter(|&&n| n >= 100).count();

@@ -138,6 +138,7 @@ impl Grid {
                                     fit,
                                     snap: true,
                                     cascades,
+                                    cube_face: 0,
                                 },
                                 bias,
                             });

@@ -359,6 +359,9 @@ pub struct ViewArgs {
     /// would be at the nearest surface in view.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub cascades: u32,
+    /// Side in texels of a point light's cube faces (0, the default: half of --shadow-map).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=16384))]
+    pub cube_face: u32,
     /// Choose the shadow settings for this scene and view: the cheapest configuration whose
     /// predicted misclassification is within this budget, e.g. `0.1%` or `0.001` (prints the
     /// choice and its prediction; overrides --shadow-map, --pcf, --cascades, --fit).
@@ -605,6 +608,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         },
         snap: !a.no_snap,
         cascades: a.cascades,
+        cube_face: a.cube_face,
     };
     Ok(v)
 }

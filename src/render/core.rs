@@ -148,7 +148,7 @@ impl FrameCore {
                         &self.gpu,
                         &sv.light_clip_from_world,
                         plan.light_source(sv.light),
-                        map_size,
+                        sv.res,
                         view.shadow.pcf.lookup_reach(),
                         view.mode == ViewMode::ShadowMap,
                     )

@@ -3,7 +3,7 @@
 //! map, the camera projection, and the frame uniform block.
 
 use super::gpu_scene::Viewpoint;
-use super::settings::{Pcf, ShadowFit, View, MAX_CASCADES};
+use super::settings::{Pcf, ShadowFit, ShadowSettings, View, MAX_CASCADES};
 use super::shadow_pass::CasterPlan;
 use super::uniforms::{
     FrameUniform, LightUniform, ShadowViewUniform, MAX_LIGHTS, MAX_SHADOW_VIEWS,
@@ -101,6 +101,9 @@ pub struct ShadowView {
     pub blend: f32,
     /// The light (index into `FramePlan::lights`) it belongs to.
     pub light: usize,
+    /// Side in texels of the square at its layer's origin it fills (the map size, or less for a
+    /// point light's cube faces).
+    pub res: u32,
 }
 
 impl ShadowView {
@@ -112,6 +115,7 @@ impl ShadowView {
             far: f32::INFINITY,
             blend: f32::INFINITY,
             light: 0,
+            res: 0,
         }
     }
 }
@@ -386,10 +390,17 @@ pub fn plan_frame(
                 vec![ShadowView::whole(m, 2.0 * tan_half / size as f32)]
             }
             LightKind::Point => {
+                let res = cube_face_size(&view.shadow);
                 let (faces, tan_half) =
-                    fit_point_faces(l.position, bounds, size, point_face_margin(view));
-                let texel = 2.0 * tan_half / size as f32;
-                faces.iter().map(|&m| ShadowView::whole(m, texel)).collect()
+                    fit_point_faces(l.position, bounds, res, point_face_margin(view));
+                let texel = 2.0 * tan_half / res as f32;
+                faces
+                    .iter()
+                    .map(|&m| ShadowView {
+                        res,
+                        ..ShadowView::whole(m, texel)
+                    })
+                    .collect()
             }
         };
         // A light whose views do not fit casts no shadow.
@@ -399,6 +410,9 @@ pub fn plan_frame(
         }
         for v in &mut own {
             v.light = i;
+            if v.res == 0 {
+                v.res = size;
+            }
         }
         views.extend(own);
     }
@@ -456,7 +470,7 @@ pub fn plan_frame(
             v.far.min(f32::MAX),
             v.blend.min(f32::MAX),
             v.texel_world,
-            0.0,
+            v.res as f32,
         );
     }
     for (i, l) in lights.iter().enumerate() {
@@ -496,6 +510,15 @@ pub fn plan_frame(
         clip_from_world,
         casters: Vec::new(),
         origin: Vec3::ZERO,
+    }
+}
+
+/// Side in texels of a point light's cube faces: `cube_face`, or half the map (0), within the map.
+pub fn cube_face_size(s: &ShadowSettings) -> u32 {
+    let size = s.map_size.max(1);
+    match s.cube_face {
+        0 => (size / 2).max(1),
+        n => n.min(size),
     }
 }
 

@@ -142,6 +142,10 @@ pub struct ShadowSettings {
     /// (the default) chooses per frame from how much coarser than a pixel one map's texels would
     /// be at the nearest receiver (`render::frame::auto_cascades`).
     pub cascades: u32,
+    /// Side in texels of each of a point light's six cube faces (each fills that square of its
+    /// own layer); 0 (the default) is half of `map_size`, so a cube costs 1.5 maps of texels, not
+    /// six.
+    pub cube_face: u32,
 }
 
 /// Most cascades a directional light can have.
@@ -160,6 +164,7 @@ impl Default for ShadowSettings {
             fit: ShadowFit::Camera,
             snap: true,
             cascades: 0,
+            cube_face: 0,
         }
     }
 }

@@ -58,6 +58,8 @@ pub struct CasterPlan {
     pub lookup: Vec4,
     /// The view's light (clusters facing away from it are not drawn).
     pub light: Viewpoint,
+    /// Side in texels of the view's square (at its layer's origin).
+    pub size: u32,
 }
 
 impl Default for CasterPlan {
@@ -74,6 +76,7 @@ impl Default for CasterPlan {
             },
             lookup: Vec4::new(1.0, 1.0, -1.0, -1.0),
             light: Viewpoint::Along(Vec3::NEG_Y),
+            size: 1,
         }
     }
 }
@@ -91,6 +94,7 @@ pub fn plan_casters(
 ) -> CasterPlan {
     let mut plan = CasterPlan {
         light,
+        size,
         ..CasterPlan::default()
     };
     let mut ndc = [
@@ -386,7 +390,15 @@ impl ShadowPass {
             unsafe {
                 d.cmd_begin_rendering(cmd, &rendering);
                 if !casters.draws.is_empty() {
-                    set_viewport(&self.ctx, cmd, map.extent);
+                    let side = casters.size.min(map.extent.width);
+                    set_viewport(
+                        &self.ctx,
+                        cmd,
+                        vk::Extent2D {
+                            width: side,
+                            height: side,
+                        },
+                    );
                     d.cmd_set_scissor(cmd, 0, &[area]);
                     d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
                     // Opaque casters first, with the depth-only pipeline; then the alpha-masked

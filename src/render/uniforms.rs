@@ -38,7 +38,8 @@ pub struct ShadowViewUniform {
     /// caster (lit without reading the map; the texels there are not cleared).
     pub rect: Vec4,
     /// x view depth where the cascade ends (the last: f32::MAX), y where blending into the next
-    /// starts, z world size of a texel (directional) or per unit distance (spot, point face).
+    /// starts, z world size of a texel (directional) or per unit distance (spot, point face), w
+    /// its side in texels (the square at the layer's origin it fills).
     pub cascade: Vec4,
 }
 
