@@ -120,8 +120,10 @@ struct Material {
     // occlusion is the red channel of the metallic-roughness texture, packed at upload as glTF's
     // ORM layout), w: 1 if unlit
     params: vec4<f32>,
-    // x: alpha cutoff (masked materials; 0 = opaque)
-    extra: vec4<f32>,    // KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
+    // x: alpha cutoff of the camera pass (masked materials; 0 = none), y: alpha cutoff of the
+    // shadow pass (masked: the same; blended: 0.5; 0 = opaque caster)
+    extra: vec4<f32>,
+    // KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
     // u' = dot(uv[2i].xyz, (u, v, 1)), v' = dot(uv[2i + 1].xyz, (u, v, 1)).
     uv: array<vec4<f32>, 8>,
 }
@@ -358,6 +360,14 @@ fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0)
 // The picked primitive's tint (pc.normal_y.w = 1), none otherwise: one mix per fragment.
 fn highlight(c: vec3<f32>) -> vec3<f32> {
     return mix(c, vec3<f32>(1.0, 0.35, 0.0), 0.5 * pc.normal_y.w);
+}
+
+// Blended materials: the lit colour with the base colour's alpha, blended over what lies behind
+// (src-alpha, one-minus-src-alpha; no depth write).
+@fragment
+fn fs_blend(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let base = base_color(in.uv);
+    return vec4<f32>(highlight(shade(in, front_facing, base).color), clamp(base.a, 0.0, 1.0));
 }
 
 @fragment

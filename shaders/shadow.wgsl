@@ -20,8 +20,9 @@ struct Material {
     base_color: vec4<f32>,
     emissive: vec4<f32>,
     params: vec4<f32>,
-    // x: alpha cutoff
-    extra: vec4<f32>,    // KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
+    // y: alpha cutoff of the shadow pass (masked: the material's; blended: 0.5)
+    extra: vec4<f32>,
+    // KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
     // u' = dot(uv[2i].xyz, (u, v, 1)), v' = dot(uv[2i + 1].xyz, (u, v, 1)).
     uv: array<vec4<f32>, 8>,
 }
@@ -57,7 +58,7 @@ fn vs_masked(@location(0) position: vec3<f32>, @location(2) uv: vec2<f32>) -> Ma
 @fragment
 fn fs_masked(in: MaskedOut) {
     let alpha = material.base_color.a * textureSample(base_color_tex, base_color_sampler, slot_uv(0u, in.uv)).a;
-    if alpha < material.extra.x {
+    if alpha < material.extra.y {
         discard;
     }
 }

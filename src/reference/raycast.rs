@@ -8,7 +8,7 @@ use crate::math::ray::Ray;
 use crate::render::frame::FramePlan;
 use crate::scene::{
     blinn_phong_params, shade_blinn_phong, AlphaMode, Filter, LightKind, Sampler, Scene, Texture,
-    TextureRef,
+    TextureRef, BLEND_SHADOW_CUTOFF,
 };
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
@@ -60,6 +60,8 @@ pub struct ReferenceFrame {
 
 /// cos 1°: a surface whose interpolated normal leaves the face normal by more is curved.
 const CURVED_COS: f32 = 0.999_847_7;
+/// Most blended surfaces one primary ray composites (deeper ones are taken as opaque).
+const MAX_BLEND_LAYERS: u32 = 8;
 
 /// What a probe ray found.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -298,27 +300,48 @@ impl<'a> ReferenceScene<'a> {
             &Ray::new(origin, dir),
             self.eps,
             dist - self.eps,
-            &|h: &Hit| self.opaque_at(h),
+            &|h: &Hit| self.stops(h, true),
         )
     }
 
-    /// The nearest surface along a primary ray (alpha-masked texels let it through).
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+    /// The nearest surface along a primary ray from `t_min` (alpha-masked texels let it
+    /// through).
+    fn intersect_from(&self, ray: &Ray, t_min: f32) -> Option<Hit> {
         self.bvh
-            .intersect_where(ray, 0.0, f32::INFINITY, &|h: &Hit| self.opaque_at(h))
+            .intersect_where(ray, t_min, f32::INFINITY, &|h: &Hit| self.stops(h, false))
     }
 
-    /// Whether a hit stops rays: always, except on an alpha-masked material where the base
-    /// colour's alpha (factor × texture, bilinear on mip 0 as everywhere here) is below the
-    /// cutoff, which is where the GPU's masked pipelines discard (camera and shadow pass alike).
-    fn opaque_at(&self, h: &Hit) -> bool {
+    /// The nearest surface along a primary ray.
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_from(ray, 0.0)
+    }
+
+    /// Whether a hit stops a primary ray or (`shadow`) a shadow ray: always, except where the
+    /// base colour's alpha (factor × texture, bilinear on mip 0 as everywhere here) is below the
+    /// cutoff of an alpha-masked material (where the GPU's masked pipelines discard, camera and
+    /// shadow pass alike), and, for shadow rays, below `BLEND_SHADOW_CUTOFF` on a blended one.
+    fn stops(&self, h: &Hit, shadow: bool) -> bool {
+        let cutoff = match self.material_of(h).map(|m| m.alpha_mode) {
+            Some(AlphaMode::Mask(c)) => c,
+            Some(AlphaMode::Blend) if shadow => BLEND_SHADOW_CUTOFF,
+            _ => return true,
+        };
+        self.alpha_at(h) >= cutoff
+    }
+
+    /// The material of the triangle hit (None: the default material).
+    fn material_of(&self, h: &Hit) -> Option<&crate::scene::Material> {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        self.scene.materials.get(prim.material)
+    }
+
+    /// Base-colour alpha (factor × texture) at hit `h`.
+    fn alpha_at(&self, h: &Hit) -> f32 {
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
         let Some(mat) = self.scene.materials.get(prim.material) else {
-            return true;
-        };
-        let AlphaMode::Mask(cutoff) = mat.alpha_mode else {
-            return true;
+            return 1.0;
         };
         let i = |k: u32| prim.indices[(r.first + k) as usize] as usize;
         let uv = if prim.uvs.is_empty() {
@@ -327,7 +350,57 @@ impl<'a> ReferenceScene<'a> {
             prim.uvs[i(0)] * (1.0 - h.u - h.v) + prim.uvs[i(1)] * h.u + prim.uvs[i(2)] * h.v
         };
         let tex = mat.base_color_texture;
-        mat.base_color.w * self.sample(tex, uv, true, Vec4::ONE).w >= cutoff
+        mat.base_color.w * self.sample(tex, uv, true, Vec4::ONE).w
+    }
+
+    /// The linear colour seen along `ray` beyond `t_min`: the first surface's shading, and where
+    /// it is blended, that over what lies behind it (up to `MAX_BLEND_LAYERS` blended surfaces);
+    /// the clear colour where nothing is hit.
+    fn radiance(
+        &self,
+        plan: &FramePlan,
+        ray: &Ray,
+        t_min: f32,
+        ambient: Vec3,
+        layers: u32,
+    ) -> Vec3 {
+        let c = crate::render::core::CLEAR_COLOR;
+        let Some(h) = self.intersect_from(ray, t_min) else {
+            return Vec3::new(c[0], c[1], c[2]);
+        };
+        let (_, rgb) = self.shade(plan, ray, &h, ambient);
+        self.blend_behind(plan, ray, &h, rgb, ambient, layers)
+    }
+
+    /// `rgb`, the shading of hit `h`, blended over what lies behind it when its material is
+    /// blended (the GPU's over operator: a·rgb + (1 − a)·behind).
+    fn blend_behind(
+        &self,
+        plan: &FramePlan,
+        ray: &Ray,
+        h: &Hit,
+        rgb: Vec3,
+        ambient: Vec3,
+        layers: u32,
+    ) -> Vec3 {
+        if layers >= MAX_BLEND_LAYERS
+            || self.material_of(h).map(|m| m.alpha_mode) != Some(AlphaMode::Blend)
+        {
+            return rgb;
+        }
+        let a = self.alpha_at(h).clamp(0.0, 1.0);
+        if a >= 1.0 {
+            return rgb;
+        }
+        // Past this surface: a relative step so that the same triangle is not hit again.
+        let behind = self.radiance(
+            plan,
+            ray,
+            h.t * (1.0 + 1e-5) + self.eps,
+            ambient,
+            layers + 1,
+        );
+        rgb * a + behind * (1.0 - a)
     }
 
     /// What lies under image position (`x`, `y`) (pixel units, centres at +0.5) of `plan`'s
@@ -461,6 +534,7 @@ impl<'a> ReferenceScene<'a> {
                     None => (None, f32::INFINITY, background, false),
                     Some(h) => {
                         let (vis, rgb) = self.shade(plan, &ray, &h, ambient);
+                        let rgb = self.blend_behind(plan, &ray, &h, rgb, ambient, 0);
                         let (ng, n) = self.hit_normals(&h);
                         (
                             Some(vis),

@@ -1,9 +1,9 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
-use super::gpu_scene::{flat_hides_nothing, vertex_layout, Draw, GpuScene, Viewpoint};
+use super::gpu_scene::{flat_hides_nothing, vertex_layout, AlphaDraw, Draw, GpuScene, Viewpoint};
 use super::pipeline::{
-    create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
 };
 use super::uniforms::FrameUniform;
 use crate::gpu::context::{Context, GpuError, VkCheck};
@@ -72,7 +72,7 @@ impl CameraPass {
             depth_clamp: false,
             depth_bias: false,
             depth_test: false,
-            additive: false,
+            blend: ColorBlend::Off,
         };
         let map_pipeline = create_pipeline(ctx, &desc)?;
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, frame_layout, slots)?;
@@ -137,9 +137,9 @@ impl CameraPass {
         // Modules first (cheap), then the missing pipelines compiled in parallel: on lavapipe
         // each is an LLVM compile of its shaders, the largest part of a cold first frame.
         let mut missing: Vec<(usize, Entry, vk::ShaderModule)> = Vec::new();
-        for &(material_bits, masked) in &scene.pipeline_keys {
+        for &(material_bits, alpha) in &scene.pipeline_keys {
             let variant = material_bits | frame_bits;
-            let entry = Entry::of(masked, debug_view);
+            let entry = Entry::of(alpha, debug_view);
             if self.pipelines.contains_key(&(variant, entry))
                 || missing.iter().any(|m| (m.0, m.1) == (variant, entry))
             {
@@ -304,7 +304,7 @@ impl CameraPass {
                 let mut bound_pipeline = vk::Pipeline::null();
                 for dr in draw_order(scene, cull) {
                     // Created by `ensure_pipelines` for this frame's bits.
-                    let entry = Entry::of(dr.masked, cull.debug_view);
+                    let entry = Entry::of(dr.alpha, cull.debug_view);
                     let pipeline = self.pipelines[&(dr.material_bits | cull.frame_bits, entry)];
                     if pipeline != bound_pipeline {
                         d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
@@ -347,9 +347,10 @@ impl CameraPass {
 /// The draws the camera can see (unless culling is off), opaque ones first and front to back
 /// (nearest bounds first, so llvmpipe's early depth test rejects more hidden fragments before
 /// shading; flat draws that hide nothing from the eye, such as the ground, after the others),
-/// then the alpha-masked ones.
+/// then the alpha-masked ones, then the blended ones back to front (farthest bounds centre
+/// first: each is blended over everything behind it).
 fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
-    let mut v: Vec<((bool, bool), f32, &Draw)> = scene
+    let mut v: Vec<((AlphaDraw, bool), f32, &Draw)> = scene
         .draws
         .iter()
         .filter(|dr| {
@@ -362,8 +363,12 @@ fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
             let hides_nothing = dr.world_plane.is_some_and(|pl| {
                 flat_hides_nothing(pl, Viewpoint::Eye(cull.eye.0), &scene.bounds)
             });
-            let key = (dr.masked, hides_nothing);
-            (key, nearest.distance_squared(cull.eye.0), dr)
+            let key = (dr.alpha, hides_nothing && dr.alpha != AlphaDraw::Blended);
+            let distance = match dr.alpha {
+                AlphaDraw::Blended => -dr.world_bounds.center().distance_squared(cull.eye.0),
+                _ => nearest.distance_squared(cull.eye.0),
+            };
+            (key, distance, dr)
         })
         .collect();
     v.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
@@ -408,6 +413,7 @@ fn scene_pipeline(
                 match entry {
                     Entry::Opaque => sh::ENTRY_FS_MAIN,
                     Entry::Masked => sh::ENTRY_FS_MASKED,
+                    Entry::Blended => sh::ENTRY_FS_BLEND,
                     Entry::Debug | Entry::Overdraw => sh::ENTRY_FS_DEBUG,
                 },
             )),
@@ -418,7 +424,11 @@ fn scene_pipeline(
             depth_clamp: false,
             depth_bias: false,
             depth_test: entry != Entry::Overdraw,
-            additive: entry == Entry::Overdraw,
+            blend: match entry {
+                Entry::Overdraw => ColorBlend::Additive,
+                Entry::Blended => ColorBlend::Over,
+                _ => ColorBlend::Off,
+            },
         },
     )
 }
@@ -434,15 +444,19 @@ pub enum Entry {
     Debug,
     /// `fs_debug` with additive blending and no depth test: the overdraw view.
     Overdraw,
+    /// `fs_blend`: blended materials, lit image, blended over (no depth write).
+    Blended,
 }
 
 impl Entry {
-    /// The entry point for a draw of a masked or opaque material in a lit or debug view.
-    pub fn of(masked: bool, debug_view: Option<Entry>) -> Entry {
-        match (debug_view, masked) {
+    /// The entry point for a draw of a material treating alpha as `alpha` in a lit or debug view
+    /// (debug views draw blended materials as opaque surfaces, like the reference's primary rays).
+    pub fn of(alpha: AlphaDraw, debug_view: Option<Entry>) -> Entry {
+        match (debug_view, alpha) {
             (Some(e), _) => e,
-            (None, true) => Entry::Masked,
-            (None, false) => Entry::Opaque,
+            (None, AlphaDraw::Masked) => Entry::Masked,
+            (None, AlphaDraw::Blended) => Entry::Blended,
+            (None, AlphaDraw::Opaque) => Entry::Opaque,
         }
     }
 }

@@ -10,7 +10,7 @@ use crate::gpu::{Buffer, Image};
 use crate::math::Aabb;
 use crate::scene::clusters::{self, Cluster};
 use crate::scene::topology::{is_closed, plane_of};
-use crate::scene::{AlphaMode, Scene};
+use crate::scene::{AlphaMode, Scene, BLEND_SHADOW_CUTOFF};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
@@ -143,6 +143,25 @@ struct PrimitiveRange {
     clusters: (u32, u32),
 }
 
+/// How a draw's material treats alpha.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum AlphaDraw {
+    /// Alpha ignored: the opaque pipeline (no discard), depth-only casters.
+    Opaque,
+    /// Discard below the cutoff (camera and shadow pass).
+    Masked,
+    /// Blended over what lies behind, after the others, back to front; casts where alpha ≥
+    /// `BLEND_SHADOW_CUTOFF`.
+    Blended,
+}
+
+impl AlphaDraw {
+    /// Whether the shadow pass tests the draw's alpha (the masked depth pipeline).
+    pub fn tests_alpha_in_shadow(self) -> bool {
+        self != AlphaDraw::Opaque
+    }
+}
+
 /// One indexed draw (a primitive of an instance).
 #[derive(Clone, Copy, Debug)]
 pub struct Draw {
@@ -172,8 +191,9 @@ pub struct Draw {
     pub double_sided: bool,
     /// The transform mirrors (negative determinant): its triangles wind clockwise on screen.
     pub mirrored: bool,
-    /// The material is alpha-masked (drawn with the discarding pipeline).
-    pub masked: bool,
+    /// How the material treats alpha (which camera pipeline draws it, and whether the shadow
+    /// pass tests alpha).
+    pub alpha: AlphaDraw,
     /// The material's shader variant bits (`material_variant_bits`).
     pub material_bits: usize,
     /// The primitive is closed and consistently wound (`scene::topology::is_closed`): seen from
@@ -298,9 +318,9 @@ pub struct GpuScene {
     pub triangles: usize,
     /// Whether draws outside the camera's view are skipped (`SceneOptions::culling`).
     pub frustum_culling: bool,
-    /// The distinct (material variant bits, alpha-masked) pairs of the draws: the camera
+    /// The distinct (material variant bits, alpha treatment) pairs of the draws: the camera
     /// pipelines the scene needs per frame variant.
-    pub pipeline_keys: Vec<(usize, bool)>,
+    pub pipeline_keys: Vec<(usize, AlphaDraw)>,
     pool: vk::DescriptorPool,
     /// Destroyed after the pool (fields drop after `Drop::drop`).
     _samplers: SamplerCache,
@@ -484,13 +504,17 @@ impl GpuScene {
                     double_sided: mat.is_some_and(|m| m.double_sided),
                     mirrored: glam::Mat3::from_mat4(world_from_model).determinant() < 0.0,
                     closed: r.closed,
-                    masked: mat.is_some_and(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
+                    alpha: match mat.map(|m| m.alpha_mode) {
+                        Some(AlphaMode::Mask(_)) => AlphaDraw::Masked,
+                        Some(AlphaMode::Blend) => AlphaDraw::Blended,
+                        _ => AlphaDraw::Opaque,
+                    },
                     material_bits: mat.map_or(0, material_variant_bits),
                 });
             }
         }
-        let mut pipeline_keys: Vec<(usize, bool)> =
-            draws.iter().map(|d| (d.material_bits, d.masked)).collect();
+        let mut pipeline_keys: Vec<(usize, AlphaDraw)> =
+            draws.iter().map(|d| (d.material_bits, d.alpha)).collect();
         pipeline_keys.sort_unstable();
         pipeline_keys.dedup();
         let vb = vk::BufferUsageFlags::VERTEX_BUFFER;
@@ -560,16 +584,11 @@ impl GpuScene {
                     },
                     m.unlit as u32 as f32,
                 ),
-                extra: Vec4::new(
-                    if let AlphaMode::Mask(c) = m.alpha_mode {
-                        c.max(1e-6)
-                    } else {
-                        0.0
-                    },
-                    0.0,
-                    0.0,
-                    0.0,
-                ),
+                extra: match m.alpha_mode {
+                    AlphaMode::Mask(c) => Vec4::new(c.max(1e-6), c.max(1e-6), 0.0, 0.0),
+                    AlphaMode::Blend => Vec4::new(0.0, BLEND_SHADOW_CUTOFF, 0.0, 0.0),
+                    AlphaMode::Opaque => Vec4::ZERO,
+                },
                 uv: uv_rows([
                     m.base_color_texture,
                     m.normal_texture,

@@ -28,8 +28,20 @@ pub struct PipelineDesc<'a> {
     pub depth_bias: bool,
     /// Depth test and write (off for full-screen passes).
     pub depth_test: bool,
-    /// Additive colour blending (ONE + ONE; the overdraw view).
-    pub additive: bool,
+    /// Colour blending.
+    pub blend: ColorBlend,
+}
+
+/// How a pipeline's colour output combines with the attachment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorBlend {
+    /// Replace.
+    Off,
+    /// ONE + ONE (the overdraw view).
+    Additive,
+    /// Over: SRC_ALPHA, ONE_MINUS_SRC_ALPHA (blended materials); the pipeline tests depth but
+    /// does not write it.
+    Over,
 }
 
 /// Creates a graphics pipeline: triangle lists, reversed-z depth test (GREATER, writes on),
@@ -66,18 +78,31 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .rasterization_samples(vk::SampleCountFlags::TYPE_1);
     let depth = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(d.depth_test)
-        .depth_write_enable(d.depth_test)
+        .depth_write_enable(d.depth_test && d.blend != ColorBlend::Over)
         .depth_compare_op(vk::CompareOp::GREATER);
     let mut blend_attachment = vk::PipelineColorBlendAttachmentState::default()
         .color_write_mask(vk::ColorComponentFlags::RGBA);
-    if d.additive {
+    let factors = match d.blend {
+        ColorBlend::Off => None,
+        ColorBlend::Additive => Some((vk::BlendFactor::ONE, vk::BlendFactor::ONE)),
+        ColorBlend::Over => Some((
+            vk::BlendFactor::SRC_ALPHA,
+            vk::BlendFactor::ONE_MINUS_SRC_ALPHA,
+        )),
+    };
+    if let Some((src, dst)) = factors {
+        // The target's alpha stays opaque (1 from the clear; ONE, ONE_MINUS_SRC_ALPHA keeps it).
         blend_attachment = blend_attachment
             .blend_enable(true)
-            .src_color_blend_factor(vk::BlendFactor::ONE)
-            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .src_color_blend_factor(src)
+            .dst_color_blend_factor(dst)
             .color_blend_op(vk::BlendOp::ADD)
             .src_alpha_blend_factor(vk::BlendFactor::ONE)
-            .dst_alpha_blend_factor(vk::BlendFactor::ZERO)
+            .dst_alpha_blend_factor(if d.blend == ColorBlend::Over {
+                vk::BlendFactor::ONE_MINUS_SRC_ALPHA
+            } else {
+                vk::BlendFactor::ZERO
+            })
             .alpha_blend_op(vk::BlendOp::ADD);
     }
     let blend_attachments = [blend_attachment];

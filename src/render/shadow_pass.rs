@@ -4,7 +4,7 @@
 use super::core::Attachment;
 use super::gpu_scene::{flat_hides_nothing, vertex_layout, GpuScene, Viewpoint};
 use super::pipeline::{
-    create_layout, create_pipeline, depth_clear_attachment, set_viewport, PipelineDesc,
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
 };
 use super::settings::{ShadowFormat, ShadowSettings};
 use super::uniforms::ShadowImmediates;
@@ -208,7 +208,7 @@ fn depth_pipeline(
             depth_clamp: true,
             depth_bias: true,
             depth_test: true,
-            additive: false,
+            blend: ColorBlend::Off,
         },
     )
 }
@@ -295,7 +295,7 @@ impl ShadowPass {
         format: ShadowFormat,
     ) -> Result<(), GpuError> {
         let fmt = vk_format(format);
-        if !scene.draws.iter().any(|d| d.masked)
+        if !scene.draws.iter().any(|d| d.alpha.tests_alpha_in_shadow())
             || self
                 .masked
                 .as_ref()
@@ -412,7 +412,7 @@ impl ShadowPass {
                         };
                         let mut bound = false;
                         for dr in casters.draws.iter().map(|&i| &scene.draws[i]) {
-                            if dr.masked != masked {
+                            if dr.alpha.tests_alpha_in_shadow() != masked {
                                 continue;
                             }
                             if !bound {

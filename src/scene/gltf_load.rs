@@ -325,13 +325,13 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             unlit: m.unlit(),
         };
         if mat.alpha_mode == AlphaMode::Blend {
-            mat.alpha_mode = AlphaMode::Opaque;
             let i = m.index().unwrap_or(0);
             scene.warn(
                 "MATERIAL_ALPHA_BLEND",
                 format!("/materials/{i}"),
                 format!(
-                    "material {i} '{}': alpha blending not supported yet, drawn opaque",
+                    "material {i} '{}': alpha-blended, sorted per draw (not per triangle), \
+                     casts where alpha >= 0.5",
                     mat.name
                 ),
             );

@@ -51,9 +51,15 @@ pub enum AlphaMode {
     Opaque,
     /// Fragments with alpha below the cutoff are discarded.
     Mask(f32),
-    /// Blended (drawn as opaque for now, with a warning).
+    /// Blended over what lies behind: drawn after the opaque and masked draws, sorted back to
+    /// front per draw, without depth writes; casts a shadow where alpha ≥
+    /// [`BLEND_SHADOW_CUTOFF`].
     Blend,
 }
+
+/// A blended material casts a shadow where its alpha is at least this (a mask at 0.5: a
+/// half-transparent surface is treated as a full caster or none, never a partial one).
+pub const BLEND_SHADOW_CUTOFF: f32 = 0.5;
 
 /// A reference to a texture and how it is sampled.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -79,8 +79,8 @@ pub const FINDING_CODES: &[(&str, &str, &str)] = &[
     ),
     (
         "MATERIAL_ALPHA_BLEND",
-        "warning",
-        "alpha blending is drawn opaque",
+        "info",
+        "alpha-blended: sorted back to front per draw, casts where alpha >= 0.5",
     ),
     (
         "MATERIAL_OCCLUSION_IGNORED",
