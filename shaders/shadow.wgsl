@@ -57,7 +57,10 @@ fn vs_masked(@location(0) position: vec3<f32>, @location(2) uv: vec2<f32>) -> Ma
 
 @fragment
 fn fs_masked(in: MaskedOut) {
-    let alpha = material.base_color.a * textureSample(base_color_tex, base_color_sampler, slot_uv(0u, in.uv)).a;
+    // Mip 0, as the reference's shadow rays read it: a shadow texel's footprint on the caster has
+    // nothing to do with the camera's, and a mip averaged across the cutoff would grow or eat the
+    // pattern (FlightHelmet's lenses: alpha 0.14-0.74 around the 0.5 cutoff).
+    let alpha = material.base_color.a * textureSampleLevel(base_color_tex, base_color_sampler, slot_uv(0u, in.uv), 0.0).a;
     if alpha < material.extra.y {
         discard;
     }
