@@ -74,6 +74,7 @@ pub enum LoadError {
 
 /// Extensions that may appear in `extensionsRequired`.
 const SUPPORTED_REQUIRED: &[&str] = &[
+    "KHR_materials_emissive_strength",
     "KHR_materials_unlit",
     "KHR_lights_punctual",
     "KHR_texture_transform",
@@ -302,7 +303,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 )
             }),
             normal_scale: m.normal_texture().map(|t| t.scale()).unwrap_or(1.0),
-            emissive: Vec3::from_array(m.emissive_factor()),
+            // KHR_materials_emissive_strength scales the factor (finite, >= 0; else 1).
+            emissive: Vec3::from_array(m.emissive_factor())
+                * m.emissive_strength()
+                    .filter(|s| s.is_finite() && *s >= 0.0)
+                    .unwrap_or(1.0),
             emissive_texture: m.emissive_texture().and_then(info_ref),
             occlusion_texture: m.occlusion_texture().and_then(|t| {
                 tex_ref(

@@ -24,6 +24,7 @@ pub const SCHEMA: &str = "umbra-inspect/1";
 /// Extensions umbra reads (others are ignored; required ones it does not read refuse the file).
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
     "KHR_materials_unlit",
     "KHR_texture_transform",
 ];
