@@ -165,6 +165,8 @@ struct VsIn {
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) tangent: vec4<f32>,
+    // COLOR_0 (white without one), multiplying the base colour.
+    @location(4) color: vec4<f32>,
 }
 
 struct VsOut {
@@ -173,6 +175,7 @@ struct VsOut {
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) tangent: vec4<f32>,
+    @location(4) color: vec4<f32>,
 }
 
 @vertex
@@ -187,6 +190,7 @@ fn vs_main(v: VsIn) -> VsOut {
     // A mirroring transform flips the bitangent.
     out.tangent = vec4<f32>(m3 * v.tangent.xyz, v.tangent.w * pc.normal_x.w);
     out.uv = v.uv;
+    out.color = v.color;
     return out;
 }
 
@@ -337,9 +341,9 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(hi, lo, c <= vec3<f32>(0.04045));
 }
 
-// The material's base colour at `uv`.
-fn base_color(uv: vec2<f32>) -> vec4<f32> {
-    var base = material.base_color;
+// The material's base colour at `uv`, times the vertex colour `color`.
+fn base_color(uv: vec2<f32>, color: vec4<f32>) -> vec4<f32> {
+    var base = material.base_color * color;
     if HAS_BASE_TEX {
         base *= textureSample(base_color_tex, base_color_sampler, slot_uv(0u, uv));
     }
@@ -354,7 +358,7 @@ fn base_color(uv: vec2<f32>) -> vec4<f32> {
 // - fs_debug, the shadow-visibility and normals views, for every material.
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    return vec4<f32>(highlight(shade(in, front_facing, base_color(in.uv)).color), 1.0);
+    return vec4<f32>(highlight(shade(in, front_facing, base_color(in.uv, in.color)).color), 1.0);
 }
 
 // The picked primitive's tint (pc.normal_y.w = 1), none otherwise: one mix per fragment.
@@ -366,13 +370,13 @@ fn highlight(c: vec3<f32>) -> vec3<f32> {
 // (src-alpha, one-minus-src-alpha; no depth write).
 @fragment
 fn fs_blend(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    let base = base_color(in.uv);
+    let base = base_color(in.uv, in.color);
     return vec4<f32>(highlight(shade(in, front_facing, base).color), clamp(base.a, 0.0, 1.0));
 }
 
 @fragment
 fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    let base = base_color(in.uv);
+    let base = base_color(in.uv, in.color);
     if base.a < material.extra.x {
         discard;
     }
@@ -397,7 +401,7 @@ fn heat(t: f32) -> vec3<f32> {
 
 @fragment
 fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    let base = base_color(in.uv);
+    let base = base_color(in.uv, in.color);
     if material.extra.x > 0.0 && base.a < material.extra.x {
         discard;
     }

@@ -45,13 +45,20 @@ fn vs_main(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
 struct MaskedOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
+    @location(1) alpha: f32,
 }
 
 @vertex
-fn vs_masked(@location(0) position: vec3<f32>, @location(2) uv: vec2<f32>) -> MaskedOut {
+fn vs_masked(
+    @location(0) position: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(4) color: vec4<f32>,
+) -> MaskedOut {
     var out: MaskedOut;
     out.clip = pc.light_clip_from_world * (pc.world_from_model * vec4<f32>(position, 1.0));
     out.uv = uv;
+    // COLOR_0's alpha multiplies the base colour's, as in the camera pass.
+    out.alpha = color.a;
     return out;
 }
 
@@ -60,7 +67,7 @@ fn fs_masked(in: MaskedOut) {
     // Mip 0, as the reference's shadow rays read it: a shadow texel's footprint on the caster has
     // nothing to do with the camera's, and a mip averaged across the cutoff would grow or eat the
     // pattern (FlightHelmet's lenses: alpha 0.14-0.74 around the 0.5 cutoff).
-    let alpha = material.base_color.a * textureSampleLevel(base_color_tex, base_color_sampler, slot_uv(0u, in.uv), 0.0).a;
+    let alpha = in.alpha * material.base_color.a * textureSampleLevel(base_color_tex, base_color_sampler, slot_uv(0u, in.uv), 0.0).a;
     if alpha < material.extra.y {
         discard;
     }

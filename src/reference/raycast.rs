@@ -349,8 +349,11 @@ impl<'a> ReferenceScene<'a> {
         } else {
             prim.uvs[i(0)] * (1.0 - h.u - h.v) + prim.uvs[i(1)] * h.u + prim.uvs[i(2)] * h.v
         };
+        let vertex_alpha = prim.color(i(0)).w * (1.0 - h.u - h.v)
+            + prim.color(i(1)).w * h.u
+            + prim.color(i(2)).w * h.v;
         let tex = mat.base_color_texture;
-        mat.base_color.w * self.sample(tex, uv, true, Vec4::ONE).w
+        vertex_alpha * mat.base_color.w * self.sample(tex, uv, true, Vec4::ONE).w
     }
 
     /// The linear colour seen along `ray` beyond `t_min`: the first surface's shading, and where
@@ -579,7 +582,11 @@ impl<'a> ReferenceScene<'a> {
         let (ng, mut n_geo) = self.hit_normals(h);
         let uv = prim.uvs[idx[0]] * w.x + prim.uvs[idx[1]] * w.y + prim.uvs[idx[2]] * w.z;
         let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];
-        let base = mat.base_color * self.sample(mat.base_color_texture, uv, true, Vec4::ONE);
+        let vertex_color =
+            prim.color(idx[0]) * w.x + prim.color(idx[1]) * w.y + prim.color(idx[2]) * w.z;
+        let base = mat.base_color
+            * vertex_color
+            * self.sample(mat.base_color_texture, uv, true, Vec4::ONE);
         let mut n = n_geo;
         if mat.normal_texture.is_some() && !prim.tangents.is_empty() {
             let t4 = prim.tangents[idx[0]] * w.x

@@ -28,6 +28,8 @@ pub struct VertexAttributes {
     pub uv: [f32; 2],
     /// Tangent with bitangent sign in w.
     pub tangent: [f32; 4],
+    /// COLOR_0, linear RGBA as 16-bit unorm (white without one).
+    pub color: [u16; 4],
 }
 
 /// The texture-transform rows of a material's four slots (identity for an empty slot).
@@ -91,7 +93,7 @@ fn packed_occlusion(
 /// interleaved attributes (binding 1): locations 0 position, 1 normal, 2 uv, 3 tangent.
 pub fn vertex_layout() -> (
     [vk::VertexInputBindingDescription; 2],
-    [vk::VertexInputAttributeDescription; 4],
+    [vk::VertexInputAttributeDescription; 5],
 ) {
     let f = |location, binding, format, offset| vk::VertexInputAttributeDescription {
         location,
@@ -117,6 +119,7 @@ pub fn vertex_layout() -> (
             f(1, 1, vk::Format::R32G32B32_SFLOAT, 0),
             f(2, 1, vk::Format::R32G32_SFLOAT, 12),
             f(3, 1, vk::Format::R32G32B32A32_SFLOAT, 20),
+            f(4, 1, vk::Format::R16G16B16A16_UNORM, 36),
         ],
     )
 }
@@ -449,6 +452,10 @@ impl GpuScene {
                             .copied()
                             .unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0))
                             .to_array(),
+                        color: p
+                            .color(i)
+                            .to_array()
+                            .map(|c| (c.clamp(0.0, 1.0) * 65535.0).round() as u16),
                     });
                 }
                 // Large primitives are split into clusters (their indices reordered cluster by

@@ -179,10 +179,11 @@ fn depth_pipeline(
     masked: bool,
     format: vk::Format,
 ) -> Result<vk::Pipeline, GpuError> {
-    // Positions only, or positions and the attribute stream for TEXCOORD_0 (location 2).
+    // Positions only, or positions and the attribute stream for TEXCOORD_0 (location 2) and
+    // COLOR_0 (location 4, whose alpha multiplies the base colour's).
     let (bindings, all) = vertex_layout();
-    let attributes = [all[0], all[2]];
-    let n = if masked { 2 } else { 1 };
+    let attributes = [all[0], all[2], all[4]];
+    let (n_bindings, n_attributes) = if masked { (2, 3) } else { (1, 1) };
     create_pipeline(
         ctx,
         &PipelineDesc {
@@ -201,8 +202,8 @@ fn depth_pipeline(
                 },
             ),
             fragment: masked.then_some((module, sh::ENTRY_FS_MASKED)),
-            bindings: &bindings[..n],
-            attributes: &attributes[..n],
+            bindings: &bindings[..n_bindings],
+            attributes: &attributes[..n_attributes],
             color_format: None,
             depth_format: format,
             depth_clamp: true,

@@ -681,13 +681,30 @@ fn read_primitive(
         ),
         None => (vec![Vec2::ZERO; n], false),
     };
-    if reader.read_colors(0).is_some() {
-        scene.warn(
-            "MESH_COLORS_IGNORED",
-            at.clone(),
-            format!("{label}: vertex colours (COLOR_0) are ignored (not supported yet)"),
-        );
-    }
+    // COLOR_0 multiplies the base colour (RGB gets alpha 1); NaN reads as white.
+    let colors: Vec<Vec4> = match reader.read_colors(0) {
+        Some(c) => {
+            let c: Vec<Vec4> = c
+                .into_rgba_f32()
+                .map(|c| Vec4::from_array(c).clamp(Vec4::ZERO, Vec4::ONE))
+                .map(|c| if c.is_nan() { Vec4::ONE } else { c })
+                .collect();
+            if c.len() == n {
+                c
+            } else {
+                scene.warn(
+                    "MESH_COLORS_IGNORED",
+                    at.clone(),
+                    format!(
+                        "{label}: COLOR_0 has {} values for {n} vertices, ignored",
+                        c.len()
+                    ),
+                );
+                Vec::new()
+            }
+        }
+        None => Vec::new(),
+    };
     let material = prim.material().index().unwrap_or(default_material);
     let mut p = Primitive {
         positions,
@@ -697,6 +714,7 @@ fn read_primitive(
         indices,
         material,
         has_uvs,
+        colors,
     };
     let wants_normal_map = scene.materials[material].normal_texture.is_some();
     match reader.read_tangents() {

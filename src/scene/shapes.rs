@@ -18,6 +18,7 @@ fn prim(
         indices,
         material: 0,
         has_uvs: true,
+        colors: Vec::new(),
     }
 }
 

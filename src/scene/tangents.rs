@@ -43,6 +43,8 @@ struct Unwelded {
     normals: Vec<Vec3>,
     uvs: Vec<Vec2>,
     tangents: Vec<Vec4>,
+    /// Vertex colours (white for a primitive without): welded vertices keep theirs.
+    colors: Vec<Vec4>,
 }
 
 impl mikktspace::Geometry for Unwelded {
@@ -80,22 +82,26 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
         normals: Vec::with_capacity(n),
         uvs: Vec::with_capacity(n),
         tangents: vec![Vec4::ZERO; n],
+        colors: Vec::with_capacity(n),
     };
+    let colored = !p.colors.is_empty();
     for &i in &p.indices {
         let i = i as usize;
         g.positions.push(p.positions[i]);
         g.normals.push(p.normals[i]);
         g.uvs.push(p.uvs[i]);
+        g.colors.push(p.color(i));
     }
     let ok = mikktspace::generate_tangents(&mut g);
     if !ok {
         p.tangents = p.normals.iter().map(|n| fallback_tangent(*n)).collect();
         return false;
     }
-    // Weld identical (position, normal, uv, tangent) vertices back together.
-    let mut map: HashMap<[u32; 12], u32> = HashMap::new();
+    // Weld identical (position, normal, uv, tangent, colour) vertices back together.
+    let mut map: HashMap<[u32; 16], u32> = HashMap::new();
     let (mut pos, mut nor, mut uv, mut tan, mut idx) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut col = Vec::new();
     for k in 0..n {
         let mut t = g.tangents[k];
         if !t.is_finite() || t.truncate().length_squared() < 1e-12 {
@@ -114,12 +120,17 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
             t.y.to_bits(),
             t.z.to_bits(),
             t.w.to_bits(),
+            g.colors[k].x.to_bits(),
+            g.colors[k].y.to_bits(),
+            g.colors[k].z.to_bits(),
+            g.colors[k].w.to_bits(),
         ];
         let id = *map.entry(key).or_insert_with(|| {
             pos.push(g.positions[k]);
             nor.push(g.normals[k]);
             uv.push(g.uvs[k]);
             tan.push(t);
+            col.push(g.colors[k]);
             (pos.len() - 1) as u32
         });
         idx.push(id);
@@ -128,6 +139,7 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
     p.normals = nor;
     p.uvs = uv;
     p.tangents = tan;
+    p.colors = if colored { col } else { Vec::new() };
     p.indices = idx;
     true
 }
@@ -163,6 +175,7 @@ mod tests {
             indices: vec![0, 1, 2, 0, 2, 3],
             material: 0,
             has_uvs: true,
+            colors: Vec::new(),
         }
     }
 
@@ -182,6 +195,22 @@ mod tests {
             assert!(t.truncate().abs_diff_eq(-Vec3::X, 1e-5), "{t}");
             assert_eq!(t.w, -1.0);
         }
+    }
+
+    #[test]
+    fn welding_keeps_vertex_colours() {
+        let mut q = quad(false);
+        let corner = |p: Vec3| Vec4::new(p.x, p.y, 0.5, 1.0);
+        q.colors = q.positions.iter().map(|&p| corner(p)).collect();
+        assert!(generate_mikktspace(&mut q));
+        assert_eq!(q.colors.len(), q.positions.len());
+        for (p, c) in q.positions.iter().zip(&q.colors) {
+            assert_eq!(*c, corner(*p));
+        }
+        // Without colours, none are made up.
+        let mut q = quad(false);
+        assert!(generate_mikktspace(&mut q));
+        assert!(q.colors.is_empty());
     }
 
     #[test]

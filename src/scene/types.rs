@@ -21,6 +21,15 @@ pub struct Primitive {
     pub material: usize,
     /// Whether the source had texture coordinates.
     pub has_uvs: bool,
+    /// Vertex colours (COLOR_0, linear RGBA, multiplying the base colour); empty: white.
+    pub colors: Vec<Vec4>,
+}
+
+impl Primitive {
+    /// The vertex colour of vertex `i` (white without COLOR_0).
+    pub fn color(&self, i: usize) -> Vec4 {
+        self.colors.get(i).copied().unwrap_or(Vec4::ONE)
+    }
 }
 
 impl Primitive {

@@ -34,7 +34,7 @@ pub const FINDING_CODES: &[(&str, &str, &str)] = &[
     (
         "MESH_COLORS_IGNORED",
         "warning",
-        "vertex colours (COLOR_0) are ignored",
+        "COLOR_0 with another count than the vertices is ignored",
     ),
     (
         "MESH_NONFINITE_POSITIONS",

@@ -65,6 +65,7 @@ fn one_triangle() -> Scene {
         indices: vec![0, 1, 2],
         material: 0,
         has_uvs: true,
+        colors: Vec::new(),
     };
     add_object(
         &mut s,
