@@ -288,8 +288,9 @@ impl ShadowPass {
         Ok(true)
     }
 
-    /// Makes sure alpha-masked casters of `scene` have their pipeline (made once per scene and
-    /// map format, only for scenes with such materials).
+    /// Makes sure alpha-masked and blended casters of `scene` (whose alpha the shadow pass
+    /// tests) have their pipeline (made once per scene and map format, only for scenes with such
+    /// materials).
     pub fn ensure_masked(
         &mut self,
         scene: &GpuScene,
@@ -403,7 +404,7 @@ impl ShadowPass {
                     d.cmd_set_scissor(cmd, 0, &[area]);
                     d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
                     // Opaque casters first, with the depth-only pipeline; then the alpha-masked
-                    // ones, whose pipeline samples the base colour and discards.
+                    // and blended ones, whose pipeline samples the base colour and discards.
                     for masked in [false, true] {
                         let (pipeline, layout) = match (&self.masked, masked) {
                             (_, false) => (self.pipeline, self.layout),
