@@ -3,169 +3,24 @@
 //! GPU's shadow-visibility frame of that light (`View::shown_light`) is judged against the CPU
 //! reference's ray-cast visibility of the same light, away from 2-pixel edge bands, with a
 //! 2048² map as the issue states; and each light must have shadow in view, so that a light
-//! casting nothing would fail.
+//! casting nothing would fail. The scenes are `--synthetic room`, `sun-and-spot` and `two-suns`.
 
 mod common;
 
 use common::*;
-use glam::{Mat4, Vec3};
 use umbra::reference::{classify, PixelClass, ReferenceScene};
 use umbra::render::{Renderer, View, ViewMode};
-use umbra::scene::shapes::{add_object, colored, cuboid, plane};
-use umbra::scene::{Camera, Light, LightKind, Scene};
+use umbra::scene::synthetic::{room_scene, sun_and_spot_scene, two_suns_scene};
+use umbra::scene::Scene;
 
 const W: u32 = 320;
 const H: u32 = 240;
 /// The issue's bound for each light: misclassified ≤ 0.5 % of judged pixels.
 const BOUND: f64 = 0.005;
 
-fn boxed(s: &mut Scene, name: &str, half: Vec3, at: Vec3, rgb: Vec3) {
-    let mut m = colored(rgb, 0.8);
-    m.double_sided = true;
-    add_object(s, name, cuboid(half), m, Mat4::from_translation(at));
-}
-
-/// An 8 × 3 × 6 m room (a double-sided box seen from inside) with a table, a cabinet, a stool,
-/// a coat stand, a wall shelf and a ceiling panel, lit by one point light in the middle: their shadows fall on
-/// the floor, two walls and the ceiling, in four of the light's cube faces.
-fn room() -> Scene {
-    let mut s = Scene {
-        name: "room".into(),
-        ..Default::default()
-    };
-    boxed(
-        &mut s,
-        "room",
-        Vec3::new(4.0, 1.5, 3.0),
-        Vec3::new(0.0, 1.5, 0.0),
-        Vec3::splat(0.8),
-    );
-    let wood = Vec3::new(0.6, 0.4, 0.25);
-    boxed(
-        &mut s,
-        "table top",
-        Vec3::new(0.8, 0.04, 0.5),
-        Vec3::new(0.0, 0.75, 0.0),
-        wood,
-    );
-    for (x, z) in [(-0.7, -0.4), (0.7, -0.4), (-0.7, 0.4), (0.7, 0.4)] {
-        boxed(
-            &mut s,
-            "leg",
-            Vec3::new(0.04, 0.355, 0.04),
-            Vec3::new(x, 0.355, z),
-            wood,
-        );
-    }
-    boxed(
-        &mut s,
-        "cabinet",
-        Vec3::new(0.4, 0.9, 0.3),
-        Vec3::new(-1.5, 0.9, -2.0),
-        wood,
-    );
-    boxed(
-        &mut s,
-        "stand",
-        Vec3::new(0.1, 1.1, 0.1),
-        Vec3::new(-3.0, 1.1, 1.6),
-        wood,
-    );
-    boxed(
-        &mut s,
-        "stool",
-        Vec3::splat(0.25),
-        Vec3::new(1.6, 0.25, 1.2),
-        wood,
-    );
-    boxed(
-        &mut s,
-        "shelf",
-        Vec3::new(0.15, 0.03, 0.8),
-        Vec3::new(-3.85, 2.0, 0.5),
-        wood,
-    );
-    boxed(
-        &mut s,
-        "panel",
-        Vec3::new(0.3, 0.02, 0.3),
-        Vec3::new(0.5, 2.5, 0.5),
-        wood,
-    );
-    s.lights.push(Light {
-        kind: LightKind::Point,
-        position: Vec3::new(0.0, 1.6, 0.0),
-        direction: Vec3::NEG_Y,
-        color: Vec3::ONE,
-        intensity: 6.0,
-        casts_shadows: true,
-    });
-    s
-}
-
-fn room_view() -> View {
-    View::new(Camera::look_at(
-        Vec3::new(3.7, 2.0, 2.7),
-        Vec3::new(-2.0, 1.5, -1.5),
-        80f32.to_radians(),
-        0.05,
-    ))
-}
-
-/// A 24 m ground with a box, a post and a low wall, under `lights`.
-fn yard(lights: Vec<Light>) -> Scene {
-    let mut s = Scene {
-        name: "yard".into(),
-        ..Default::default()
-    };
-    add_object(
-        &mut s,
-        "ground",
-        plane(24.0, 1.0),
-        colored(Vec3::splat(0.8), 1.0),
-        Mat4::IDENTITY,
-    );
-    let red = Vec3::new(0.7, 0.2, 0.1);
-    boxed(&mut s, "box", Vec3::ONE, Vec3::new(0.0, 1.0, 0.0), red);
-    boxed(
-        &mut s,
-        "post",
-        Vec3::new(0.15, 1.5, 0.15),
-        Vec3::new(3.0, 1.5, -1.0),
-        red,
-    );
-    boxed(
-        &mut s,
-        "wall",
-        Vec3::new(2.0, 0.4, 0.1),
-        Vec3::new(-2.5, 0.4, 2.5),
-        red,
-    );
-    s.lights = lights;
-    s
-}
-
-fn yard_view() -> View {
-    View::new(Camera::look_at(
-        Vec3::new(4.5, 5.0, 7.0),
-        Vec3::new(0.0, 0.0, 0.5),
-        55f32.to_radians(),
-        0.1,
-    ))
-}
-
-fn spot() -> Light {
-    Light {
-        kind: LightKind::Spot {
-            inner: 0.45,
-            outer: 0.6,
-        },
-        position: Vec3::new(-3.0, 5.0, 3.0),
-        direction: (Vec3::new(0.5, 0.0, -0.5) - Vec3::new(-3.0, 5.0, 3.0)).normalize(),
-        color: Vec3::ONE,
-        intensity: 40.0,
-        casts_shadows: true,
-    }
+/// The view from a generated scene's camera 0.
+fn camera_view(s: &Scene) -> View {
+    View::new(s.cameras[0])
 }
 
 /// What one light's shadow frame scored.
@@ -264,12 +119,12 @@ fn check(s: &Score, min_shadow: f64) {
 
 #[test]
 fn a_point_light_shadows_a_closed_room_on_every_face() {
-    let scene = room();
+    let scene = room_scene();
     // 2048² faces (the issue's figure), and the default (half the 2048² map: 1024²).
-    let s = judge_with(&scene, &room_view(), 0, "room_point_2048", 2048);
+    let s = judge_with(&scene, &camera_view(&scene), 0, "room_point_2048", 2048);
     // Measured: 0 of 71,007 wrong; 4.8 % in exact shadow.
     check(&s, 0.04);
-    let s = judge(&scene, &room_view(), 0, "room_point");
+    let s = judge(&scene, &camera_view(&scene), 0, "room_point");
     // Measured: 0 of 71,007 wrong (128² faces: 28, 0.039 %).
     check(&s, 0.04);
     // Shadow lies in at least four faces (measured: +x 1,352, −x 208, +y 182, −y 1,614 px).
@@ -279,10 +134,9 @@ fn a_point_light_shadows_a_closed_room_on_every_face() {
 
 #[test]
 fn a_spot_lamp_and_the_sun_both_cast() {
-    let sun = Light::sun(Vec3::new(0.4, -1.0, 0.3), 2.0);
-    let scene = yard(vec![sun, spot()]);
+    let scene = sun_and_spot_scene();
     for light in 0..2 {
-        let s = judge(&scene, &yard_view(), light, "spot_and_sun");
+        let s = judge(&scene, &camera_view(&scene), light, "spot_and_sun");
         // Measured: 0 wrong for both; 8.3 % (sun) and 5.9 % (spot) in exact shadow.
         check(&s, 0.05);
     }
@@ -290,11 +144,9 @@ fn a_spot_lamp_and_the_sun_both_cast() {
 
 #[test]
 fn two_suns_both_cast() {
-    let a = Light::sun(Vec3::new(0.5, -1.0, 0.2), 1.2);
-    let b = Light::sun(Vec3::new(-0.7, -0.8, 0.4), 0.8);
-    let scene = yard(vec![a, b]);
+    let scene = two_suns_scene();
     for light in 0..2 {
-        let s = judge(&scene, &yard_view(), light, "two_suns");
+        let s = judge(&scene, &camera_view(&scene), light, "two_suns");
         // Measured: 0 wrong for both; 8.0 % and 6.4 % in exact shadow.
         check(&s, 0.05);
     }

@@ -146,7 +146,7 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
     } else if let Some(s) = umbra::scene::synthetic::by_name(spec) {
         s
     } else {
-        bail!("{spec}: no such file, and not demo, town, grazing, stability, double-sided or spheres:N");
+        bail!("{spec}: no such file, and not demo, town, grazing, stability, double-sided, room, sun-and-spot, two-suns or spheres:N");
     };
     for w in &s.warnings {
         print_warning(&s.name, w);
@@ -303,8 +303,9 @@ pub struct ViewArgs {
     /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided
     /// primitives), `town` (2 km across, cameras at eye height and on a roof), `grazing` (a sun 6° above the
     /// horizon over posts, spheres and crates), `stability` (a thin wall, a box, spheres and a
-    /// torus: the stability suite's scene) or `spheres:N` (an N×N grid of 1,200-triangle
-    /// spheres).
+    /// torus: the stability suite's scene), `room` (a point light in a furnished room),
+    /// `sun-and-spot` and `two-suns` (a yard where two lights cast) or `spheres:N` (an N×N grid of
+    /// 1,200-triangle spheres).
     #[arg(long)]
     pub synthetic: Option<String>,
     /// Image size WxH.
@@ -516,7 +517,7 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
         (None, None) => demo_scene(),
         (None, Some(name)) => umbra::scene::synthetic::by_name(name).ok_or_else(|| {
             anyhow!(
-                "--synthetic {name}: expected double-sided, town, grazing, stability or spheres:N with N in 1..=256"
+                "--synthetic {name}: expected double-sided, town, grazing, stability, room, sun-and-spot, two-suns or spheres:N with N in 1..=256"
             )
         })?,
     };

@@ -1,9 +1,10 @@
 //! Generated benchmark scenes: a double-sided scene shaped like the C++ Vulkan sample's
 //! (about 52k triangles in 12 primitives, every material double-sided), grids of spheres for
-//! frame time against triangle count, and a town for shadows at every distance.
+//! frame time against triangle count, a town for shadows at every distance, and scenes where
+//! several lights cast (a point light in a room, a sun with a spot lamp, two suns).
 
 use super::shapes::{add_object, colored, cuboid, plane, torus, uv_sphere};
-use super::{Camera, Light, Scene};
+use super::{Camera, Light, LightKind, Scene};
 use glam::{Mat4, Vec3};
 
 /// A ground plane and 11 spheres of 4,736 triangles (52,098 triangles, 12 primitives), every
@@ -280,10 +281,152 @@ pub fn stability_scene() -> Scene {
     s
 }
 
-/// The generated scene called `name`: `double-sided`, `town`, `grazing`, `stability` or `spheres:N`
-/// (1 ≤ N ≤ 256); `None` for any other name.
+/// A double-sided box of colour `rgb` with half extents `half` centred at `at`.
+fn boxed(s: &mut Scene, name: &str, half: Vec3, at: Vec3, rgb: Vec3) {
+    let mut m = colored(rgb, 0.8);
+    m.double_sided = true;
+    add_object(s, name, cuboid(half), m, Mat4::from_translation(at));
+}
+
+/// An 8 × 3 × 6 m room (a double-sided box seen from inside) with a table, a cabinet, a stool, a
+/// coat stand, a wall shelf and a ceiling panel, lit by one point light in the middle: their
+/// shadows fall on the floor, two walls and the ceiling, in four of the light's cube faces.
+/// Camera 0 stands in a corner.
+pub fn room_scene() -> Scene {
+    let mut s = Scene {
+        name: "room".into(),
+        ..Default::default()
+    };
+    let (wall, wood) = (Vec3::splat(0.8), Vec3::new(0.6, 0.4, 0.25));
+    boxed(
+        &mut s,
+        "room",
+        Vec3::new(4.0, 1.5, 3.0),
+        Vec3::Y * 1.5,
+        wall,
+    );
+    boxed(
+        &mut s,
+        "table top",
+        Vec3::new(0.8, 0.04, 0.5),
+        Vec3::Y * 0.75,
+        wood,
+    );
+    for (x, z) in [(-0.7, -0.4), (0.7, -0.4), (-0.7, 0.4), (0.7, 0.4)] {
+        boxed(
+            &mut s,
+            "leg",
+            Vec3::new(0.04, 0.355, 0.04),
+            Vec3::new(x, 0.355, z),
+            wood,
+        );
+    }
+    let furniture = [
+        (
+            "cabinet",
+            Vec3::new(0.4, 0.9, 0.3),
+            Vec3::new(-1.5, 0.9, -2.0),
+        ),
+        ("stand", Vec3::new(0.1, 1.1, 0.1), Vec3::new(-3.0, 1.1, 1.6)),
+        ("stool", Vec3::splat(0.25), Vec3::new(1.6, 0.25, 1.2)),
+        (
+            "shelf",
+            Vec3::new(0.15, 0.03, 0.8),
+            Vec3::new(-3.85, 2.0, 0.5),
+        ),
+        ("panel", Vec3::new(0.3, 0.02, 0.3), Vec3::new(0.5, 2.5, 0.5)),
+    ];
+    for (name, half, at) in furniture {
+        boxed(&mut s, name, half, at, wood);
+    }
+    s.lights.push(Light {
+        kind: LightKind::Point,
+        position: Vec3::new(0.0, 1.6, 0.0),
+        direction: Vec3::NEG_Y,
+        color: Vec3::ONE,
+        intensity: 6.0,
+        casts_shadows: true,
+    });
+    s.cameras.push(Camera::look_at(
+        Vec3::new(3.7, 2.0, 2.7),
+        Vec3::new(-2.0, 1.5, -1.5),
+        80f32.to_radians(),
+        0.05,
+    ));
+    s
+}
+
+/// A 24 m yard (ground, a box, a post, a low wall) under `lights`, camera 0 above a corner.
+fn yard_scene(name: &str, lights: Vec<Light>) -> Scene {
+    let mut s = Scene {
+        name: name.into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "ground",
+        plane(24.0, 1.0),
+        colored(Vec3::splat(0.8), 1.0),
+        Mat4::IDENTITY,
+    );
+    let red = Vec3::new(0.7, 0.2, 0.1);
+    boxed(&mut s, "box", Vec3::ONE, Vec3::Y, red);
+    boxed(
+        &mut s,
+        "post",
+        Vec3::new(0.15, 1.5, 0.15),
+        Vec3::new(3.0, 1.5, -1.0),
+        red,
+    );
+    boxed(
+        &mut s,
+        "wall",
+        Vec3::new(2.0, 0.4, 0.1),
+        Vec3::new(-2.5, 0.4, 2.5),
+        red,
+    );
+    s.lights = lights;
+    s.cameras.push(Camera::look_at(
+        Vec3::new(4.5, 5.0, 7.0),
+        Vec3::new(0.0, 0.0, 0.5),
+        55f32.to_radians(),
+        0.1,
+    ));
+    s
+}
+
+/// The yard under a sun (light 0) and a spot lamp aimed at the box (light 1).
+pub fn sun_and_spot_scene() -> Scene {
+    let at = Vec3::new(-3.0, 5.0, 3.0);
+    let spot = Light {
+        kind: LightKind::Spot {
+            inner: 0.45,
+            outer: 0.6,
+        },
+        position: at,
+        direction: (Vec3::new(0.5, 0.0, -0.5) - at).normalize(),
+        color: Vec3::ONE,
+        intensity: 40.0,
+        casts_shadows: true,
+    };
+    let sun = Light::sun(Vec3::new(0.4, -1.0, 0.3), 2.0);
+    yard_scene("sun and spot", vec![sun, spot])
+}
+
+/// The yard under two suns from different sides.
+pub fn two_suns_scene() -> Scene {
+    let a = Light::sun(Vec3::new(0.5, -1.0, 0.2), 1.2);
+    let b = Light::sun(Vec3::new(-0.7, -0.8, 0.4), 0.8);
+    yard_scene("two suns", vec![a, b])
+}
+
+/// The generated scene called `name`: `double-sided`, `town`, `grazing`, `stability`, `room`,
+/// `sun-and-spot`, `two-suns` or `spheres:N` (1 ≤ N ≤ 256); `None` for any other name.
 pub fn by_name(name: &str) -> Option<Scene> {
     match name {
+        "room" => Some(room_scene()),
+        "sun-and-spot" => Some(sun_and_spot_scene()),
+        "two-suns" => Some(two_suns_scene()),
         "double-sided" => Some(double_sided_scene()),
         "town" => Some(town_scene()),
         "grazing" => Some(grazing_scene()),
