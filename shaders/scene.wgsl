@@ -129,8 +129,9 @@ struct Material {
 }
 
 // Texture coordinates of slot i (0 base colour, 1 normal, 2 metallic-roughness, 3 emissive).
-fn slot_uv(i: u32, uv: vec2<f32>) -> vec2<f32> {
-    let p = vec3<f32>(uv, 1.0);
+// `uvs` holds TEXCOORD_0 (xy) and TEXCOORD_1 (zw); uv[2i].w says which set the slot reads.
+fn slot_uv(i: u32, uvs: vec4<f32>) -> vec2<f32> {
+    let p = vec3<f32>(select(uvs.xy, uvs.zw, material.uv[2u * i].w > 0.5), 1.0);
     return vec2<f32>(dot(material.uv[2u * i].xyz, p), dot(material.uv[2u * i + 1u].xyz, p));
 }
 
@@ -167,13 +168,16 @@ struct VsIn {
     @location(3) tangent: vec4<f32>,
     // COLOR_0 (white without one), multiplying the base colour.
     @location(4) color: vec4<f32>,
+    // TEXCOORD_1 (TEXCOORD_0 without one).
+    @location(5) uv1: vec2<f32>,
 }
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world_position: vec3<f32>,
     @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
+    // xy: TEXCOORD_0, zw: TEXCOORD_1.
+    @location(2) uv: vec4<f32>,
     @location(3) tangent: vec4<f32>,
     @location(4) color: vec4<f32>,
 }
@@ -189,7 +193,7 @@ fn vs_main(v: VsIn) -> VsOut {
     let m3 = mat3x3<f32>(pc.world_from_model[0].xyz, pc.world_from_model[1].xyz, pc.world_from_model[2].xyz);
     // A mirroring transform flips the bitangent.
     out.tangent = vec4<f32>(m3 * v.tangent.xyz, v.tangent.w * pc.normal_x.w);
-    out.uv = v.uv;
+    out.uv = vec4<f32>(v.uv, v.uv1);
     out.color = v.color;
     return out;
 }
@@ -342,7 +346,7 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
 }
 
 // The material's base colour at `uv`, times the vertex colour `color`.
-fn base_color(uv: vec2<f32>, color: vec4<f32>) -> vec4<f32> {
+fn base_color(uv: vec4<f32>, color: vec4<f32>) -> vec4<f32> {
     var base = material.base_color * color;
     if HAS_BASE_TEX {
         base *= textureSample(base_color_tex, base_color_sampler, slot_uv(0u, uv));
@@ -426,7 +430,7 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
         return vec4<f32>(vec3<f32>(OVERDRAW_STEP), 1.0);
     }
     if mode == VIEW_UV_CHECKER {
-        let cell = floor(in.uv * CHECKER_CELLS);
+        let cell = floor(in.uv.xy * CHECKER_CELLS);
         let odd = (i32(cell.x) + i32(cell.y)) & 1;
         return vec4<f32>(srgb_to_linear(vec3<f32>(select(0.15, 0.85, odd == 1))), 1.0);
     }

@@ -28,8 +28,9 @@ struct Material {
 }
 
 // Texture coordinates of slot i (0 base colour, 1 normal, 2 metallic-roughness, 3 emissive).
-fn slot_uv(i: u32, uv: vec2<f32>) -> vec2<f32> {
-    let p = vec3<f32>(uv, 1.0);
+// `uvs` holds TEXCOORD_0 (xy) and TEXCOORD_1 (zw); uv[2i].w says which set the slot reads.
+fn slot_uv(i: u32, uvs: vec4<f32>) -> vec2<f32> {
+    let p = vec3<f32>(select(uvs.xy, uvs.zw, material.uv[2u * i].w > 0.5), 1.0);
     return vec2<f32>(dot(material.uv[2u * i].xyz, p), dot(material.uv[2u * i + 1u].xyz, p));
 }
 
@@ -44,7 +45,7 @@ fn vs_main(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
 
 struct MaskedOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) uv: vec2<f32>,
+    @location(0) uv: vec4<f32>,
     @location(1) alpha: f32,
 }
 
@@ -53,10 +54,11 @@ fn vs_masked(
     @location(0) position: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(4) color: vec4<f32>,
+    @location(5) uv1: vec2<f32>,
 ) -> MaskedOut {
     var out: MaskedOut;
     out.clip = pc.light_clip_from_world * (pc.world_from_model * vec4<f32>(position, 1.0));
-    out.uv = uv;
+    out.uv = vec4<f32>(uv, uv1);
     // COLOR_0's alpha multiplies the base colour's, as in the camera pass.
     out.alpha = color.a;
     return out;

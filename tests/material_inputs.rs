@@ -196,3 +196,114 @@ fn vertex_colours_multiply_the_base_colour() {
         }
     }
 }
+
+/// Three unit quads side by side, TEXCOORD_0 all zero and TEXCOORD_1 spanning each quad, textured
+/// with a 2×2 nearest-filtered checker (red, green / blue, white) read through: `texCoord` 1;
+/// `texCoord` 0 overridden to 1 by KHR_texture_transform; `texCoord` 2 (not loaded: set 0).
+fn second_set_quads() -> PathBuf {
+    let mut b = Builder::default();
+    b.use_extension("KHR_materials_unlit");
+    b.use_extension("KHR_texture_transform");
+    let mut img = image::RgbaImage::new(2, 2);
+    for (x, y, c) in [
+        (0, 0, [255, 0, 0, 255]),
+        (1, 0, [0, 255, 0, 255]),
+        (0, 1, [0, 0, 255, 255]),
+        (1, 1, [255, 255, 255, 255]),
+    ] {
+        img.put_pixel(x, y, image::Rgba(c));
+    }
+    let image = b.image(common::gltf_builder::png(&img));
+    // NEAREST magnification and minification, clamped.
+    let sampler = b.sampler(9728, 9728, 33071, 33071);
+    let tex = b.texture(image, Some(sampler));
+    let infos = [
+        json!({"index": tex, "texCoord": 1}),
+        json!({"index": tex, "texCoord": 0,
+               "extensions": {"KHR_texture_transform": {"texCoord": 1}}}),
+        json!({"index": tex, "texCoord": 2}),
+    ];
+    for (i, info) in infos.into_iter().enumerate() {
+        let x = i as f32 * 1.2;
+        let pos = b.floats(
+            &[
+                x,
+                0.0,
+                0.0,
+                x + 1.0,
+                0.0,
+                0.0,
+                x + 1.0,
+                1.0,
+                0.0,
+                x,
+                1.0,
+                0.0,
+            ],
+            3,
+            "VEC3",
+        );
+        let uv0 = b.floats(&[0.0; 8], 2, "VEC2");
+        let uv1 = b.floats(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0], 2, "VEC2");
+        let idx = b.indices(&[0, 1, 2, 0, 2, 3], common::gltf_builder::U16);
+        let mat = b.material(json!({"name": format!("set {i}"),
+                                    "extensions": {"KHR_materials_unlit": {}},
+                                    "pbrMetallicRoughness": {"baseColorTexture": info}}));
+        let mesh = b.mesh(
+            &format!("quad {i}"),
+            vec![
+                json!({"attributes": {"POSITION": pos, "TEXCOORD_0": uv0, "TEXCOORD_1": uv1},
+                         "indices": idx, "material": mat}),
+            ],
+        );
+        b.node(json!({ "mesh": mesh }), true);
+    }
+    b.write(&tmp("second_set"), "second_set", Container::Glb)
+}
+
+#[test]
+fn textures_read_the_texcoord_set_they_name() {
+    let scene = load_gltf(&second_set_quads()).unwrap();
+    let sets: Vec<u32> = scene.materials[..3]
+        .iter()
+        .map(|m| m.base_color_texture.unwrap().tex_coord)
+        .collect();
+    // texCoord 1; 0 overridden to 1 by the transform; 2 falls back to 0 with a warning.
+    assert_eq!(sets, [1, 1, 0]);
+    assert!(scene.warnings.iter().any(|w| w.code == "TEXCOORD_FALLBACK"
+        && w.pointer == "/materials/2/pbrMetallicRoughness/baseColorTexture"));
+    assert_eq!(scene.meshes[0].primitives[0].uvs1.len(), 4);
+    let ctx = context();
+    let mut r = Renderer::new(&ctx, &scene).unwrap();
+    let v = View::new(Camera::look_at(
+        Vec3::new(1.7, 0.5, 3.2),
+        Vec3::new(1.7, 0.5, 0.0),
+        60f32.to_radians(),
+        0.1,
+    ));
+    let (w, h) = (300, 120);
+    let f = r.render(&v, w, h).unwrap();
+    let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, v.ambient);
+    assert_validation_clean(&ctx);
+    save(&f.image, "texcoord_sets.png");
+    // Quads 0 and 1 show the checker through TEXCOORD_1 (v = 1 at the bottom: blue, white below,
+    // red, green above); quad 2 reads TEXCOORD_0 = 0 everywhere: red all over.
+    let red = [255u8, 0, 0];
+    let quadrants = [
+        (0.25, 0.75, red),
+        (0.75, 0.75, [0, 255, 0]),
+        (0.25, 0.25, [0, 0, 255]),
+        (0.75, 0.25, [255, 255, 255]),
+    ];
+    for q in 0..3 {
+        for (u, y, want) in quadrants {
+            let want = if q == 2 { red } else { want };
+            let p = Vec3::new(q as f32 * 1.2 + u, y, 0.0);
+            let (x, yy) = project(&f.plan.clip_from_world, p, w, h).unwrap();
+            for (name, img) in [("GPU", &f.image), ("reference", &exact.image)] {
+                let px = img.get_pixel(x as u32, yy as u32);
+                assert_eq!(&px.0[..3], &want, "quad {q} at ({u}, {y}) {name}");
+            }
+        }
+    }
+}

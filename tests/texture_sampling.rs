@@ -56,6 +56,7 @@ fn quad_scene_with(sampler: Sampler, transform: UvTransform) -> (Scene, View) {
             texture: tex,
             sampler,
             transform,
+            tex_coord: 0,
         }),
         unlit: true,
         ..Default::default()
@@ -338,6 +339,7 @@ fn texture_transform_moves_the_normal_map_too() {
                     offset: Vec2::new(offset, 0.0),
                     ..Default::default()
                 },
+                tex_coord: 0,
             }),
             ..Default::default()
         };
@@ -414,6 +416,7 @@ fn occlusion_scales_the_ambient_term_only() {
                 texture: tex,
                 sampler: nearest(Wrap::Repeat, Wrap::Repeat),
                 transform: UvTransform::default(),
+                tex_coord: 0,
             }),
             occlusion_strength: 0.8,
             ..Default::default()

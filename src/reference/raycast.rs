@@ -242,12 +242,13 @@ impl<'a> ReferenceScene<'a> {
     /// Sample of mip 0 at `uv` after the slot's texture transform, with the texture's sampler: its magnification filter (nearest or
     /// bilinear) and wrap modes (decoded from sRGB when `srgb`). Mip 0 only: the reference has
     /// no pixel footprint, so minification filters and mipmaps are not modelled.
-    fn sample(&self, tex: Option<TextureRef>, uv: Vec2, srgb: bool, default: Vec4) -> Vec4 {
+    /// `uvs` are the hit's TEXCOORD_0 and TEXCOORD_1; the slot reads its own set.
+    fn sample(&self, tex: Option<TextureRef>, uvs: [Vec2; 2], srgb: bool, default: Vec4) -> Vec4 {
         let Some((t, s, uv)) = tex.and_then(|r| {
             Some((
                 self.scene.textures.get(r.texture)?,
                 r.sampler,
-                r.transform.apply(uv),
+                r.transform.apply(uvs[(r.tex_coord as usize).min(1)]),
             ))
         }) else {
             return default;
@@ -349,11 +350,12 @@ impl<'a> ReferenceScene<'a> {
         } else {
             prim.uvs[i(0)] * (1.0 - h.u - h.v) + prim.uvs[i(1)] * h.u + prim.uvs[i(2)] * h.v
         };
+        let uv1 = prim.uv1(i(0)) * (1.0 - h.u - h.v) + prim.uv1(i(1)) * h.u + prim.uv1(i(2)) * h.v;
         let vertex_alpha = prim.color(i(0)).w * (1.0 - h.u - h.v)
             + prim.color(i(1)).w * h.u
             + prim.color(i(2)).w * h.v;
         let tex = mat.base_color_texture;
-        vertex_alpha * mat.base_color.w * self.sample(tex, uv, true, Vec4::ONE).w
+        vertex_alpha * mat.base_color.w * self.sample(tex, [uv, uv1], true, Vec4::ONE).w
     }
 
     /// The linear colour seen along `ray` beyond `t_min`: the first surface's shading, and where
@@ -581,6 +583,8 @@ impl<'a> ReferenceScene<'a> {
         let m3 = Mat3::from_mat4(self.matrices[r.instance as usize]);
         let (ng, mut n_geo) = self.hit_normals(h);
         let uv = prim.uvs[idx[0]] * w.x + prim.uvs[idx[1]] * w.y + prim.uvs[idx[2]] * w.z;
+        let uv1 = prim.uv1(idx[0]) * w.x + prim.uv1(idx[1]) * w.y + prim.uv1(idx[2]) * w.z;
+        let uv = [uv, uv1];
         let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];
         let vertex_color =
             prim.color(idx[0]) * w.x + prim.color(idx[1]) * w.y + prim.color(idx[2]) * w.z;

@@ -30,6 +30,8 @@ pub struct VertexAttributes {
     pub tangent: [f32; 4],
     /// COLOR_0, linear RGBA as 16-bit unorm (white without one).
     pub color: [u16; 4],
+    /// TEXCOORD_1 (TEXCOORD_0 without one).
+    pub uv1: [f32; 2],
 }
 
 /// The texture-transform rows of a material's four slots (identity for an empty slot).
@@ -37,7 +39,8 @@ fn uv_rows(slots: [Option<crate::scene::TextureRef>; 4]) -> [Vec4; 8] {
     let mut rows = [Vec4::ZERO; 8];
     for (i, t) in slots.iter().enumerate() {
         let (r0, r1) = t.map(|t| t.transform).unwrap_or_default().rows();
-        rows[2 * i] = r0.extend(0.0);
+        // w: the TEXCOORD set the slot reads.
+        rows[2 * i] = r0.extend(t.map_or(0.0, |t| t.tex_coord as f32));
         rows[2 * i + 1] = r1.extend(0.0);
     }
     rows
@@ -93,7 +96,7 @@ fn packed_occlusion(
 /// interleaved attributes (binding 1): locations 0 position, 1 normal, 2 uv, 3 tangent.
 pub fn vertex_layout() -> (
     [vk::VertexInputBindingDescription; 2],
-    [vk::VertexInputAttributeDescription; 5],
+    [vk::VertexInputAttributeDescription; 6],
 ) {
     let f = |location, binding, format, offset| vk::VertexInputAttributeDescription {
         location,
@@ -120,6 +123,7 @@ pub fn vertex_layout() -> (
             f(2, 1, vk::Format::R32G32_SFLOAT, 12),
             f(3, 1, vk::Format::R32G32B32A32_SFLOAT, 20),
             f(4, 1, vk::Format::R16G16B16A16_UNORM, 36),
+            f(5, 1, vk::Format::R32G32_SFLOAT, 44),
         ],
     )
 }
@@ -456,6 +460,7 @@ impl GpuScene {
                             .color(i)
                             .to_array()
                             .map(|c| (c.clamp(0.0, 1.0) * 65535.0).round() as u16),
+                        uv1: p.uv1(i).to_array(),
                     });
                 }
                 // Large primitives are split into clusters (their indices reordered cluster by

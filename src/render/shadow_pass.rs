@@ -179,11 +179,11 @@ fn depth_pipeline(
     masked: bool,
     format: vk::Format,
 ) -> Result<vk::Pipeline, GpuError> {
-    // Positions only, or positions and the attribute stream for TEXCOORD_0 (location 2) and
-    // COLOR_0 (location 4, whose alpha multiplies the base colour's).
+    // Positions only, or positions and the attribute stream for TEXCOORD_0 (location 2),
+    // COLOR_0 (location 4, whose alpha multiplies the base colour's) and TEXCOORD_1 (5).
     let (bindings, all) = vertex_layout();
-    let attributes = [all[0], all[2], all[4]];
-    let (n_bindings, n_attributes) = if masked { (2, 3) } else { (1, 1) };
+    let attributes = [all[0], all[2], all[4], all[5]];
+    let (n_bindings, n_attributes) = if masked { (2, 4) } else { (1, 1) };
     create_pipeline(
         ctx,
         &PipelineDesc {

@@ -256,7 +256,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         }
     }
     scene.image_textures = image_slots.clone();
-    let tex_ref = |t: gltf::Texture, transform: UvTransform| {
+    let tex_ref = |t: gltf::Texture, transform: UvTransform, tex_coord: u32| {
         image_slots
             .get(t.source().index())
             .copied()
@@ -265,11 +265,18 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 texture,
                 sampler: Sampler::from_gltf(&t.sampler()),
                 transform,
+                tex_coord,
             })
     };
     const EXT_TRANSFORM: &str = "KHR_texture_transform";
     let json_transform =
         |v: Option<&serde_json::Value>| v.map(UvTransform::from_json).unwrap_or_default();
+    // The transform's texCoord override (JSON), else the textureInfo's own set.
+    let json_set = |v: Option<&serde_json::Value>, own: u32| {
+        v.and_then(|v| v.get("texCoord"))
+            .and_then(|c| c.as_u64())
+            .map_or(own, |c| c.min(u32::MAX as u64) as u32)
+    };
     // A textureInfo's KHR_texture_transform (identity without one).
     let info_ref = |i: gltf::texture::Info| {
         let transform = i
@@ -281,7 +288,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             })
             .filter(|x| x.offset.is_finite() && x.rotation.is_finite() && x.scale.is_finite())
             .unwrap_or_default();
-        tex_ref(i.texture(), transform)
+        let set = i
+            .texture_transform()
+            .and_then(|x| x.tex_coord())
+            .unwrap_or(i.tex_coord());
+        tex_ref(i.texture(), transform, set)
     };
 
     // Materials (index = glTF index; the default material goes last).
@@ -297,9 +308,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             // gltf 1.4 types the extension on textureInfo only: normal and occlusion textureInfos
             // carry it as JSON.
             normal_texture: m.normal_texture().and_then(|t| {
+                let ext = t.extension_value(EXT_TRANSFORM);
                 tex_ref(
                     t.texture(),
-                    json_transform(t.extension_value(EXT_TRANSFORM)),
+                    json_transform(ext),
+                    json_set(ext, t.tex_coord()),
                 )
             }),
             normal_scale: m.normal_texture().map(|t| t.scale()).unwrap_or(1.0),
@@ -310,9 +323,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                     .unwrap_or(1.0),
             emissive_texture: m.emissive_texture().and_then(info_ref),
             occlusion_texture: m.occlusion_texture().and_then(|t| {
+                let ext = t.extension_value(EXT_TRANSFORM);
                 tex_ref(
                     t.texture(),
-                    json_transform(t.extension_value(EXT_TRANSFORM)),
+                    json_transform(ext),
+                    json_set(ext, t.tex_coord()),
                 )
             }),
             occlusion_strength: m
@@ -344,12 +359,42 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         if !mat.base_color.is_finite() {
             mat.base_color = Vec4::ONE;
         }
+        // TEXCOORD_0 and _1 are loaded; a slot reading another set reads set 0.
+        let i = m.index().unwrap_or(0);
+        let name = mat.name.clone();
+        for (slot, t) in [
+            (
+                "pbrMetallicRoughness/baseColorTexture",
+                &mut mat.base_color_texture,
+            ),
+            ("normalTexture", &mut mat.normal_texture),
+            (
+                "pbrMetallicRoughness/metallicRoughnessTexture",
+                &mut mat.metallic_roughness_texture,
+            ),
+            ("emissiveTexture", &mut mat.emissive_texture),
+            ("occlusionTexture", &mut mat.occlusion_texture),
+        ] {
+            if let Some(t) = t.as_mut().filter(|t| t.tex_coord > 1) {
+                scene.warn(
+                    "TEXCOORD_FALLBACK",
+                    format!("/materials/{i}/{slot}"),
+                    format!(
+                        "material {i} '{name}': {slot} reads TEXCOORD_{}; only sets 0 and 1 \
+                         are loaded, set 0 read instead",
+                        t.tex_coord
+                    ),
+                );
+                t.tex_coord = 0;
+            }
+        }
         // Occlusion is drawn from the metallic-roughness texture's red channel (glTF's ORM
         // packing; a separate image is packed in at upload), so it must be sampled alike.
         if let (Some(o), Some(mr)) = (mat.occlusion_texture, mat.metallic_roughness_texture) {
             let size = |t: usize| scene.textures.get(t).map(|t| (t.width, t.height));
             if o.sampler != mr.sampler
                 || o.transform != mr.transform
+                || o.tex_coord != mr.tex_coord
                 || size(o.texture) != size(mr.texture)
             {
                 let i = m.index().unwrap_or(0);
@@ -358,7 +403,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                     format!("/materials/{i}/occlusionTexture"),
                     format!(
                         "material {i} '{}': occlusion texture differs from metallic-roughness in \
-                         size, sampler or transform; ignored",
+                         size, sampler, transform or TEXCOORD set; ignored",
                         mat.name
                     ),
                 );
@@ -681,6 +726,28 @@ fn read_primitive(
         ),
         None => (vec![Vec2::ZERO; n], false),
     };
+    // TEXCOORD_1, for slots that read it (non-finite values read as 0).
+    let uvs1: Vec<Vec2> = match reader.read_tex_coords(1) {
+        Some(it) => it
+            .into_f32()
+            .map(Vec2::from_array)
+            .map(|v| if v.is_finite() { v } else { Vec2::ZERO })
+            .collect(),
+        None => Vec::new(),
+    };
+    let uvs1 = if uvs1.is_empty() || uvs1.len() == n {
+        uvs1
+    } else {
+        scene.warn(
+            "TEXCOORD_FALLBACK",
+            at.clone(),
+            format!(
+                "{label}: TEXCOORD_1 has {} values for {n} vertices; set 0 read instead",
+                uvs1.len()
+            ),
+        );
+        Vec::new()
+    };
     // COLOR_0 multiplies the base colour (RGB gets alpha 1); NaN reads as white.
     let colors: Vec<Vec4> = match reader.read_colors(0) {
         Some(c) => {
@@ -715,6 +782,7 @@ fn read_primitive(
         material,
         has_uvs,
         colors,
+        uvs1,
     };
     let wants_normal_map = scene.materials[material].normal_texture.is_some();
     match reader.read_tangents() {

@@ -19,6 +19,7 @@ fn prim(
         material: 0,
         has_uvs: true,
         colors: Vec::new(),
+        uvs1: Vec::new(),
     }
 }
 

@@ -45,6 +45,8 @@ struct Unwelded {
     tangents: Vec<Vec4>,
     /// Vertex colours (white for a primitive without): welded vertices keep theirs.
     colors: Vec<Vec4>,
+    /// TEXCOORD_1 (set 0's for a primitive without).
+    uvs1: Vec<Vec2>,
 }
 
 impl mikktspace::Geometry for Unwelded {
@@ -83,25 +85,28 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
         uvs: Vec::with_capacity(n),
         tangents: vec![Vec4::ZERO; n],
         colors: Vec::with_capacity(n),
+        uvs1: Vec::with_capacity(n),
     };
     let colored = !p.colors.is_empty();
+    let second_set = !p.uvs1.is_empty();
     for &i in &p.indices {
         let i = i as usize;
         g.positions.push(p.positions[i]);
         g.normals.push(p.normals[i]);
         g.uvs.push(p.uvs[i]);
         g.colors.push(p.color(i));
+        g.uvs1.push(p.uv1(i));
     }
     let ok = mikktspace::generate_tangents(&mut g);
     if !ok {
         p.tangents = p.normals.iter().map(|n| fallback_tangent(*n)).collect();
         return false;
     }
-    // Weld identical (position, normal, uv, tangent, colour) vertices back together.
-    let mut map: HashMap<[u32; 16], u32> = HashMap::new();
+    // Weld identical (position, normal, uvs, tangent, colour) vertices back together.
+    let mut map: HashMap<[u32; 18], u32> = HashMap::new();
     let (mut pos, mut nor, mut uv, mut tan, mut idx) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut col = Vec::new();
+    let (mut col, mut uv1) = (Vec::new(), Vec::new());
     for k in 0..n {
         let mut t = g.tangents[k];
         if !t.is_finite() || t.truncate().length_squared() < 1e-12 {
@@ -124,6 +129,8 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
             g.colors[k].y.to_bits(),
             g.colors[k].z.to_bits(),
             g.colors[k].w.to_bits(),
+            g.uvs1[k].x.to_bits(),
+            g.uvs1[k].y.to_bits(),
         ];
         let id = *map.entry(key).or_insert_with(|| {
             pos.push(g.positions[k]);
@@ -131,6 +138,7 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
             uv.push(g.uvs[k]);
             tan.push(t);
             col.push(g.colors[k]);
+            uv1.push(g.uvs1[k]);
             (pos.len() - 1) as u32
         });
         idx.push(id);
@@ -140,6 +148,7 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
     p.uvs = uv;
     p.tangents = tan;
     p.colors = if colored { col } else { Vec::new() };
+    p.uvs1 = if second_set { uv1 } else { Vec::new() };
     p.indices = idx;
     true
 }
@@ -176,6 +185,7 @@ mod tests {
             material: 0,
             has_uvs: true,
             colors: Vec::new(),
+            uvs1: Vec::new(),
         }
     }
 

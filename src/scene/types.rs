@@ -23,12 +23,23 @@ pub struct Primitive {
     pub has_uvs: bool,
     /// Vertex colours (COLOR_0, linear RGBA, multiplying the base colour); empty: white.
     pub colors: Vec<Vec4>,
+    /// Second texture coordinates (TEXCOORD_1); empty: none (a slot reading set 1 reads set 0).
+    pub uvs1: Vec<Vec2>,
 }
 
 impl Primitive {
     /// The vertex colour of vertex `i` (white without COLOR_0).
     pub fn color(&self, i: usize) -> Vec4 {
         self.colors.get(i).copied().unwrap_or(Vec4::ONE)
+    }
+
+    /// TEXCOORD_1 of vertex `i` (TEXCOORD_0's without one).
+    pub fn uv1(&self, i: usize) -> Vec2 {
+        self.uvs1
+            .get(i)
+            .or_else(|| self.uvs.get(i))
+            .copied()
+            .unwrap_or_default()
     }
 }
 
@@ -79,6 +90,9 @@ pub struct TextureRef {
     pub sampler: super::Sampler,
     /// KHR_texture_transform of this slot (identity without one).
     pub transform: super::UvTransform,
+    /// The TEXCOORD set it reads: 0 or 1 (the textureInfo's `texCoord`, or the transform's
+    /// override).
+    pub tex_coord: u32,
 }
 
 impl TextureRef {
@@ -88,6 +102,7 @@ impl TextureRef {
             texture,
             sampler: super::Sampler::default(),
             transform: super::UvTransform::default(),
+            tex_coord: 0,
         }
     }
 }

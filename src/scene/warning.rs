@@ -83,6 +83,12 @@ pub const FINDING_CODES: &[(&str, &str, &str)] = &[
         "alpha-blended: sorted back to front per draw, casts where alpha >= 0.5",
     ),
     (
+        "TEXCOORD_FALLBACK",
+        "warning",
+        "a texture reads a TEXCOORD set umbra does not load (2 and up), or a TEXCOORD_1 of the \
+         wrong count: set 0 is read",
+    ),
+    (
         "MATERIAL_OCCLUSION_IGNORED",
         "warning",
         "an occlusion texture not packable with metallic-roughness (size, sampler, transform) is ignored",

@@ -66,6 +66,7 @@ fn one_triangle() -> Scene {
         material: 0,
         has_uvs: true,
         colors: Vec::new(),
+        uvs1: Vec::new(),
     };
     add_object(
         &mut s,
