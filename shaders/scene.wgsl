@@ -66,7 +66,7 @@ struct Light {
     direction: vec4<f32>,
     // rgb: colour * intensity; w: unused
     color: vec4<f32>,
-    // x: cos(inner cone), y: cos(outer cone)
+    // x: cos(inner cone), y: cos(outer cone), z: range (0: none)
     cone: vec4<f32>,
     // x: first shadow view (-1: casts none), y: its view count (cascades near to far; 6 cube
     // faces +x, -x, +y, -y, +z, -z for a point light)
@@ -556,10 +556,17 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
             let d = light.position.xyz - p;
             let r2 = max(dot(d, d), 1e-8);
             l = d * inverseSqrt(r2);
-            radiance = radiance / r2;
+            // Inverse square, windowed to zero at the range (KHR_lights_punctual):
+            // clamp(1 - (d / range)^4, 0, 1); cone.z = 0 means no range.
+            let range2 = light.cone.z * light.cone.z;
+            let q = r2 / max(range2, 1e-30);
+            let window = select(1.0, clamp(1.0 - q * q, 0.0, 1.0), light.cone.z > 0.0);
+            radiance = radiance * (window / r2);
             if light.position.w == LIGHT_SPOT {
                 let cd = dot(-l, light.direction.xyz);
-                radiance *= smoothstep(light.cone.y, light.cone.x, cd);
+                // KHR_lights_punctual's cone: t^2, t linear between the outer and inner cosines.
+                let t = clamp((cd - light.cone.y) / max(light.cone.x - light.cone.y, 0.001), 0.0, 1.0);
+                radiance *= t * t;
             }
         }
         var vis = select(0.0, 1.0, dot(n_geo, l) > 0.0);

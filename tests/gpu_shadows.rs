@@ -459,6 +459,7 @@ fn spot_light_shadow_matches_geometry() {
         color: Vec3::ONE,
         intensity: 60.0,
         casts_shadows: true,
+        range: None,
     };
     let scene = box_scene(light);
     let mut r = Renderer::new(&ctx, &scene).unwrap();

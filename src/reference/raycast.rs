@@ -89,13 +89,9 @@ fn light_at(l: &crate::scene::Light, p: Vec3) -> (Vec3, f32, Vec3) {
             let d = l.position - p;
             let r2 = d.length_squared().max(1e-8);
             let dir = d / r2.sqrt();
-            let mut rad = l.color * l.intensity / r2;
-            if let LightKind::Spot { inner, outer } = l.kind {
-                let cd = (-dir).dot(l.direction.normalize_or(Vec3::NEG_Y));
-                let (lo, hi) = (outer.cos(), inner.cos());
-                let t = ((cd - lo) / (hi - lo)).clamp(0.0, 1.0);
-                rad *= t * t * (3.0 - 2.0 * t);
-            }
+            let mut rad = l.color * l.intensity / r2 * l.range_window(r2.sqrt());
+            let cd = (-dir).dot(l.direction.normalize_or(Vec3::NEG_Y));
+            rad *= l.cone_attenuation(cd);
             (dir, r2.sqrt(), rad)
         }
     }

@@ -481,6 +481,8 @@ pub fn plan_frame(
                 (2.0, Vec4::new(inner.cos(), outer.cos(), 0.0, 0.0))
             }
         };
+        // z: the range (0 = none).
+        let cone = Vec4::new(cone.x, cone.y, l.range.unwrap_or(0.0), 0.0);
         let first = views.iter().position(|v| v.light == i);
         let count = views.iter().filter(|v| v.light == i).count();
         u.lights[i] = LightUniform {
@@ -696,6 +698,7 @@ mod tests {
             color: Vec3::ONE,
             intensity: 5.0,
             casts_shadows: true,
+            range: None,
         };
         let spot = Light {
             kind: LightKind::Spot {

@@ -518,6 +518,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 color: Vec3::from_array(l.color()),
                 intensity: l.intensity().max(0.0),
                 casts_shadows: true,
+                range: l.range().filter(|r| r.is_finite() && *r > 0.0),
             });
         }
         for c in node.children() {

@@ -346,6 +346,7 @@ pub fn room_scene() -> Scene {
         color: Vec3::ONE,
         intensity: 6.0,
         casts_shadows: true,
+        range: None,
     });
     s.cameras.push(Camera::look_at(
         Vec3::new(3.7, 2.0, 2.7),
@@ -408,6 +409,7 @@ pub fn sun_and_spot_scene() -> Scene {
         color: Vec3::ONE,
         intensity: 40.0,
         casts_shadows: true,
+        range: None,
     };
     let sun = Light::sun(Vec3::new(0.4, -1.0, 0.3), 2.0);
     yard_scene("sun and spot", vec![sun, spot])

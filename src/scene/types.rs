@@ -209,6 +209,35 @@ pub struct Light {
     /// Whether it casts shadows (each casting light gets shadow views while the frame has them:
     /// `render::MAX_SHADOW_VIEWS`).
     pub casts_shadows: bool,
+    /// KHR_lights_punctual `range` (point, spot): the intensity is windowed by
+    /// clamp(1 − (d/range)⁴, 0, 1) and is zero beyond it; None: unlimited.
+    pub range: Option<f32>,
+}
+
+impl Light {
+    /// The spec's distance window at distance `d` (1 without a range).
+    pub fn range_window(&self, d: f32) -> f32 {
+        match self.range {
+            Some(r) if self.kind != LightKind::Directional => {
+                (1.0 - (d / r).powi(4)).clamp(0.0, 1.0)
+            }
+            _ => 1.0,
+        }
+    }
+
+    /// The spec's spot-cone attenuation for the cosine `cd` of the angle from the spot axis:
+    /// t² with t = clamp((cd − cos outer) / max(0.001, cos inner − cos outer), 0, 1) (1 for
+    /// other kinds).
+    pub fn cone_attenuation(&self, cd: f32) -> f32 {
+        match self.kind {
+            LightKind::Spot { inner, outer } => {
+                let scale = 1.0 / (inner.cos() - outer.cos()).max(0.001);
+                let t = ((cd - outer.cos()) * scale).clamp(0.0, 1.0);
+                t * t
+            }
+            _ => 1.0,
+        }
+    }
 }
 
 impl Light {
@@ -229,6 +258,7 @@ impl Light {
             color: Vec3::ONE,
             intensity,
             casts_shadows: true,
+            range: None,
         }
     }
 
