@@ -21,33 +21,42 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
+/// A unit quad facing +Z at x..x + 1, y 0..1 (corners counter-clockwise from (x, 0)): its
+/// POSITION and index accessors.
+fn unit_quad(b: &mut Builder, x: f32) -> (usize, usize) {
+    let pos = b.floats(
+        &[
+            x,
+            0.0,
+            0.0,
+            x + 1.0,
+            0.0,
+            0.0,
+            x + 1.0,
+            1.0,
+            0.0,
+            x,
+            1.0,
+            0.0,
+        ],
+        3,
+        "VEC3",
+    );
+    (
+        pos,
+        b.indices(&[0, 1, 2, 0, 2, 3], common::gltf_builder::U16),
+    )
+}
+
 /// A unit quad facing +Z with materials of emissive factor (0.1, 0.05, 0.02) and the given
-/// strengths (one quad each, side by side), no lights but a dim one far off.
+/// strengths (one quad each, side by side), no lights (so the default sun).
 fn emissive_quads(strengths: &[Option<f32>]) -> PathBuf {
     let mut b = Builder::default();
     b.use_extension("KHR_materials_emissive_strength");
     for (i, s) in strengths.iter().enumerate() {
         let x = i as f32 * 1.2;
-        let pos = b.floats(
-            &[
-                x,
-                0.0,
-                0.0,
-                x + 1.0,
-                0.0,
-                0.0,
-                x + 1.0,
-                1.0,
-                0.0,
-                x,
-                1.0,
-                0.0,
-            ],
-            3,
-            "VEC3",
-        );
+        let (pos, idx) = unit_quad(&mut b, x);
         let nrm = b.floats(&[0.0, 0.0, 1.0].repeat(4), 3, "VEC3");
-        let idx = b.indices(&[0, 1, 2, 0, 2, 3], common::gltf_builder::U16);
         let mut m = json!({"name": format!("glow {i}"), "emissiveFactor": [0.1, 0.05, 0.02],
                            "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0]}});
         if let Some(s) = s {
@@ -116,11 +125,7 @@ fn vertex_colours_multiply_the_base_colour() {
     // triangle's corner colours times the factor.
     let mut b = Builder::default();
     b.use_extension("KHR_materials_unlit");
-    let pos = b.floats(
-        &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0],
-        3,
-        "VEC3",
-    );
+    let (pos, idx) = unit_quad(&mut b, 0.0);
     let corners = [
         Vec3::new(1.0, 0.0, 0.0),
         Vec3::new(0.0, 1.0, 0.0),
@@ -129,7 +134,6 @@ fn vertex_colours_multiply_the_base_colour() {
     ];
     let flat: Vec<f32> = corners.iter().flat_map(|c| c.to_array()).collect();
     let col = b.floats(&flat, 3, "VEC3");
-    let idx = b.indices(&[0, 1, 2, 0, 2, 3], common::gltf_builder::U16);
     let mat = b.material(
         json!({"name": "tinted", "extensions": {"KHR_materials_unlit": {}},
                                 "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 0.5, 1.0]}}),
@@ -225,27 +229,9 @@ fn second_set_quads() -> PathBuf {
     ];
     for (i, info) in infos.into_iter().enumerate() {
         let x = i as f32 * 1.2;
-        let pos = b.floats(
-            &[
-                x,
-                0.0,
-                0.0,
-                x + 1.0,
-                0.0,
-                0.0,
-                x + 1.0,
-                1.0,
-                0.0,
-                x,
-                1.0,
-                0.0,
-            ],
-            3,
-            "VEC3",
-        );
+        let (pos, idx) = unit_quad(&mut b, x);
         let uv0 = b.floats(&[0.0; 8], 2, "VEC2");
         let uv1 = b.floats(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0], 2, "VEC2");
-        let idx = b.indices(&[0, 1, 2, 0, 2, 3], common::gltf_builder::U16);
         let mat = b.material(json!({"name": format!("set {i}"),
                                     "extensions": {"KHR_materials_unlit": {}},
                                     "pbrMetallicRoughness": {"baseColorTexture": info}}));
