@@ -98,11 +98,9 @@ struct Frame {
     // w: index of the light whose visibility `--view shadow` writes (MAX_LIGHTS + 1 when none);
     // xyz: the eye the cascades are split from (the shadow-fitting camera)
     shadow_light: vec4<f32>,
-    // x: constant bias in shadow texels, applied towards the light; y: the shown light's first
-    // shadow view
+    // x: constant bias in shadow texels, applied towards the light
     bias: vec4<f32>,
-    // xyz: the shadow-fitting camera's forward (view depth = dot(p - shadow_light.xyz, forward));
-    // w: the shown light's number of shadow views.
+    // xyz: the shadow-fitting camera's forward (view depth = dot(p - shadow_light.xyz, forward))
     camera_forward: vec4<f32>,
     // x: view mode, y: PCF kernel width in bilinear taps (0 = single nearest compare),
     // z: 1 if hardware linear comparison filtering is used, w: number of lights
@@ -412,10 +410,10 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
     let mode = frame.modes.x;
     // Shadow-map texels per screen pixel (derivatives first: uniform control flow), in the shown
     // light's cascade (or face).
-    let first = i32(frame.bias.y);
-    let n = i32(frame.camera_forward.w);
-    var layer = first + cascade_of(in.world_position, first, n);
     let shown = frame.lights[min(u32(frame.shadow_light.w), MAX_LIGHTS - 1u)];
+    let first = max(i32(shown.shadow.x), 0);
+    let n = i32(shown.shadow.y);
+    var layer = first + cascade_of(in.world_position, first, n);
     if shown.position.w == LIGHT_POINT {
         layer = first + cube_face(in.world_position - shown.position.xyz);
     }
@@ -451,7 +449,7 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
         return vec4<f32>(srgb_to_linear(vec3<f32>(1.0 - clamp(d / frame.shadow.z, 0.0, 1.0))), 1.0);
     }
     if mode == VIEW_TEXEL_DENSITY {
-        if frame.shadow.w == 0.0 || frame.camera_forward.w < 1.0 {
+        if frame.shadow.w == 0.0 || n < 1 {
             return vec4<f32>(srgb_to_linear(vec3<f32>(0.5)), 1.0);
         }
         // Screen pixels per shadow texel, log2 over [1/16, 16]: dark blue where texels are finer

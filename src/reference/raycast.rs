@@ -97,6 +97,21 @@ fn light_at(l: &crate::scene::Light, p: Vec3) -> (Vec3, f32, Vec3) {
     }
 }
 
+/// The interpolated TEXCOORD_0, TEXCOORD_1 and COLOR_0 at hit `h` on the triangle whose first
+/// index is `first` (zeros without texture coordinates, white without colours).
+fn surface_inputs(prim: &crate::scene::Primitive, first: usize, h: &Hit) -> ([Vec2; 2], Vec4) {
+    let i = [0, 1, 2].map(|k| prim.indices[first + k] as usize);
+    let w = [1.0 - h.u - h.v, h.u, h.v];
+    let uv0 = |v: usize| prim.uvs.get(v).copied().unwrap_or_default();
+    let (mut uvs, mut color) = ([Vec2::ZERO; 2], Vec4::ZERO);
+    for (v, w) in i.into_iter().zip(w) {
+        uvs[0] += uv0(v) * w;
+        uvs[1] += prim.uv1(v) * w;
+        color += prim.color(v) * w;
+    }
+    (uvs, color)
+}
+
 /// What a click on the image hits (`ReferenceScene::pick`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pick {
@@ -340,18 +355,9 @@ impl<'a> ReferenceScene<'a> {
         let Some(mat) = self.scene.materials.get(prim.material) else {
             return 1.0;
         };
-        let i = |k: u32| prim.indices[(r.first + k) as usize] as usize;
-        let uv = if prim.uvs.is_empty() {
-            Vec2::ZERO
-        } else {
-            prim.uvs[i(0)] * (1.0 - h.u - h.v) + prim.uvs[i(1)] * h.u + prim.uvs[i(2)] * h.v
-        };
-        let uv1 = prim.uv1(i(0)) * (1.0 - h.u - h.v) + prim.uv1(i(1)) * h.u + prim.uv1(i(2)) * h.v;
-        let vertex_alpha = prim.color(i(0)).w * (1.0 - h.u - h.v)
-            + prim.color(i(1)).w * h.u
-            + prim.color(i(2)).w * h.v;
+        let (uvs, color) = surface_inputs(prim, r.first as usize, h);
         let tex = mat.base_color_texture;
-        vertex_alpha * mat.base_color.w * self.sample(tex, [uv, uv1], true, Vec4::ONE).w
+        color.w * mat.base_color.w * self.sample(tex, uvs, true, Vec4::ONE).w
     }
 
     /// The linear colour seen along `ray` beyond `t_min`: the first surface's shading, and where
@@ -578,12 +584,8 @@ impl<'a> ReferenceScene<'a> {
         let p = ray.at(h.t);
         let m3 = Mat3::from_mat4(self.matrices[r.instance as usize]);
         let (ng, mut n_geo) = self.hit_normals(h);
-        let uv = prim.uvs[idx[0]] * w.x + prim.uvs[idx[1]] * w.y + prim.uvs[idx[2]] * w.z;
-        let uv1 = prim.uv1(idx[0]) * w.x + prim.uv1(idx[1]) * w.y + prim.uv1(idx[2]) * w.z;
-        let uv = [uv, uv1];
+        let (uv, vertex_color) = surface_inputs(prim, r.first as usize, h);
         let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];
-        let vertex_color =
-            prim.color(idx[0]) * w.x + prim.color(idx[1]) * w.y + prim.color(idx[2]) * w.z;
         let base = mat.base_color
             * vertex_color
             * self.sample(mat.base_color_texture, uv, true, Vec4::ONE);

@@ -422,8 +422,6 @@ pub fn plan_frame(
         .filter(|&i| has_views(i))
         .or_else(|| views.first().map(|v| v.light));
     let shadows_on = view.shadow.enabled && shadow_light.is_some();
-    let first_shown = shadow_light.and_then(|i| views.iter().position(|v| v.light == i));
-    let shown_count = shadow_light.map_or(0, |i| views.iter().filter(|v| v.light == i).count());
     let mut u = FrameUniform {
         clip_from_world,
         camera_position: view.camera.position().extend(1.0),
@@ -440,18 +438,13 @@ pub fn plan_frame(
         shadow_light: fit_camera
             .position()
             .extend(shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32)),
-        bias: Vec4::new(
-            view.shadow.constant_bias,
-            first_shown.unwrap_or(0) as f32,
-            0.0,
-            0.0,
-        ),
+        bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
         camera_forward: (fit_camera
             .view_from_world()
             .inverse()
             .transform_vector3(Vec3::NEG_Z))
         .normalize_or(Vec3::NEG_Z)
-        .extend(shown_count.max(1) as f32),
+        .extend(0.0),
         modes: [
             view.mode.shader_value(),
             view.shadow.pcf.taps(),
@@ -733,7 +726,11 @@ mod tests {
         v.shown_light = Some(3);
         let p = plan_frame(&lights, &s.bounds(), &[], &v, 1.5, 720, false);
         assert_eq!(
-            (p.shadow_light, p.uniform.bias.y, p.uniform.camera_forward.w),
+            (
+                p.shadow_light,
+                p.uniform.lights[3].shadow.x,
+                p.uniform.lights[3].shadow.y
+            ),
             (Some(3), 10.0, 1.0)
         );
         v.shown_light = Some(4);

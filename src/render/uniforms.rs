@@ -70,9 +70,9 @@ pub struct FrameUniform {
     /// none); xyz: the eye cascades are split from (the shadow-fitting camera's position; view
     /// depth = dot(p − eye, forward)).
     pub shadow_light: Vec4,
-    /// x constant bias in shadow texels (towards the light); y the shown light's first view.
+    /// x constant bias in shadow texels (towards the light).
     pub bias: Vec4,
-    /// xyz: the shadow-fitting camera's forward direction; w: the shown light's view count.
+    /// xyz: the shadow-fitting camera's forward direction.
     pub camera_forward: Vec4,
     /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
     pub modes: [u32; 4],
