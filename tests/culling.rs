@@ -152,7 +152,7 @@ fn masked_and_opaque_materials_draw_in_their_pipelines() {
         45f32.to_radians(),
         0.1,
     );
-    let mut view = View::new(cam);
+    let mut view = View::new(cam).raw_output();
     view.shadow.enabled = false;
     let f = render(&ctx, &s, true, &view);
     save(&f.image, "masked_stripes.png");

@@ -76,7 +76,7 @@ fn y_up_and_x_right_conventions() {
     );
     let ctx = context();
     let mut r = Renderer::new(&ctx, &s).unwrap();
-    let f = r.render(&View::new(cam), 200, 100).unwrap();
+    let f = r.render(&View::new(cam).raw_output(), 200, 100).unwrap();
     save(&f.image, "conventions.png");
     let (mut red_top, mut red_bottom, mut green_left, mut green_right) = (0, 0, 0, 0);
     for (x, y, p) in f.image.enumerate_pixels() {
@@ -144,7 +144,7 @@ fn lit_surface_matches_blinn_phong_on_cpu() {
     let cam = Camera::look_at(eye, Vec3::new(1.0, 0.5, 0.0), 50f32.to_radians(), 0.1);
     let ctx = context();
     let mut r = Renderer::new(&ctx, &s).unwrap();
-    let mut view = View::new(cam);
+    let mut view = View::new(cam).raw_output();
     view.ambient = Vec3::splat(0.1);
     let (w, h) = (64, 64);
     let f = r.render(&view, w, h).unwrap();

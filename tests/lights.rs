@@ -56,7 +56,8 @@ fn linear_at(scene: &Scene, p: Vec3) -> (f32, f32) {
         Vec3::new(1.5, 0.0, 0.0),
         60f32.to_radians(),
         0.1,
-    ));
+    ))
+    .raw_output();
     v.ambient = Vec3::ZERO;
     let f = r.render(&v, W, H).unwrap();
     let exact = ReferenceScene::new(scene).render(&f.plan, W, H, v.ambient);

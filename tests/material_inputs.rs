@@ -94,7 +94,8 @@ fn emissive_strength_scales_the_emissive_factor() {
         Vec3::new(1.7, 0.5, 0.0),
         60f32.to_radians(),
         0.1,
-    ));
+    ))
+    .raw_output();
     v.ambient = Vec3::ZERO;
     let (w, h) = (240, 120);
     let f = r.render(&v, w, h).unwrap();
@@ -164,7 +165,8 @@ fn vertex_colours_multiply_the_base_colour() {
         Vec3::new(0.5, 0.5, 0.0),
         50f32.to_radians(),
         0.1,
-    ));
+    ))
+    .raw_output();
     let (w, h) = (160, 160);
     let f = r.render(&v, w, h).unwrap();
     let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, v.ambient);
@@ -266,7 +268,8 @@ fn textures_read_the_texcoord_set_they_name() {
         Vec3::new(1.7, 0.5, 0.0),
         60f32.to_radians(),
         0.1,
-    ));
+    ))
+    .raw_output();
     let (w, h) = (300, 120);
     let f = r.render(&v, w, h).unwrap();
     let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, v.ambient);

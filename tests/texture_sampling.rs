@@ -72,7 +72,7 @@ fn quad_scene_with(sampler: Sampler, transform: UvTransform) -> (Scene, View) {
         90f32.to_radians(),
         0.01,
     );
-    let mut v = View::new(cam);
+    let mut v = View::new(cam).raw_output();
     v.shadow.enabled = false;
     (s, v)
 }
@@ -352,7 +352,7 @@ fn texture_transform_moves_the_normal_map_too() {
             90f32.to_radians(),
             0.01,
         );
-        let mut v = View::new(cam);
+        let mut v = View::new(cam).raw_output();
         v.shadow.enabled = false;
         let (gpu, exact) = render_scene(&ctx, (s, v), &format!("normal_offset_{offset}"));
         let luma = |img: &image::RgbaImage, x0: u32, x1: u32| {
@@ -429,7 +429,7 @@ fn occlusion_scales_the_ambient_term_only() {
             90f32.to_radians(),
             0.01,
         );
-        let mut v = View::new(cam);
+        let mut v = View::new(cam).raw_output();
         v.shadow.enabled = false;
         (s, v)
     };

@@ -40,6 +40,7 @@ fn front_view() -> View {
         40f32.to_radians(),
         0.1,
     ))
+    .raw_output()
 }
 
 /// The over operator, `top` over `below` (linear).
@@ -169,6 +170,21 @@ fn three_overlapping_quads_are_sorted_back_to_front() {
     // Measured: GPU 1 level, reference 0; the unsorted order's colour is 77 levels away.
     assert!(gpu <= 2.0 && reference <= 2.0, "{gpu} {reference}");
     assert!(wrong_order >= 50.0, "{wrong_order}");
+    // At the default exposure and tone curve each layer is tone-mapped, then composited, on the
+    // GPU and in the reference alike.
+    let mut v = front_view();
+    v.exposure = Default::default();
+    v.tonemap = Default::default();
+    let f = r.render(&v, W, H).unwrap();
+    let exact = ReferenceScene::new(&s).render(&f.plan, W, H, v.ambient);
+    let (gpu, reference) = (f.image.get_pixel(x, y).0, exact.image.get_pixel(x, y).0);
+    let d = (0..3).map(|k| gpu[k].abs_diff(reference[k])).max().unwrap();
+    eprintln!("tone-mapped: GPU {gpu:?}, reference {reference:?} where all three overlap");
+    assert!(
+        d <= 2,
+        "tone-mapped layers: GPU {gpu:?}, reference {reference:?}"
+    );
+    assert_validation_clean(&ctx);
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! Viewer key actions on the view settings, as pure logic; each returns the line to print.
 
 use glam::Vec3;
-use umbra::render::{Pcf, View, ViewMode, MAX_CASCADES};
+use umbra::render::{Pcf, Tonemap, View, ViewMode, MAX_CASCADES};
 use umbra::scene::Light;
 
 /// What a key does.
@@ -31,6 +31,12 @@ pub enum Action {
     ToggleShadows,
     /// Next cascade count: automatic, 1, 2, 3, 4 (`N`).
     CycleCascades,
+    /// Next tone-mapping curve: PBR Neutral, ACES, none (`T`).
+    CycleTonemap,
+    /// Exposure half a stop up (`.`).
+    ExposureUp,
+    /// Exposure half a stop down (`,`).
+    ExposureDown,
 }
 
 /// The sun as elevation/azimuth in degrees.
@@ -144,6 +150,22 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 n => format!("cascades: {n}"),
             }
         }
+        Action::CycleTonemap => {
+            view.tonemap = match view.tonemap {
+                Tonemap::Neutral => Tonemap::Aces,
+                Tonemap::Aces => Tonemap::None,
+                Tonemap::None => Tonemap::Neutral,
+            };
+            format!("tone mapping: {:?}", view.tonemap)
+        }
+        Action::ExposureUp | Action::ExposureDown => {
+            let step = if a == Action::ExposureUp { 0.5 } else { -0.5 };
+            view.exposure_compensation = (view.exposure_compensation + step).clamp(-16.0, 16.0);
+            format!(
+                "exposure compensation: {:+.1} EV",
+                view.exposure_compensation
+            )
+        }
     }
 }
 
@@ -240,6 +262,17 @@ mod tests {
             })
             .collect();
         assert_eq!(counts, [1, 2, 3, 4, 0]);
+        let curves: Vec<Tonemap> = (0..3)
+            .map(|_| {
+                apply(Action::CycleTonemap, &mut v, &mut sun);
+                v.tonemap
+            })
+            .collect();
+        assert_eq!(curves, [Tonemap::Aces, Tonemap::None, Tonemap::Neutral]);
+        apply(Action::ExposureUp, &mut v, &mut sun);
+        apply(Action::ExposureUp, &mut v, &mut sun);
+        apply(Action::ExposureDown, &mut v, &mut sun);
+        assert_eq!(v.exposure_compensation, 0.5);
         // L: lights 0, 1, then back to the default.
         let shown: Vec<Option<usize>> = (0..3)
             .map(|_| {

@@ -4,7 +4,9 @@ use anyhow::{anyhow, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 use std::path::PathBuf;
-use umbra::render::{Pcf, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode};
+use umbra::render::{
+    Exposure, Pcf, ShadowFit, ShadowFormat, ShadowSettings, Tonemap, View, ViewMode,
+};
 use umbra::scene::{demo::demo_scene, load_gltf, Camera, Scene};
 
 /// umbra: real-time shadow-mapping renderer (Vulkan).
@@ -329,6 +331,20 @@ pub struct ViewArgs {
     /// Output: the lit image or a debug view.
     #[arg(long = "view", value_enum, default_value = "lit")]
     pub mode: ViewMode,
+    /// Exposure of the lit image: `auto` (metered from the scene's lights, so a scene authored
+    /// in lux and candela needs no flag), an EV100 value (scale 1 / (1.2 · 2^EV100); e.g. 15 for
+    /// a sunlit scene in lux), or `xS` for a linear scale S (`x1`: the shading's raw values).
+    #[arg(long, default_value = "auto", value_parser = parse_exposure, allow_hyphen_values = true)]
+    pub exposure: Exposure,
+    /// Ambient intensity Ia (the formula's ka·Ia term): one value for grey or R,G,B, in the
+    /// units of the scene's lights (0.12 suits unit-intensity lights; a scene lit in lux wants
+    /// a sky's worth, e.g. 1000).
+    #[arg(long, default_value = "0.12", value_parser = parse_ambient)]
+    pub ambient: Vec3,
+    /// Tone-mapping curve of the lit image: Khronos PBR Neutral, ACES (Hill's fit), or none
+    /// (exposed values clamped).
+    #[arg(long, value_enum, default_value = "neutral")]
+    pub tonemap: Tonemap,
     /// Shadow-map size in texels.
     #[arg(long, default_value_t = 2048)]
     pub shadow_map: u32,
@@ -406,6 +422,38 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
         ));
     }
     Ok((w, h))
+}
+
+/// One finite value ≥ 0 (grey) or R,G,B.
+fn parse_ambient(s: &str) -> Result<Vec3, String> {
+    let v = match s.trim().parse::<f32>() {
+        Ok(g) => Vec3::splat(g),
+        Err(_) => parse_vec3(s)?,
+    };
+    if !(v.is_finite() && v.min_element() >= 0.0) {
+        return Err(format!("ambient '{s}' must be finite and >= 0"));
+    }
+    Ok(v)
+}
+
+/// `auto`, an EV100 number, or `x` and a linear scale.
+pub(crate) fn parse_exposure(s: &str) -> Result<Exposure, String> {
+    let t = s.trim();
+    if t.eq_ignore_ascii_case("auto") {
+        return Ok(Exposure::Auto);
+    }
+    if let Some(k) = t.strip_prefix(['x', 'X']) {
+        return match k.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(Exposure::Scale(v)),
+            _ => Err(format!("exposure scale '{k}' must be a number above 0")),
+        };
+    }
+    match t.parse::<f32>() {
+        Ok(v) if v.is_finite() && v.abs() <= 64.0 => Ok(Exposure::Ev100(v)),
+        _ => Err(format!(
+            "'{s}' is not `auto`, an EV100 within -64..64, or `x` and a scale (e.g. x1)"
+        )),
+    }
 }
 
 fn parse_budget(s: &str) -> Result<f64, String> {
@@ -580,6 +628,9 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         i => i,
     };
     v.mode = a.mode;
+    v.exposure = a.exposure;
+    v.ambient = a.ambient;
+    v.tonemap = a.tonemap;
     if let Some(i) = a.shadow_light {
         let n = umbra::render::effective_lights(&scene.lights, &v).len();
         if i >= n {

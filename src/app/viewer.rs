@@ -96,6 +96,9 @@ fn script_key(name: &str) -> Option<KeyCode> {
         "tab" => KeyCode::Tab,
         "c" => KeyCode::KeyC,
         "p" => KeyCode::KeyP,
+        "t" => KeyCode::KeyT,
+        "comma" => KeyCode::Comma,
+        "period" => KeyCode::Period,
         _ => return None,
     })
 }
@@ -115,6 +118,9 @@ fn key_action(code: KeyCode) -> Option<KeyAction> {
         KeyCode::KeyV => Setting(Action::CycleView),
         KeyCode::KeyH => Setting(Action::ToggleShadows),
         KeyCode::KeyN => Setting(Action::CycleCascades),
+        KeyCode::KeyT => Setting(Action::CycleTonemap),
+        KeyCode::Period => Setting(Action::ExposureUp),
+        KeyCode::Comma => Setting(Action::ExposureDown),
         KeyCode::KeyL => ShadowLight,
         KeyCode::KeyW => Move(MoveKey::W),
         KeyCode::KeyA => Move(MoveKey::A),

@@ -1,5 +1,5 @@
-//! Pure maths: rotations, reversed-z projections, bounds, rays, interpolation, Bézier paths and
-//! light-frustum fitting. No Vulkan here; everything is unit-tested.
+//! Pure maths: rotations, reversed-z projections, bounds, rays, interpolation, Bézier paths,
+//! light-frustum fitting and tone-mapping curves. No Vulkan here; everything is unit-tested.
 
 pub mod bezier;
 pub mod bounds;
@@ -9,6 +9,7 @@ pub mod projection;
 pub mod ray;
 pub mod rotation;
 pub mod shadow_fit;
+pub mod tonemap;
 
 pub use bounds::Aabb;
 pub use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};

@@ -376,7 +376,7 @@ impl<'a> ReferenceScene<'a> {
             return Vec3::new(c[0], c[1], c[2]);
         };
         let (_, rgb) = self.shade(plan, ray, &h, ambient);
-        self.blend_behind(plan, ray, &h, rgb, ambient, layers)
+        self.blend_behind(plan, ray, &h, plan.display(rgb), ambient, layers)
     }
 
     /// `rgb`, the shading of hit `h`, blended over what lies behind it when its material is
@@ -541,7 +541,7 @@ impl<'a> ReferenceScene<'a> {
                     None => (None, f32::INFINITY, background, false),
                     Some(h) => {
                         let (vis, rgb) = self.shade(plan, &ray, &h, ambient);
-                        let rgb = self.blend_behind(plan, &ray, &h, rgb, ambient, 0);
+                        let rgb = self.blend_behind(plan, &ray, &h, plan.display(rgb), ambient, 0);
                         let (ng, n) = self.hit_normals(&h);
                         (
                             Some(vis),

@@ -3,7 +3,7 @@
 //! map, the camera projection, and the frame uniform block.
 
 use super::gpu_scene::Viewpoint;
-use super::settings::{Pcf, ShadowFit, ShadowSettings, View, MAX_CASCADES};
+use super::settings::{Exposure, Pcf, ShadowFit, ShadowSettings, Tonemap, View, MAX_CASCADES};
 use super::shadow_pass::CasterPlan;
 use super::uniforms::{
     FrameUniform, LightUniform, ShadowViewUniform, MAX_LIGHTS, MAX_SHADOW_VIEWS,
@@ -243,6 +243,11 @@ pub struct FramePlan {
     pub clip_from_world: Mat4,
     /// The shadow pass's casters and area per shadow view (set by `FrameCore::prepare`).
     pub casters: Vec<CasterPlan>,
+    /// The linear scale applied to the lit image before tone mapping (`View::exposure`
+    /// resolved: auto exposure metered from this frame's lights).
+    pub exposure: f32,
+    /// The tone-mapping curve of the lit image.
+    pub tonemap: Tonemap,
     /// What every position and matrix of this plan is relative to (world = plan + origin):
     /// [`crate::scene::Scene::render_origin`] when planned by the renderer, zero from
     /// [`plan_frame`].
@@ -277,6 +282,12 @@ impl FramePlan {
     /// The shown light's views (`shadow_light`; empty without one).
     pub fn primary_views(&self) -> &[ShadowView] {
         self.shadow_light.map_or(&[][..], |i| self.light_views(i))
+    }
+
+    /// The display value of a lit colour: exposed, then tone-mapped (the camera pass's
+    /// `display`; blended layers are composited after it, as on the GPU).
+    pub fn display(&self, rgb: Vec3) -> Vec3 {
+        self.tonemap.apply(rgb * self.exposure)
     }
 
     /// Whether light `i` is shadowed by the map this frame (shadows on and it has views).
@@ -422,6 +433,8 @@ pub fn plan_frame(
         .filter(|&i| has_views(i))
         .or_else(|| views.first().map(|v| v.light));
     let shadows_on = view.shadow.enabled && shadow_light.is_some();
+    let exposure = exposure_scale(view.exposure, &lights, view.ambient, bounds)
+        * view.exposure_compensation.clamp(-64.0, 64.0).exp2();
     let mut u = FrameUniform {
         clip_from_world,
         camera_position: view.camera.position().extend(1.0),
@@ -451,6 +464,7 @@ pub fn plan_frame(
             hw_compare as u32,
             lights.len() as u32,
         ],
+        output: Vec4::new(exposure, view.tonemap.shader_value(), 0.0, 0.0),
         lights: [LightUniform::default(); MAX_LIGHTS],
         // Set per view below (rectangles with the casters, `shadow_pass::plan_casters`; until
         // then every lookup is lit); slots past the views are never read.
@@ -505,6 +519,64 @@ pub fn plan_frame(
         clip_from_world,
         casters: Vec::new(),
         origin: Vec3::ZERO,
+        exposure,
+        tonemap: view.tonemap,
+    }
+}
+
+/// The illuminance (lux, as luminance) that auto exposure meters: at the centre of `bounds`, the
+/// sum over `lights` of what each delivers to a surface facing it (a directional light its
+/// intensity; a point or spot light I / d², range-windowed, the spot's cone ignored, d at least a
+/// quarter of the bounds' half-diagonal so that a light at the centre does not blind the meter)
+/// plus the ambient term.
+pub fn metered_illuminance(lights: &[Light], ambient: Vec3, bounds: &Aabb) -> f32 {
+    let luma = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let (centre, half) = if bounds.is_empty() {
+        (Vec3::ZERO, 0.0)
+    } else {
+        (bounds.center(), 0.5 * bounds.diagonal())
+    };
+    let min_d2 = (0.25 * half).powi(2).max(1e-12);
+    let direct: f32 = lights
+        .iter()
+        .map(|l| {
+            let i = luma(l.color) * l.intensity.max(0.0);
+            match l.kind {
+                LightKind::Directional => i,
+                _ => {
+                    let d2 = l.position.distance_squared(centre).max(min_d2);
+                    let window = l.range.map_or(1.0, |r| {
+                        let q = d2 / (r * r).max(1e-30);
+                        (1.0 - q * q).clamp(0.0, 1.0)
+                    });
+                    i * window / d2
+                }
+            }
+        })
+        .sum();
+    direct + luma(ambient.max(Vec3::ZERO))
+}
+
+/// The linear scale `exposure` sets for a scene lit by `lights` and `ambient` within `bounds`:
+/// auto meters [`metered_illuminance`] (scale 1 where nothing lights the scene).
+pub fn exposure_scale(exposure: Exposure, lights: &[Light], ambient: Vec3, bounds: &Aabb) -> f32 {
+    use crate::math::tonemap::{exposure_from_ev100, metered_ev100};
+    let s = match exposure {
+        Exposure::Auto => {
+            let e = metered_illuminance(lights, ambient, bounds);
+            if e.is_finite() && e > 0.0 {
+                exposure_from_ev100(metered_ev100(e))
+            } else {
+                1.0
+            }
+        }
+        Exposure::Ev100(ev) => exposure_from_ev100(ev),
+        Exposure::Scale(s) => s,
+    };
+    if s.is_finite() && s > 0.0 {
+        s
+    } else {
+        1.0
     }
 }
 

@@ -17,10 +17,11 @@ pub(crate) mod uniforms;
 #[cfg(feature = "viewer")]
 pub(crate) mod window;
 
-pub use frame::{effective_lights, FramePlan, ScenePlanner, ShadowView};
+pub use frame::{effective_lights, metered_illuminance, FramePlan, ScenePlanner, ShadowView};
 pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 pub use settings::{
-    Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowSettings, View, ViewMode, MAX_CASCADES,
+    Exposure, Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowSettings, Tonemap, View, ViewMode,
+    MAX_CASCADES,
 };
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
 #[cfg(feature = "viewer")]

@@ -1,5 +1,6 @@
 //! What a frame is rendered with: view, shadow and output settings.
 
+pub use crate::math::tonemap::Tonemap;
 use crate::scene::Camera;
 use glam::Vec3;
 
@@ -202,6 +203,22 @@ impl SceneOptions {
     }
 }
 
+/// How bright the scene is drawn: the linear scale applied before tone mapping.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum Exposure {
+    /// Metered from the scene's lights (the default): scale `math::tonemap::KEY_VALUE` / E (an
+    /// 18 % grey card facing the key light lands at middle grey), E the illuminance the lights
+    /// and the ambient term deliver at the centre of the scene's bounds
+    /// (`frame::metered_illuminance`; EV100 `math::tonemap::metered_ev100`), so a scene
+    /// authored in lux and candela and the same scene in unit intensities look alike.
+    #[default]
+    Auto,
+    /// A camera's exposure value at ISO 100: scale 1 / (1.2 · 2^EV100).
+    Ev100(f32),
+    /// A linear scale (1 = the shading's values as they are; tests that want raw values).
+    Scale(f32),
+}
+
 /// Everything that decides one frame's pixels besides the scene.
 #[derive(Clone, Debug)]
 pub struct View {
@@ -217,6 +234,13 @@ pub struct View {
     pub shadow: ShadowSettings,
     /// Ambient intensity Ia.
     pub ambient: Vec3,
+    /// Exposure before tone mapping (the lit image; debug views are not exposed).
+    pub exposure: Exposure,
+    /// Exposure compensation in stops on top of `exposure` (+1 doubles the scale; the viewer's
+    /// `,` and `.` keys).
+    pub exposure_compensation: f32,
+    /// Tone-mapping curve from exposed values to the display (the lit image only).
+    pub tonemap: Tonemap,
     /// Fit the light frustum to this camera instead of `camera` (for stability tests).
     pub shadow_fit_camera: Option<Camera>,
     /// Tint this (instance, primitive) orange in the lit image (the viewer's picked primitive).
@@ -235,6 +259,15 @@ impl View {
         v
     }
 
+    /// The same view with its lit image's raw values: exposure 1, no tone curve (values
+    /// clamped to [0, 1]), as umbra drew before exposure existed; for tests that check levels.
+    pub fn raw_output(mut self) -> Self {
+        self.exposure = Exposure::Scale(1.0);
+        self.exposure_compensation = 0.0;
+        self.tonemap = Tonemap::None;
+        self
+    }
+
     /// A view through `camera` with default settings.
     pub fn new(camera: Camera) -> Self {
         Self {
@@ -244,6 +277,9 @@ impl View {
             mode: ViewMode::Lit,
             shadow: ShadowSettings::default(),
             ambient: Vec3::splat(0.12),
+            exposure: Exposure::Auto,
+            exposure_compensation: 0.0,
+            tonemap: Tonemap::Neutral,
             shadow_fit_camera: None,
             highlight: None,
             shown_light: None,

@@ -76,6 +76,8 @@ pub struct FrameUniform {
     pub camera_forward: Vec4,
     /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
     pub modes: [u32; 4],
+    /// x exposure (linear scale), y tone-mapping operator (`Tonemap::shader_value`).
+    pub output: Vec4,
     /// Lights.
     pub lights: [LightUniform; MAX_LIGHTS],
     /// Shadow views; layer i of the shadow map belongs to view i.
