@@ -175,7 +175,10 @@ struct VsIn {
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) world_position: vec3<f32>,
+    // Centroid: with MSAA a pixel on a silhouette is shaded at a point inside the triangle, so
+    // its shadow lookup and lighting never use a position extrapolated past the edge (without
+    // MSAA the centroid is the pixel centre).
+    @location(0) @interpolate(perspective, centroid) world_position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     // xy: TEXCOORD_0, zw: TEXCOORD_1.
     @location(2) uv: vec4<f32>,

@@ -73,6 +73,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     let mut view = make_view(&scene, &a.view)?;
     let ctx = offscreen_context(a.validation, a.device.clone())?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
+    app::cli::warn_msaa(&a.view, renderer.samples());
     app::cli::apply_budget(&scene, &mut view, &a.view, &mut renderer)?;
     let (w, h) = a.view.size;
     let n = a.repeat.max(1);
@@ -119,6 +120,7 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
     let mut view = make_view(&scene, &a.view)?;
     let ctx = offscreen_context(false, a.device.clone())?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
+    app::cli::warn_msaa(&a.view, renderer.samples());
     app::cli::apply_budget(&scene, &mut view, &a.view, &mut renderer)?;
     let (w, h) = a.view.size;
     let t0 = std::time::Instant::now();
@@ -511,6 +513,7 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
     let mut base = make_view(&scene, &a.view)?;
     let ctx = offscreen_context(false, a.device.clone())?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
+    app::cli::warn_msaa(&a.view, renderer.samples());
     app::cli::apply_budget(&scene, &mut base, &a.view, &mut renderer)?;
     let (w, h) = a.view.size;
     println!(

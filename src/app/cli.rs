@@ -397,6 +397,11 @@ pub struct ViewArgs {
     /// Add a ground plane under the model (to see its shadow).
     #[arg(long)]
     pub ground: bool,
+    /// Multisample anti-aliasing, samples per pixel (1 = off); default 4 on GPUs, 1 on CPU
+    /// devices (lavapipe). A count the device lacks falls to the largest below it, with a
+    /// warning.
+    #[arg(long, value_parser = parse_msaa)]
+    pub msaa: Option<u32>,
 }
 
 /// `WxH`, each side 1..=`MAX_SIDE`.
@@ -422,6 +427,14 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
         ));
     }
     Ok((w, h))
+}
+
+/// 1, 2, 4 or 8.
+fn parse_msaa(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n @ (1 | 2 | 4 | 8)) => Ok(n),
+        _ => Err(format!("'{s}' is not 1, 2, 4 or 8 samples")),
+    }
 }
 
 /// One finite value ≥ 0 (grey) or R,G,B.
@@ -584,6 +597,15 @@ pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
     umbra::render::SceneOptions {
         anisotropy: a.anisotropy,
         culling: !a.no_culling,
+        msaa: a.msaa,
+    }
+}
+
+/// The documented fallback of `--msaa N` on a device without N samples: a warning line naming
+/// the count used.
+pub fn warn_msaa(a: &ViewArgs, samples: u32) {
+    if let Some(n) = a.msaa.filter(|&n| n != samples) {
+        eprintln!("warning: --msaa {n}: the device has no {n}-sample attachments; using {samples}");
     }
 }
 

@@ -15,6 +15,9 @@ pub enum Access {
     ColorAttachment,
     /// Depth attachment read/write (tests and writes).
     DepthAttachment,
+    /// The single-sample target of a depth resolve: the spec synchronises resolves at colour
+    /// attachment output with colour attachment access, whatever the aspect.
+    DepthResolve,
     /// Sampled in a fragment shader (colour textures).
     FragmentSampled,
     /// A depth image sampled in a fragment shader (shadow map lookups).
@@ -52,6 +55,11 @@ pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk:
         Access::DepthAttachment => (
             S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
             A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+        ),
+        Access::DepthResolve => (
+            S::COLOR_ATTACHMENT_OUTPUT,
+            A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
             vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
         ),
         Access::FragmentSampled => (

@@ -171,7 +171,20 @@ impl Image {
         mip_levels: u32,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, GpuError> {
-        Self::create(ctx, name, format, extent, mip_levels, None, usage)
+        Self::create(ctx, name, format, extent, mip_levels, None, usage, 1)
+    }
+
+    /// Creates a named device-local multisampled 2-D image of `samples` samples per pixel (one
+    /// mip level; a render target to resolve from).
+    pub fn new_multisampled(
+        ctx: &Arc<Context>,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        samples: u32,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self, GpuError> {
+        Self::create(ctx, name, format, extent, 1, None, usage, samples)
     }
 
     /// Creates a named device-local 2-D array image of `layers` layers (at least 1), one mip
@@ -184,10 +197,11 @@ impl Image {
         layers: u32,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, GpuError> {
-        Self::create(ctx, name, format, extent, 1, Some(layers.max(1)), usage)
+        Self::create(ctx, name, format, extent, 1, Some(layers.max(1)), usage, 1)
     }
 
-    /// `new` (`array` None) or `new_array` (`array` = its layer count).
+    /// `new` (`array` None) or `new_array` (`array` = its layer count), `samples` per pixel.
+    #[allow(clippy::too_many_arguments)]
     fn create(
         ctx: &Arc<Context>,
         name: &str,
@@ -196,6 +210,7 @@ impl Image {
         mip_levels: u32,
         array: Option<u32>,
         usage: vk::ImageUsageFlags,
+        samples: u32,
     ) -> Result<Self, GpuError> {
         let layers = array.unwrap_or(1);
         let info = vk::ImageCreateInfo::default()
@@ -208,7 +223,7 @@ impl Image {
             })
             .mip_levels(mip_levels.max(1))
             .array_layers(layers)
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(vk::SampleCountFlags::from_raw(samples.max(1)))
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)

@@ -33,6 +33,8 @@ pub struct CameraPass {
     frame_layout: vk::DescriptorSetLayout,
     module: vk::ShaderModule,
     color_format: vk::Format,
+    /// Samples per pixel of the colour and depth attachments (MSAA; 1 = off).
+    samples: u32,
     /// Shader modules of the override variants created so far (by variant index).
     variant_modules: HashMap<usize, vk::ShaderModule>,
     /// Scene pipelines created so far, by (variant index, entry point).
@@ -45,11 +47,13 @@ pub struct CameraPass {
 }
 
 impl CameraPass {
-    /// Creates the pass for `color_format`, with `slots` frame-uniform slots (frames in flight).
+    /// Creates the pass for `color_format` at `samples` per pixel, with `slots` frame-uniform
+    /// slots (frames in flight).
     pub fn new(
         ctx: &Arc<Context>,
         scene: &GpuScene,
         color_format: vk::Format,
+        samples: u32,
         slots: usize,
     ) -> Result<Self, GpuError> {
         let frame_layout = set_layout(ctx, sh::BINDINGS, 0, "frame set layout")?;
@@ -73,6 +77,7 @@ impl CameraPass {
             depth_bias: false,
             depth_test: false,
             blend: ColorBlend::Off,
+            samples,
         };
         let map_pipeline = create_pipeline(ctx, &desc)?;
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, frame_layout, slots)?;
@@ -115,6 +120,7 @@ impl CameraPass {
             frame_layout,
             module,
             color_format,
+            samples,
             variant_modules: HashMap::new(),
             pipelines: HashMap::new(),
             map_pipeline,
@@ -159,13 +165,14 @@ impl CameraPass {
             };
             missing.push((variant, entry, module));
         }
-        let (ctx, layout, color_format) = (&self.ctx, self.layout, self.color_format);
+        let (ctx, layout, color_format, samples) =
+            (&self.ctx, self.layout, self.color_format, self.samples);
         let built: Vec<Result<vk::Pipeline, GpuError>> = std::thread::scope(|s| {
             let threads: Vec<_> = missing
                 .iter()
                 .map(|&(variant, entry, module)| {
                     s.spawn(move || {
-                        scene_pipeline(ctx, layout, color_format, variant, entry, module)
+                        scene_pipeline(ctx, layout, color_format, samples, variant, entry, module)
                     })
                 })
                 .collect();
@@ -249,6 +256,7 @@ impl CameraPass {
         scene: &GpuScene,
         color: vk::ImageView,
         depth: vk::ImageView,
+        resolve: Resolve,
         extent: vk::Extent2D,
         clear: [f32; 4],
         shadow_map_view: bool,
@@ -256,15 +264,31 @@ impl CameraPass {
     ) -> usize {
         let d = &self.ctx.device;
         self.ctx.begin_label(cmd, "camera pass");
-        let color_att = [vk::RenderingAttachmentInfo::default()
+        let mut color_att = vk::RenderingAttachmentInfo::default()
             .image_view(color)
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue {
                 color: vk::ClearColorValue { float32: clear },
-            })];
-        let depth_att = depth_clear_attachment(depth);
+            });
+        let mut depth_att = depth_clear_attachment(depth);
+        if let Some(target) = resolve.color {
+            // The samples are averaged into the target; they need not be kept.
+            color_att = color_att
+                .store_op(vk::AttachmentStoreOp::DONT_CARE)
+                .resolve_mode(vk::ResolveModeFlags::AVERAGE)
+                .resolve_image_view(target)
+                .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+        }
+        if let Some(target) = resolve.depth {
+            // Sample 0 (every device supports it): the depth of the pixel centre's nearest sample.
+            depth_att = depth_att
+                .resolve_mode(vk::ResolveModeFlags::SAMPLE_ZERO)
+                .resolve_image_view(target)
+                .resolve_image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+        }
+        let color_att = [color_att];
         let rendering = vk::RenderingInfo::default()
             .render_area(vk::Rect2D {
                 offset: vk::Offset2D::default(),
@@ -391,11 +415,21 @@ pub struct CameraCull {
     pub highlight: Option<(usize, usize)>,
 }
 
+/// Where a multisampled camera pass resolves to (both None without MSAA).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Resolve {
+    /// The single-sample colour image the samples are averaged into.
+    pub color: Option<vk::ImageView>,
+    /// The single-sample depth image sample 0 is copied into (for depth readback).
+    pub depth: Option<vk::ImageView>,
+}
+
 /// Creates the scene pipeline of shader `variant` (in `module`) with fragment entry `entry`.
 fn scene_pipeline(
     ctx: &Context,
     layout: vk::PipelineLayout,
     color_format: vk::Format,
+    samples: u32,
     variant: usize,
     entry: Entry,
     module: vk::ShaderModule,
@@ -429,6 +463,7 @@ fn scene_pipeline(
                 Entry::Blended => ColorBlend::Over,
                 _ => ColorBlend::Off,
             },
+            samples,
         },
     )
 }

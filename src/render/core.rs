@@ -2,7 +2,7 @@
 //! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
 //! record exactly the same commands, so the window and the capture give the same pixels.
 
-use super::camera_pass::{CameraCull, CameraPass};
+use super::camera_pass::{CameraCull, CameraPass, Resolve, DEPTH_FORMAT};
 use super::frame::{plan_frame, FramePlan};
 use super::gpu_scene::GpuScene;
 use super::settings::{SceneOptions, View, ViewMode};
@@ -49,6 +49,58 @@ impl Attachment {
     }
 }
 
+/// The multisampled colour and depth images a camera pass renders into when MSAA is on; it
+/// resolves them into the target's single-sample images.
+pub struct MsaaTargets {
+    _color: Image,
+    _depth: Image,
+    /// The multisampled colour attachment.
+    pub color: Attachment,
+    /// The multisampled depth attachment.
+    pub depth: Attachment,
+    /// Their size (the window compares it on resize).
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
+    pub extent: vk::Extent2D,
+    /// The colour image's format.
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
+    pub color_format: vk::Format,
+}
+
+impl MsaaTargets {
+    /// Colour (`format`) and depth images of `extent` at `samples` per pixel.
+    pub fn new(
+        ctx: &Arc<Context>,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        samples: u32,
+    ) -> Result<Self, GpuError> {
+        let color = Image::new_multisampled(
+            ctx,
+            "multisampled colour",
+            format,
+            extent,
+            samples,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT,
+        )?;
+        let depth = Image::new_multisampled(
+            ctx,
+            "multisampled depth",
+            DEPTH_FORMAT,
+            extent,
+            samples,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        )?;
+        Ok(Self {
+            color: Attachment::of(&color),
+            depth: Attachment::of(&depth),
+            _color: color,
+            _depth: depth,
+            extent,
+            color_format: format,
+        })
+    }
+}
+
 /// Scene + passes + per-slot uniforms and timestamps.
 pub struct FrameCore {
     /// The context.
@@ -61,6 +113,8 @@ pub struct FrameCore {
     pub shadow: ShadowPass,
     /// Camera pass.
     pub camera: CameraPass,
+    /// Samples per pixel of the camera pass (`SceneOptions::msaa` resolved for the device).
+    pub samples: u32,
     query_pool: vk::QueryPool,
     timestamps_written: Vec<bool>,
     /// World bounds of every draw (the receivers cascades are split over).
@@ -83,7 +137,8 @@ impl FrameCore {
         let gpu = GpuScene::new(ctx, scene, options, origin)?;
         let receiver_bounds = gpu.draws.iter().map(|d| d.world_bounds).collect();
         let shadow = ShadowPass::new(ctx)?;
-        let camera = CameraPass::new(ctx, &gpu, color_format, slots)?;
+        let samples = options.resolved_samples(ctx);
+        let camera = CameraPass::new(ctx, &gpu, color_format, samples, slots)?;
         let query_pool = unsafe {
             ctx.device.create_query_pool(
                 &vk::QueryPoolCreateInfo::default()
@@ -100,6 +155,7 @@ impl FrameCore {
             gpu,
             shadow,
             camera,
+            samples,
             query_pool,
             timestamps_written: vec![false; slots],
             receiver_bounds,
@@ -165,7 +221,9 @@ impl FrameCore {
     }
 
     /// Records the shadow pass and the camera pass with timestamps; leaves `color` as a colour
-    /// attachment and `depth` as a depth attachment. Returns what was drawn.
+    /// attachment and `depth` as a depth attachment. With `msaa` the pass draws into its
+    /// multisampled images and resolves colour into `color` (and depth, sample 0, into `depth`
+    /// when `resolve_depth`). Returns what was drawn.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -175,6 +233,8 @@ impl FrameCore {
         plan: &FramePlan,
         color: &mut Attachment,
         depth: &mut Attachment,
+        msaa: Option<&mut MsaaTargets>,
+        resolve_depth: bool,
         extent: vk::Extent2D,
     ) -> PassCounts {
         let ctx = self.ctx.clone();
@@ -215,7 +275,24 @@ impl FrameCore {
             }
         }
         color.transition(d, cmd, Access::ColorAttachment);
-        depth.transition(d, cmd, Access::DepthAttachment);
+        let (draw_color, draw_depth, resolve) = match msaa {
+            Some(m) => {
+                m.color.transition(d, cmd, Access::ColorAttachment);
+                m.depth.transition(d, cmd, Access::DepthAttachment);
+                if resolve_depth {
+                    depth.transition(d, cmd, Access::DepthResolve);
+                }
+                let resolve = Resolve {
+                    color: Some(color.view),
+                    depth: resolve_depth.then_some(depth.view),
+                };
+                (m.color.view, m.depth.view, resolve)
+            }
+            None => {
+                depth.transition(d, cmd, Access::DepthAttachment);
+                (color.view, depth.view, Resolve::default())
+            }
+        };
         let aspect = extent.width as f32 / extent.height.max(1) as f32;
         let t = (view.camera.fov_y * 0.5).tan();
         let cull = CameraCull {
@@ -232,8 +309,9 @@ impl FrameCore {
             cmd,
             slot,
             &self.gpu,
-            color.view,
-            depth.view,
+            draw_color,
+            draw_depth,
+            resolve,
             extent,
             if view.mode == ViewMode::Overdraw {
                 [0.0, 0.0, 0.0, 1.0]

@@ -30,6 +30,8 @@ pub struct PipelineDesc<'a> {
     pub depth_test: bool,
     /// Colour blending.
     pub blend: ColorBlend,
+    /// Samples per pixel of the attachments (1, or the MSAA count).
+    pub samples: u32,
 }
 
 /// How a pipeline's colour output combines with the attachment.
@@ -75,7 +77,7 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .depth_bias_enable(d.depth_bias)
         .line_width(1.0);
     let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        .rasterization_samples(vk::SampleCountFlags::from_raw(d.samples.max(1)));
     let depth = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(d.depth_test)
         .depth_write_enable(d.depth_test && d.blend != ColorBlend::Over)

@@ -1,7 +1,7 @@
 //! The offscreen renderer: the shared frame core into an image, read back to RGBA8.
 
 use super::camera_pass::DEPTH_FORMAT;
-use super::core::{Attachment, FrameCore};
+use super::core::{Attachment, FrameCore, MsaaTargets};
 use super::frame::FramePlan;
 use super::settings::{SceneOptions, View};
 use crate::gpu::barrier::Access;
@@ -59,6 +59,8 @@ struct Target {
     depth_at: Attachment,
     readback: Buffer,
     depth_readback: Buffer,
+    /// The multisampled images drawn into (resolved into `color`, `depth`) with MSAA.
+    msaa: Option<MsaaTargets>,
 }
 
 /// Renders views of one scene offscreen.
@@ -163,6 +165,11 @@ impl Renderer {
         self.read_depth = on;
     }
 
+    /// Samples per pixel of the camera pass (MSAA; 1 = off).
+    pub fn samples(&self) -> u32 {
+        self.core.samples
+    }
+
     /// Triangles per frame.
     pub fn triangles(&self) -> usize {
         self.core.gpu.triangles
@@ -213,7 +220,14 @@ impl Renderer {
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
+        let samples = self.core.samples;
+        let msaa = if samples > 1 {
+            Some(MsaaTargets::new(ctx, OFFSCREEN_FORMAT, extent, samples)?)
+        } else {
+            None
+        };
         self.target = Some(Target {
+            msaa,
             color_at: Attachment::of(&color),
             depth_at: Attachment::of(&depth),
             color,
@@ -252,6 +266,8 @@ impl Renderer {
             &plan,
             &mut t.color_at,
             &mut t.depth_at,
+            t.msaa.as_mut(),
+            self.read_depth,
             extent,
         );
         t.color_at.transition(d, cmd, Access::TransferSrc);

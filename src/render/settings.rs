@@ -180,6 +180,11 @@ pub struct SceneOptions {
     /// of closed double-sided meshes seen from outside. On by default; off only to measure what
     /// it saves.
     pub culling: bool,
+    /// Multisample anti-aliasing: samples per pixel of the camera pass (1, 2, 4 or 8). `None`:
+    /// 4 on GPUs, 1 on CPU devices (lavapipe, where 4 samples cost
+    /// `README.md`'s measured share of the frame). A count the device lacks falls to the
+    /// largest it has below it (`resolved_samples`).
+    pub msaa: Option<u32>,
 }
 
 impl Default for SceneOptions {
@@ -187,11 +192,29 @@ impl Default for SceneOptions {
         Self {
             anisotropy: None,
             culling: true,
+            msaa: None,
         }
     }
 }
 
 impl SceneOptions {
+    /// The MSAA sample count to use on `ctx`'s device: `msaa` (or the device class's default)
+    /// rounded down to a count its colour and depth attachments both support.
+    pub fn resolved_samples(&self, ctx: &crate::gpu::Context) -> u32 {
+        let cpu = ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU;
+        let wanted = self.msaa.unwrap_or(if cpu { 1 } else { 4 }).clamp(1, 64);
+        let l = &ctx.properties.limits;
+        let supported = l.framebuffer_color_sample_counts & l.framebuffer_depth_sample_counts;
+        let mut n = wanted.next_power_of_two().min(64);
+        if n > wanted {
+            n /= 2;
+        }
+        while n > 1 && !supported.contains(ash::vk::SampleCountFlags::from_raw(n)) {
+            n /= 2;
+        }
+        n.max(1)
+    }
+
     /// The anisotropy to use on `ctx`'s device (1.0 = off), clamped to what it supports.
     pub fn resolved_anisotropy(&self, ctx: &crate::gpu::Context) -> f32 {
         if !ctx.anisotropy {

@@ -210,6 +210,7 @@ fn depth_pipeline(
             depth_bias: true,
             depth_test: true,
             blend: ColorBlend::Off,
+            samples: 1,
         },
     )
 }

@@ -3,7 +3,7 @@
 //! semaphore).
 
 use super::camera_pass::DEPTH_FORMAT;
-use super::core::{Attachment, FrameCore};
+use super::core::{Attachment, FrameCore, MsaaTargets};
 use super::renderer::{copy_to_buffer, rgba_from_readback, transfer_to_host_barrier};
 use super::settings::{SceneOptions, View};
 use super::swapchain::Swapchain;
@@ -58,6 +58,8 @@ pub struct WindowRenderer {
     pub(crate) swapchain: Swapchain,
     frames: Vec<FrameSync>,
     depth: Option<(Image, Attachment)>,
+    /// Multisampled colour and depth (resolved into the swapchain image) with MSAA.
+    msaa: Option<MsaaTargets>,
     frame: usize,
     wanted: (u32, u32),
     screenshot: Option<Buffer>,
@@ -112,6 +114,7 @@ impl WindowRenderer {
             swapchain,
             frames,
             depth: None,
+            msaa: None,
             frame: 0,
             wanted: (width, height),
             screenshot: None,
@@ -135,11 +138,28 @@ impl WindowRenderer {
         let e = self.swapchain.extent;
         if e.width == 0 || e.height == 0 {
             self.depth = None;
+            self.msaa = None;
             return Ok(());
         }
-        if self.depth.as_ref().is_some_and(|(d, _)| d.extent == e) {
+        let samples = self.core.samples;
+        let msaa_ok = samples == 1
+            || self
+                .msaa
+                .as_ref()
+                .is_some_and(|m| m.extent == e && m.color_format == self.swapchain.format);
+        if self.depth.as_ref().is_some_and(|(d, _)| d.extent == e) && msaa_ok {
             return Ok(());
         }
+        self.msaa = if samples > 1 {
+            Some(MsaaTargets::new(
+                &self.core.ctx,
+                self.swapchain.format,
+                e,
+                samples,
+            )?)
+        } else {
+            None
+        };
         let image = Image::new(
             &self.core.ctx,
             "window depth",
@@ -206,7 +226,17 @@ impl WindowRenderer {
         ctx.begin_one_time(cmd)?;
         let casters = self
             .core
-            .record(cmd, f, view, &plan, &mut color, depth, extent)
+            .record(
+                cmd,
+                f,
+                view,
+                &plan,
+                &mut color,
+                depth,
+                self.msaa.as_mut(),
+                false,
+                extent,
+            )
             .casters;
         if want_copy {
             color.transition(d, cmd, Access::TransferSrc);
