@@ -145,7 +145,7 @@ fn lit_surface_matches_blinn_phong_on_cpu() {
     let ctx = context();
     let mut r = Renderer::new(&ctx, &s).unwrap();
     let mut view = View::new(cam).raw_output();
-    view.ambient = Vec3::splat(0.1);
+    view.ambient = Some(Vec3::splat(0.1));
     let (w, h) = (64, 64);
     let f = r.render(&view, w, h).unwrap();
     let m = blinn_phong_params(base, 0.0, 0.6);
@@ -154,7 +154,7 @@ fn lit_surface_matches_blinn_phong_on_cpu() {
         let (o, d) = pixel_ray(&f.plan.clip_from_scene(), px, py, w, h);
         let p = o + d * (-o.z / d.z);
         let v = (eye - p).normalize();
-        let lin = m.ka * view.ambient
+        let lin = m.ka * view.ambient.unwrap()
             + shade_blinn_phong(&m, Vec3::Z, -light_dir, v, Vec3::splat(1.3), 1.0);
         let got = f.image.get_pixel(px, py);
         for c in 0..3 {

@@ -58,9 +58,9 @@ fn linear_at(scene: &Scene, p: Vec3) -> (f32, f32) {
         0.1,
     ))
     .raw_output();
-    v.ambient = Vec3::ZERO;
+    v.ambient = Some(Vec3::ZERO);
     let f = r.render(&v, W, H).unwrap();
-    let exact = ReferenceScene::new(scene).render(&f.plan, W, H, v.ambient);
+    let exact = ReferenceScene::new(scene).render(&f.plan, W, H, f.plan.ambient);
     assert_validation_clean(&ctx);
     let (x, y) = project(&f.plan.clip_from_world, p, W, H).unwrap();
     let (x, y) = (x as u32, y as u32);

@@ -109,7 +109,7 @@ fn judge(scene: &Scene) -> (Judged, RenderedFrame) {
     r.set_read_depth(true);
     let v = view();
     let f = r.render(&v, W, H).unwrap();
-    let exact = ReferenceScene::new(scene).render(&f.plan, W, H, v.ambient);
+    let exact = ReferenceScene::new(scene).render(&f.plan, W, H, f.plan.ambient);
     let c = classify(&f.image, f.depth.as_deref().unwrap(), &f.plan, &exact);
     let mut j = Judged {
         judged: 0,

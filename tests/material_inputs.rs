@@ -96,10 +96,10 @@ fn emissive_strength_scales_the_emissive_factor() {
         0.1,
     ))
     .raw_output();
-    v.ambient = Vec3::ZERO;
+    v.ambient = Some(Vec3::ZERO);
     let (w, h) = (240, 120);
     let f = r.render(&v, w, h).unwrap();
-    let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, v.ambient);
+    let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, f.plan.ambient);
     assert_validation_clean(&ctx);
     save(&f.image, "emissive_strength.png");
     for (i, want) in [base, base * 4.0, base].iter().enumerate() {
@@ -169,7 +169,7 @@ fn vertex_colours_multiply_the_base_colour() {
     .raw_output();
     let (w, h) = (160, 160);
     let f = r.render(&v, w, h).unwrap();
-    let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, v.ambient);
+    let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, f.plan.ambient);
     assert_validation_clean(&ctx);
     save(&f.image, "vertex_colours.png");
     let factor = Vec3::new(1.0, 1.0, 0.5);
@@ -272,7 +272,7 @@ fn textures_read_the_texcoord_set_they_name() {
     .raw_output();
     let (w, h) = (300, 120);
     let f = r.render(&v, w, h).unwrap();
-    let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, v.ambient);
+    let exact = ReferenceScene::new(&scene).render(&f.plan, w, h, f.plan.ambient);
     assert_validation_clean(&ctx);
     save(&f.image, "texcoord_sets.png");
     // Quads 0 and 1 show the checker through TEXCOORD_1 (v = 1 at the bottom: blue, white below,

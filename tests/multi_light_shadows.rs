@@ -58,7 +58,7 @@ fn judge_with(scene: &Scene, base: &View, light: usize, name: &str, cube_face: u
         &r.render(&lit, W, H).unwrap().image,
         &format!("{name}_lit.png"),
     );
-    let exact = ReferenceScene::new(scene).render(&f.plan, W, H, v.ambient);
+    let exact = ReferenceScene::new(scene).render(&f.plan, W, H, f.plan.ambient);
     let c = classify(&f.image, f.depth.as_deref().unwrap(), &f.plan, &exact);
     let mut s = Score {
         judged: 0,

@@ -71,7 +71,7 @@ fn measure(map: u32) -> (umbra::reference::Metrics, image::RgbaImage) {
     let lit = r.render(&view, w, h).unwrap();
     view.mode = ViewMode::Shadow;
     let shadow = r.render(&view, w, h).unwrap();
-    let reference = ReferenceScene::new(&scene).render(&lit.plan, w, h, view.ambient);
+    let reference = ReferenceScene::new(&scene).render(&lit.plan, w, h, lit.plan.ambient);
     let (m, diff) = compare(
         &lit.image,
         &shadow.image,

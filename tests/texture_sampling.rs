@@ -107,7 +107,7 @@ fn render_scene(
 ) -> (image::RgbaImage, image::RgbaImage) {
     let mut r = Renderer::new(ctx, &scene).unwrap();
     let f = r.render(&view, N, N).unwrap();
-    let exact = ReferenceScene::new(&scene).render(&f.plan, N, N, view.ambient);
+    let exact = ReferenceScene::new(&scene).render(&f.plan, N, N, f.plan.ambient);
     save(&f.image, &format!("sampler_{name}.png"));
     (f.image, exact.image)
 }

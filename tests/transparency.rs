@@ -100,7 +100,7 @@ fn a_half_transparent_quad_blends_over_a_known_background() {
     let v = front_view();
     let f = r.render(&v, W, H).unwrap();
     save(&f.image, "blend_over.png");
-    let exact = ReferenceScene::new(&s).render(&f.plan, W, H, v.ambient);
+    let exact = ReferenceScene::new(&s).render(&f.plan, W, H, f.plan.ambient);
     assert_validation_clean(&ctx);
     // Red over the background left of centre, over the clear colour right of it.
     let y = H / 2;
@@ -151,7 +151,7 @@ fn three_overlapping_quads_are_sorted_back_to_front() {
     let v = front_view();
     let f = r.render(&v, W, H).unwrap();
     save(&f.image, "blend_three_quads.png");
-    let exact = ReferenceScene::new(&s).render(&f.plan, W, H, v.ambient);
+    let exact = ReferenceScene::new(&s).render(&f.plan, W, H, f.plan.ambient);
     assert_validation_clean(&ctx);
     // Where all three overlap: the back one over the clear colour, then the middle, then front.
     let all = over(quads[0].0, over(quads[1].0, over(quads[2].0, CLEAR)));
@@ -176,7 +176,7 @@ fn three_overlapping_quads_are_sorted_back_to_front() {
     v.exposure = Default::default();
     v.tonemap = Default::default();
     let f = r.render(&v, W, H).unwrap();
-    let exact = ReferenceScene::new(&s).render(&f.plan, W, H, v.ambient);
+    let exact = ReferenceScene::new(&s).render(&f.plan, W, H, f.plan.ambient);
     let (gpu, reference) = (f.image.get_pixel(x, y).0, exact.image.get_pixel(x, y).0);
     let d = (0..3).map(|k| gpu[k].abs_diff(reference[k])).max().unwrap();
     eprintln!("tone-mapped: GPU {gpu:?}, reference {reference:?} where all three overlap");
@@ -237,7 +237,7 @@ fn blended_surfaces_cast_where_alpha_reaches_one_half() {
         v.mode = ViewMode::Shadow;
         let f = r.render(&v, 320, 240).unwrap();
         save(&f.image, &format!("blend_shadow_{blend}.png"));
-        let exact = ReferenceScene::new(&s).render(&f.plan, 320, 240, v.ambient);
+        let exact = ReferenceScene::new(&s).render(&f.plan, 320, 240, f.plan.ambient);
         let c = classify(&f.image, f.depth.as_deref().unwrap(), &f.plan, &exact);
         assert_validation_clean(&ctx);
         let (mut judged, mut wrong, mut shadow) = (0usize, 0usize, 0usize);

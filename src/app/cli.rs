@@ -148,7 +148,7 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
     } else if let Some(s) = umbra::scene::synthetic::by_name(spec) {
         s
     } else {
-        bail!("{spec}: no such file, and not demo, town, grazing, stability, double-sided, room, sun-and-spot, two-suns or spheres:N");
+        bail!("{spec}: no such file, and not demo, town, grazing, stability, double-sided, room, sun-and-spot, two-suns, lux-yard or spheres:N");
     };
     for w in &s.warnings {
         print_warning(&s.name, w);
@@ -306,8 +306,8 @@ pub struct ViewArgs {
     /// primitives), `town` (2 km across, cameras at eye height and on a roof), `grazing` (a sun 6° above the
     /// horizon over posts, spheres and crates), `stability` (a thin wall, a box, spheres and a
     /// torus: the stability suite's scene), `room` (a point light in a furnished room),
-    /// `sun-and-spot` and `two-suns` (a yard where two lights cast) or `spheres:N` (an N×N grid of
-    /// 1,200-triangle spheres).
+    /// `sun-and-spot` and `two-suns` (a yard where two lights cast), `lux-yard` (the yard lit in
+    /// lux and candela) or `spheres:N` (an N×N grid of 1,200-triangle spheres).
     #[arg(long)]
     pub synthetic: Option<String>,
     /// Image size WxH.
@@ -337,10 +337,10 @@ pub struct ViewArgs {
     #[arg(long, default_value = "auto", value_parser = parse_exposure, allow_hyphen_values = true)]
     pub exposure: Exposure,
     /// Ambient intensity Ia (the formula's ka·Ia term): one value for grey or R,G,B, in the
-    /// units of the scene's lights (0.12 suits unit-intensity lights; a scene lit in lux wants
-    /// a sky's worth, e.g. 1000).
-    #[arg(long, default_value = "0.12", value_parser = parse_ambient)]
-    pub ambient: Vec3,
+    /// units of the scene's lights. Default: 7 % of the direct illuminance auto exposure
+    /// meters (0.12 under the default sun), so it follows the lights' units.
+    #[arg(long, value_parser = parse_ambient)]
+    pub ambient: Option<Vec3>,
     /// Tone-mapping curve of the lit image: Khronos PBR Neutral, ACES (Hill's fit), or none
     /// (exposed values clamped).
     #[arg(long, value_enum, default_value = "neutral")]
@@ -578,7 +578,7 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
         (None, None) => demo_scene(),
         (None, Some(name)) => umbra::scene::synthetic::by_name(name).ok_or_else(|| {
             anyhow!(
-                "--synthetic {name}: expected double-sided, town, grazing, stability, room, sun-and-spot, two-suns or spheres:N with N in 1..=256"
+                "--synthetic {name}: expected double-sided, town, grazing, stability, room, sun-and-spot, two-suns, lux-yard or spheres:N with N in 1..=256"
             )
         })?,
     };

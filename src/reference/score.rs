@@ -40,7 +40,7 @@ pub fn score(
     renderer.set_read_depth(false);
     let shadow = shadow?;
     let t0 = std::time::Instant::now();
-    let frame = exact.get_or_insert_with(|| reference.render(&lit.plan, w, h, view.ambient));
+    let frame = exact.get_or_insert_with(|| reference.render(&lit.plan, w, h, lit.plan.ambient));
     let reference_ms = t0.elapsed().as_secs_f64() * 1e3;
     let depth = shadow.depth.as_deref().unwrap_or(&[]);
     let classified = classify(&shadow.image, depth, &lit.plan, frame);

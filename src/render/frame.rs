@@ -3,7 +3,10 @@
 //! map, the camera projection, and the frame uniform block.
 
 use super::gpu_scene::Viewpoint;
-use super::settings::{Exposure, Pcf, ShadowFit, ShadowSettings, Tonemap, View, MAX_CASCADES};
+use super::settings::{
+    Exposure, Pcf, ShadowFit, ShadowSettings, Tonemap, View, AUTO_AMBIENT, MAX_CASCADES,
+    UNIT_AMBIENT,
+};
 use super::shadow_pass::CasterPlan;
 use super::uniforms::{
     FrameUniform, LightUniform, ShadowViewUniform, MAX_LIGHTS, MAX_SHADOW_VIEWS,
@@ -248,6 +251,8 @@ pub struct FramePlan {
     pub exposure: f32,
     /// The tone-mapping curve of the lit image.
     pub tonemap: Tonemap,
+    /// The ambient intensity Ia this frame is shaded with (`View::ambient` resolved).
+    pub ambient: Vec3,
     /// What every position and matrix of this plan is relative to (world = plan + origin):
     /// [`crate::scene::Scene::render_origin`] when planned by the renderer, zero from
     /// [`plan_frame`].
@@ -433,12 +438,20 @@ pub fn plan_frame(
         .filter(|&i| has_views(i))
         .or_else(|| views.first().map(|v| v.light));
     let shadows_on = view.shadow.enabled && shadow_light.is_some();
-    let exposure = exposure_scale(view.exposure, &lights, view.ambient, bounds)
+    let ambient = view.ambient.unwrap_or_else(|| {
+        let direct = metered_illuminance(&lights, Vec3::ZERO, receivers, bounds);
+        Vec3::splat(if direct.is_finite() && direct > 0.0 {
+            AUTO_AMBIENT * direct
+        } else {
+            UNIT_AMBIENT
+        })
+    });
+    let exposure = exposure_scale(view.exposure, &lights, ambient, receivers, bounds)
         * view.exposure_compensation.clamp(-64.0, 64.0).exp2();
     let mut u = FrameUniform {
         clip_from_world,
         camera_position: view.camera.position().extend(1.0),
-        ambient: view.ambient.extend(0.0),
+        ambient: ambient.extend(0.0),
         shadow: Vec4::new(
             size as f32,
             view.shadow.normal_offset,
@@ -521,49 +534,80 @@ pub fn plan_frame(
         origin: Vec3::ZERO,
         exposure,
         tonemap: view.tonemap,
+        ambient,
     }
 }
 
-/// The illuminance (lux, as luminance) that auto exposure meters: at the centre of `bounds`, the
-/// sum over `lights` of what each delivers to a surface facing it (a directional light its
-/// intensity; a point or spot light I / d², range-windowed, the spot's cone ignored, d at least a
-/// quarter of the bounds' half-diagonal so that a light at the centre does not blind the meter)
-/// plus the ambient term.
-pub fn metered_illuminance(lights: &[Light], ambient: Vec3, bounds: &Aabb) -> f32 {
+/// The illuminance (lux, as luminance) that auto exposure meters: the median, over the
+/// `receivers` (each draw's world box; the centre of `bounds` when there are none), of what the
+/// lights deliver at the box's centre to a surface facing each (a directional light its
+/// intensity; a point or spot light I / d², range-windowed, the spot's cone ignored, d at least
+/// the box's half-diagonal, so a lamp inside a room is metered on the room's walls), plus the
+/// ambient term. The median keeps one receiver next to a lamp from darkening the whole frame.
+pub fn metered_illuminance(
+    lights: &[Light],
+    ambient: Vec3,
+    receivers: &[Aabb],
+    bounds: &Aabb,
+) -> f32 {
     let luma = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
-    let (centre, half) = if bounds.is_empty() {
-        (Vec3::ZERO, 0.0)
-    } else {
-        (bounds.center(), 0.5 * bounds.diagonal())
-    };
-    let min_d2 = (0.25 * half).powi(2).max(1e-12);
-    let direct: f32 = lights
-        .iter()
-        .map(|l| {
-            let i = luma(l.color) * l.intensity.max(0.0);
-            match l.kind {
-                LightKind::Directional => i,
-                _ => {
-                    let d2 = l.position.distance_squared(centre).max(min_d2);
-                    let window = l.range.map_or(1.0, |r| {
-                        let q = d2 / (r * r).max(1e-30);
-                        (1.0 - q * q).clamp(0.0, 1.0)
-                    });
-                    i * window / d2
+    let at = |centre: Vec3, radius: f32| -> f32 {
+        let min_d2 = (radius * radius).max(1e-12);
+        lights
+            .iter()
+            .map(|l| {
+                let i = luma(l.color) * l.intensity.max(0.0);
+                match l.kind {
+                    LightKind::Directional => i,
+                    _ => {
+                        let d2 = l.position.distance_squared(centre).max(min_d2);
+                        let window = l.range.map_or(1.0, |r| {
+                            let q = d2 / (r * r).max(1e-30);
+                            (1.0 - q * q).clamp(0.0, 1.0)
+                        });
+                        i * window / d2
+                    }
                 }
-            }
-        })
-        .sum();
-    direct + luma(ambient.max(Vec3::ZERO))
+            })
+            .sum()
+    };
+    let mut values: Vec<f32> = receivers
+        .iter()
+        .filter(|b| !b.is_empty())
+        .map(|b| at(b.center(), 0.5 * b.diagonal()))
+        .filter(|e| e.is_finite())
+        .collect();
+    if values.is_empty() {
+        let (c, r) = if bounds.is_empty() {
+            (Vec3::ZERO, 0.0)
+        } else {
+            (bounds.center(), 0.5 * bounds.diagonal())
+        };
+        values.push(at(c, r));
+    }
+    values.sort_by(f32::total_cmp);
+    let n = values.len();
+    let median = if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    };
+    median + luma(ambient.max(Vec3::ZERO))
 }
 
 /// The linear scale `exposure` sets for a scene lit by `lights` and `ambient` within `bounds`:
 /// auto meters [`metered_illuminance`] (scale 1 where nothing lights the scene).
-pub fn exposure_scale(exposure: Exposure, lights: &[Light], ambient: Vec3, bounds: &Aabb) -> f32 {
+pub fn exposure_scale(
+    exposure: Exposure,
+    lights: &[Light],
+    ambient: Vec3,
+    receivers: &[Aabb],
+    bounds: &Aabb,
+) -> f32 {
     use crate::math::tonemap::{exposure_from_ev100, metered_ev100};
     let s = match exposure {
         Exposure::Auto => {
-            let e = metered_illuminance(lights, ambient, bounds);
+            let e = metered_illuminance(lights, ambient, receivers, bounds);
             if e.is_finite() && e > 0.0 {
                 exposure_from_ev100(metered_ev100(e))
             } else {
@@ -717,6 +761,42 @@ fn frame_variant_bits(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn metering_takes_the_median_receiver_and_walls_for_an_inside_lamp() {
+        let lamp = Light {
+            kind: LightKind::Point,
+            position: Vec3::ZERO,
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            intensity: 100.0,
+            casts_shadows: false,
+            range: None,
+        };
+        let room = Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0));
+        // A lamp inside a room is metered at the room's half-diagonal: 100 / 75.
+        let e = metered_illuminance(&[lamp], Vec3::ZERO, &[room], &room);
+        assert!((e - 100.0 / 75.0).abs() < 1e-5, "{e}");
+        // Three small boxes 1, 2 and 10 m away: the median is the one 2 m away (100 / 4).
+        let boxes: Vec<Aabb> = [1.0f32, 2.0, 10.0]
+            .iter()
+            .map(|&d| Aabb::new(Vec3::new(d, -0.01, -0.01), Vec3::new(d, 0.01, 0.01)))
+            .collect();
+        let e = metered_illuminance(&[lamp], Vec3::splat(0.5), &boxes, &room);
+        assert!((e - (25.0 + 0.5)).abs() < 1e-3, "{e}");
+        // A sun meters its intensity wherever the receivers are; the default ambient is 7 % of it.
+        let sun = Light::sun(Vec3::NEG_Y, 3.0);
+        let v = View::new(crate::scene::Camera::look_at(
+            Vec3::new(0.0, 2.0, 8.0),
+            Vec3::ZERO,
+            0.8,
+            0.1,
+        ));
+        let p = plan_frame(&[sun], &room, &boxes, &v, 1.5, 100, false);
+        assert!((p.ambient - Vec3::splat(AUTO_AMBIENT * 3.0)).length() < 1e-5);
+        let k = crate::math::tonemap::KEY_VALUE;
+        assert!((p.exposure - k / (3.0 * (1.0 + AUTO_AMBIENT))).abs() < 1e-5);
+    }
     use crate::scene::demo::demo_scene;
 
     #[test]

@@ -21,7 +21,7 @@ pub use frame::{effective_lights, metered_illuminance, FramePlan, ScenePlanner, 
 pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 pub use settings::{
     Exposure, Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowSettings, Tonemap, View, ViewMode,
-    MAX_CASCADES,
+    AUTO_AMBIENT, MAX_CASCADES, UNIT_AMBIENT,
 };
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
 #[cfg(feature = "viewer")]

@@ -226,6 +226,14 @@ impl SceneOptions {
     }
 }
 
+/// The default ambient as a fraction of the metered direct illuminance (the demo's 0.12 under
+/// its sun of 1.7).
+pub const AUTO_AMBIENT: f32 = 0.07;
+
+/// The ambient umbra used before it followed the lights (`View::raw_output`), and where nothing
+/// lights the scene.
+pub const UNIT_AMBIENT: f32 = 0.12;
+
 /// How bright the scene is drawn: the linear scale applied before tone mapping.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum Exposure {
@@ -255,8 +263,10 @@ pub struct View {
     pub mode: ViewMode,
     /// Shadow settings.
     pub shadow: ShadowSettings,
-    /// Ambient intensity Ia.
-    pub ambient: Vec3,
+    /// Ambient intensity Ia, in the lights' units. `None` (the default): [`AUTO_AMBIENT`] of
+    /// the direct illuminance auto exposure meters (`frame::metered_illuminance`), so the fill
+    /// follows the lights whatever their units (0.12 under the default sun of 1.7).
+    pub ambient: Option<Vec3>,
     /// Exposure before tone mapping (the lit image; debug views are not exposed).
     pub exposure: Exposure,
     /// Exposure compensation in stops on top of `exposure` (+1 doubles the scale; the viewer's
@@ -283,10 +293,12 @@ impl View {
     }
 
     /// The same view with its lit image's raw values: exposure 1, no tone curve (values
-    /// clamped to [0, 1]), as umbra drew before exposure existed; for tests that check levels.
+    /// clamped to [0, 1]) and, unless set, an ambient of [`UNIT_AMBIENT`], as umbra drew before
+    /// exposure existed; for tests that check levels.
     pub fn raw_output(mut self) -> Self {
         self.exposure = Exposure::Scale(1.0);
         self.exposure_compensation = 0.0;
+        self.ambient = self.ambient.or(Some(Vec3::splat(UNIT_AMBIENT)));
         self.tonemap = Tonemap::None;
         self
     }
@@ -299,7 +311,7 @@ impl View {
             sun_intensity: None,
             mode: ViewMode::Lit,
             shadow: ShadowSettings::default(),
-            ambient: Vec3::splat(0.12),
+            ambient: None,
             exposure: Exposure::Auto,
             exposure_compensation: 0.0,
             tonemap: Tonemap::Neutral,

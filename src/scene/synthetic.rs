@@ -422,13 +422,43 @@ pub fn two_suns_scene() -> Scene {
     yard_scene("two suns", vec![a, b])
 }
 
+/// The yard lit in physical units, as Bevy's MixedLightingExample is: a sun of 10,000 lux (light
+/// 0) and two warm lamps of 1,000 cd 1.2 m above the ground (lights 1, 2). At raw values it is a
+/// white sheet; auto exposure brings it to the display (`umbra render --synthetic lux-yard`; a
+/// sky's ambient, `--ambient 800`, lifts its shadows).
+pub fn lux_yard_scene() -> Scene {
+    let sun = Light {
+        color: Vec3::new(1.0, 0.96, 0.9),
+        ..Light::sun(Vec3::new(0.4, -0.8, 0.3), 1e4)
+    };
+    let lamp = |position: Vec3| Light {
+        kind: LightKind::Point,
+        position,
+        direction: Vec3::NEG_Y,
+        color: Vec3::new(1.0, 0.8, 0.6),
+        intensity: 1e3,
+        casts_shadows: true,
+        range: None,
+    };
+    yard_scene(
+        "yard in lux",
+        vec![
+            sun,
+            lamp(Vec3::new(-1.6, 1.2, 1.6)),
+            lamp(Vec3::new(2.2, 1.2, 0.6)),
+        ],
+    )
+}
+
 /// The generated scene called `name`: `double-sided`, `town`, `grazing`, `stability`, `room`,
-/// `sun-and-spot`, `two-suns` or `spheres:N` (1 ≤ N ≤ 256); `None` for any other name.
+/// `sun-and-spot`, `two-suns`, `lux-yard` or `spheres:N` (1 ≤ N ≤ 256); `None` for any other
+/// name.
 pub fn by_name(name: &str) -> Option<Scene> {
     match name {
         "room" => Some(room_scene()),
         "sun-and-spot" => Some(sun_and_spot_scene()),
         "two-suns" => Some(two_suns_scene()),
+        "lux-yard" => Some(lux_yard_scene()),
         "double-sided" => Some(double_sided_scene()),
         "town" => Some(town_scene()),
         "grazing" => Some(grazing_scene()),

@@ -188,7 +188,7 @@ pub fn classify_view(
 ) -> Result<(Counts, RenderedFrame), GpuError> {
     let f = shadow_frame(renderer, view, size)?;
     let frame =
-        exact.get_or_insert_with(|| reference.render(&f.plan, size.0, size.1, view.ambient));
+        exact.get_or_insert_with(|| reference.render(&f.plan, size.0, size.1, f.plan.ambient));
     let c = classify(&f.image, f.depth.as_deref().unwrap_or(&[]), &f.plan, frame);
     Ok((Counts::of(&c, frame), f))
 }
