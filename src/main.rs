@@ -481,6 +481,7 @@ fn inspect(a: app::cli::InspectArgs) -> anyhow::Result<()> {
     let mut report = umbra::scene::inspect::document_report(&a.scene, &scene)?;
     let (w, h) = a.view.size;
     report["shadow_plan"] = umbra::render::report::plan_report(&scene, &view, w, h);
+    report["exposure"] = umbra::render::report::exposure_report(&scene, &view, w, h);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

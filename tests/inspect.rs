@@ -265,6 +265,17 @@ fn every_corpus_model_validates_against_the_schema() {
         let t = &r["totals"];
         assert!(t["triangles"].as_u64().unwrap() > 0, "{}", m.display());
         assert!(t["draw_calls"].as_u64().unwrap() > 0, "{}", m.display());
+        // Auto exposure maps what it metered to the key value (an 18 % card at middle grey).
+        let e = &r["exposure"];
+        let (lux, scale) = (
+            e["metered_lux"].as_f64().unwrap(),
+            e["scale"].as_f64().unwrap(),
+        );
+        assert!(
+            lux > 0.0 && (lux * scale - umbra::math::tonemap::KEY_VALUE as f64).abs() < 1e-3,
+            "{}: {e}",
+            m.display()
+        );
         // A shadow view, or no light that casts (Cubes.glb: a point light only; point lights
         // cast no shadow yet).
         let p = &r["shadow_plan"];

@@ -129,6 +129,20 @@ pub fn format_report(r: &Value, md: bool) -> String {
         out += &t.render(md);
     }
 
+    let e = &r["exposure"];
+    if !e.is_null() {
+        out += &h("Exposure (default view)");
+        out += &format!(
+            "{}: metered {} lux, EV100 {}, scale {}, ambient {}, tone curve {}\n",
+            cell(&e["mode"]),
+            cell(&e["metered_lux"]),
+            cell(&e["ev100"]),
+            cell(&e["scale"]),
+            cell(&e["ambient"][0]),
+            cell(&e["tonemap"])
+        );
+    }
+
     let p = &r["shadow_plan"];
     out += &h("Shadow plan (default view)");
     if p["light"].is_null() {
