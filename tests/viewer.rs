@@ -94,35 +94,45 @@ fn umbra(args: &[&str], display: Option<&str>) -> (bool, String) {
 #[test]
 fn viewer_screenshot_matches_offscreen_render() {
     let x = Xvfb::start();
-    let shot = out("viewer_shot.png");
-    let offscreen = out("viewer_offscreen.png");
-    let common = ["--size", "320x240", "--sun-dir=-0.6,-0.5,-0.4"];
-    let mut args = vec![
-        "view",
-        "--frames",
-        "30",
-        "--screenshot",
-        shot.to_str().unwrap(),
-        "--validation",
-    ];
-    args.extend(common);
-    let (ok, log) = umbra(&args, Some(&x.display));
-    assert!(ok, "viewer failed:\n{log}");
-    let mut args = vec!["render", "-o", offscreen.to_str().unwrap(), "--validation"];
-    args.extend(common);
-    let (ok, log) = umbra(&args, None);
-    assert!(ok, "render failed:\n{log}");
-    let a = image::open(&shot).unwrap().to_rgba8();
-    let b = image::open(&offscreen).unwrap().to_rgba8();
-    assert_eq!(a.dimensions(), (320, 240));
-    assert_eq!(a.dimensions(), b.dimensions());
-    let (p, f) = (psnr(&b, &a), flip(&b, &a));
-    eprintln!("viewer vs offscreen: PSNR {p:.1} dB, FLIP {f:.5}");
-    // Same passes, same plan: identical up to the camera reconstructed by the controller.
-    assert!(
-        p > 40.0 && f < 0.01,
-        "viewer and offscreen differ: PSNR {p:.1} dB, FLIP {f:.4}"
-    );
+    // Without and with MSAA (4 samples: lavapipe's only count above 1; the window resolves
+    // into the swapchain image, the renderer into its own).
+    for msaa in ["1", "4"] {
+        let shot = out(&format!("viewer_shot_msaa{msaa}.png"));
+        let offscreen = out(&format!("viewer_offscreen_msaa{msaa}.png"));
+        let common = [
+            "--size",
+            "320x240",
+            "--sun-dir=-0.6,-0.5,-0.4",
+            "--msaa",
+            msaa,
+        ];
+        let mut args = vec![
+            "view",
+            "--frames",
+            "30",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--validation",
+        ];
+        args.extend(common);
+        let (ok, log) = umbra(&args, Some(&x.display));
+        assert!(ok, "viewer failed:\n{log}");
+        let mut args = vec!["render", "-o", offscreen.to_str().unwrap(), "--validation"];
+        args.extend(common);
+        let (ok, log) = umbra(&args, None);
+        assert!(ok, "render failed:\n{log}");
+        let a = image::open(&shot).unwrap().to_rgba8();
+        let b = image::open(&offscreen).unwrap().to_rgba8();
+        assert_eq!(a.dimensions(), (320, 240));
+        assert_eq!(a.dimensions(), b.dimensions());
+        let (p, f) = (psnr(&b, &a), flip(&b, &a));
+        eprintln!("viewer vs offscreen, --msaa {msaa}: PSNR {p:.1} dB, FLIP {f:.5}");
+        // Same passes, same plan: identical up to the camera reconstructed by the controller.
+        assert!(
+            p > 40.0 && f < 0.01,
+            "viewer and offscreen differ at --msaa {msaa}: PSNR {p:.1} dB, FLIP {f:.4}"
+        );
+    }
 }
 
 #[test]
