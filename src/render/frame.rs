@@ -253,6 +253,9 @@ pub struct FramePlan {
     pub tonemap: Tonemap,
     /// The ambient intensity Ia this frame is shaded with (`View::ambient` resolved).
     pub ambient: Vec3,
+    /// What auto exposure metered for this frame ([`metered_illuminance`] with `ambient`), used
+    /// or not.
+    pub metered_lux: f32,
     /// What every position and matrix of this plan is relative to (world = plan + origin):
     /// [`crate::scene::Scene::render_origin`] when planned by the renderer, zero from
     /// [`plan_frame`].
@@ -438,15 +441,17 @@ pub fn plan_frame(
         .filter(|&i| has_views(i))
         .or_else(|| views.first().map(|v| v.light));
     let shadows_on = view.shadow.enabled && shadow_light.is_some();
+    // Metered once: the default ambient follows the direct part, auto exposure the sum.
+    let direct = metered_illuminance(&lights, Vec3::ZERO, receivers, bounds);
     let ambient = view.ambient.unwrap_or_else(|| {
-        let direct = metered_illuminance(&lights, Vec3::ZERO, receivers, bounds);
         Vec3::splat(if direct.is_finite() && direct > 0.0 {
             AUTO_AMBIENT * direct
         } else {
             UNIT_AMBIENT
         })
     });
-    let exposure = exposure_scale(view.exposure, &lights, ambient, receivers, bounds)
+    let metered_lux = direct + luminance(ambient.max(Vec3::ZERO));
+    let exposure = exposure_scale(view.exposure, metered_lux)
         * view.exposure_compensation.clamp(-64.0, 64.0).exp2();
     let mut u = FrameUniform {
         clip_from_world,
@@ -535,6 +540,7 @@ pub fn plan_frame(
         exposure,
         tonemap: view.tonemap,
         ambient,
+        metered_lux,
     }
 }
 
@@ -550,13 +556,12 @@ pub fn metered_illuminance(
     receivers: &[Aabb],
     bounds: &Aabb,
 ) -> f32 {
-    let luma = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     let at = |centre: Vec3, radius: f32| -> f32 {
         let min_d2 = (radius * radius).max(1e-12);
         lights
             .iter()
             .map(|l| {
-                let i = luma(l.color) * l.intensity.max(0.0);
+                let i = luminance(l.color) * l.intensity.max(0.0);
                 match l.kind {
                     LightKind::Directional => i,
                     _ => {
@@ -592,24 +597,22 @@ pub fn metered_illuminance(
     } else {
         0.5 * (values[n / 2 - 1] + values[n / 2])
     };
-    median + luma(ambient.max(Vec3::ZERO))
+    median + luminance(ambient.max(Vec3::ZERO))
 }
 
-/// The linear scale `exposure` sets for a scene lit by `lights` and `ambient` within `bounds`:
-/// auto meters [`metered_illuminance`] (scale 1 where nothing lights the scene).
-pub fn exposure_scale(
-    exposure: Exposure,
-    lights: &[Light],
-    ambient: Vec3,
-    receivers: &[Aabb],
-    bounds: &Aabb,
-) -> f32 {
+/// Rec. 709 luminance of a linear colour.
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// The linear scale `exposure` sets for a scene whose auto exposure metered `metered_lux`
+/// ([`metered_illuminance`]; scale 1 where nothing lights the scene).
+pub fn exposure_scale(exposure: Exposure, metered_lux: f32) -> f32 {
     use crate::math::tonemap::{exposure_from_ev100, metered_ev100};
     let s = match exposure {
         Exposure::Auto => {
-            let e = metered_illuminance(lights, ambient, receivers, bounds);
-            if e.is_finite() && e > 0.0 {
-                exposure_from_ev100(metered_ev100(e))
+            if metered_lux.is_finite() && metered_lux > 0.0 {
+                exposure_from_ev100(metered_ev100(metered_lux))
             } else {
                 1.0
             }

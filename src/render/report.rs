@@ -30,15 +30,6 @@ fn inside_xy(b: &Aabb, clip: &Mat4) -> bool {
 pub fn exposure_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
     let planner = super::frame::ScenePlanner::new(scene);
     let plan = planner.plan(view, w, h);
-    let lights = super::frame::effective_lights(&scene.lights, view);
-    let origin = scene.render_origin();
-    let rebased: Vec<_> = lights.iter().map(|l| l.rebased(origin)).collect();
-    let bounds = planner
-        .receivers()
-        .iter()
-        .fold(Aabb::EMPTY, |b, r| b.union(r));
-    let metered =
-        super::frame::metered_illuminance(&rebased, plan.ambient, planner.receivers(), &bounds);
     let mode = match view.exposure {
         super::settings::Exposure::Auto => "auto".to_string(),
         super::settings::Exposure::Ev100(ev) => format!("EV100 {ev}"),
@@ -46,7 +37,7 @@ pub fn exposure_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
     };
     json!({
         "mode": mode,
-        "metered_lux": metered,
+        "metered_lux": plan.metered_lux,
         "ev100": crate::math::tonemap::ev100_from_exposure(plan.exposure),
         "scale": plan.exposure,
         "compensation_ev": view.exposure_compensation,
