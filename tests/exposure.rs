@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::gltf_builder::{Builder, Container, F32, U16};
+use common::gltf_builder::{Builder, Container, U16};
 use common::*;
 use glam::{Quat, Vec3};
 use serde_json::{json, Value};
@@ -30,7 +30,6 @@ fn mesh(b: &mut Builder, name: &str, p: &Primitive, material: usize) -> usize {
     let pos = b.floats(&flat(&p.positions), 3, "VEC3");
     let nrm = b.floats(&flat(&p.normals), 3, "VEC3");
     let idx = b.indices(&p.indices, U16);
-    let _ = F32;
     b.mesh(
         name,
         vec![

@@ -205,10 +205,8 @@ impl SceneOptions {
         let wanted = self.msaa.unwrap_or(if cpu { 1 } else { 4 }).clamp(1, 64);
         let l = &ctx.properties.limits;
         let supported = l.framebuffer_color_sample_counts & l.framebuffer_depth_sample_counts;
-        let mut n = wanted.next_power_of_two().min(64);
-        if n > wanted {
-            n /= 2;
-        }
+        // The largest power of two not above `wanted`, then down to what the device has.
+        let mut n = 1u32 << wanted.ilog2();
         while n > 1 && !supported.contains(ash::vk::SampleCountFlags::from_raw(n)) {
             n /= 2;
         }
