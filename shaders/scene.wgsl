@@ -31,6 +31,8 @@ override PCF_BIT1: bool = false; // requires SHADOWS
 // More than one shadow view (cascades, several shadowed lights, a point light's cube faces): each
 // light reads its own views, chosen per pixel; without, the one shadowed light reads view 0.
 override MANY_VIEWS: bool = true; // requires SHADOWS
+// A shadowed light has a size (light.direction.w > 0): its lookups are PCSS soft shadows.
+override SOFT: bool = true; // requires SHADOWS
 
 // Bilinear taps per side of the PCF kernel (0 = one nearest comparison).
 fn pcf_taps() -> i32 {
@@ -62,7 +64,8 @@ const OVERDRAW_STEP: f32 = 0.0625;
 struct Light {
     // xyz: position (point, spot); w: kind (0 directional, 1 point, 2 spot)
     position: vec4<f32>,
-    // xyz: unit direction the light travels (directional, spot); w: unused
+    // xyz: unit direction the light travels (directional, spot); w: soft-shadow size, 0 for hard
+    // shadows (directional: tan of half the angular diameter; point, spot: the radius)
     direction: vec4<f32>,
     // rgb: colour * intensity; w: unused
     color: vec4<f32>,
@@ -277,7 +280,7 @@ fn light_view(light: Light, p: vec3<f32>, pixel: vec2<f32>, first: i32, n: i32) 
 
 // Filtered shadow-map visibility of world point `p` with geometric normal `ng`, in shadow view
 // `layer` of light `light` whose direction at `p` is `l` (call only when shadows are on).
-fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, layer: i32) -> f32 {
+fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, layer: i32, pixel: vec2<f32>) -> f32 {
     let view = frame.views[layer];
     var texel_world = view.cascade.z;
     if light.position.w != LIGHT_DIRECTIONAL {
@@ -304,6 +307,10 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, la
     // Depth clamp is on in the shadow pass, so receivers are clamped the same way.
     let depth = clamp(ndc.z, 0.0, 1.0);
     let size = i32(view.cascade.w);
+    if SOFT && light.direction.w > 0.0 {
+        let grad = receiver_gradient(view, p + offset, ng, texel_world);
+        return soft_visibility(view, light, layer, p_texel, depth, grad, texel_world, pixel);
+    }
     let kernel = pcf_taps();
     if kernel == 0 {
         return compare_texel(vec2<i32>(floor(p_texel)), layer, depth, size);
@@ -341,6 +348,141 @@ fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, la
         }
     }
     return sum / f32(kernel * kernel);
+}
+
+// PCSS (percentage-closer soft shadows, Fernando 2005) for a light of size light.direction.w:
+// a blocker search over the widest penumbra this receiver can have, then a filter whose radius is
+// the penumbra the average blocker casts by similar triangles: (d_receiver - d_blocker) * tan(half
+// angle) for a directional light, radius * (d_receiver - d_blocker) / d_blocker for a point or
+// spot light. Both on a golden-angle spiral turned per pixel (interleaved-gradient noise), so
+// the filter's banding becomes fine noise; each tap compares against the receiver's plane
+// (`grad`), so a wide kernel does not shadow the sloped surface it lies on.
+const SOFT_TAPS: i32 = 16;
+// Widest penumbra radius filtered, in texels (render::frame::SOFT_MAX_TEXELS).
+const SOFT_MAX_TEXELS: f32 = 32.0;
+
+// Tap k of the unit disk's area-uniform golden-angle spiral, r = sqrt((k + 0.5) / SOFT_TAPS),
+// whose direction `dir` the caller turns by the golden angle from tap to tap (no trigonometry
+// or table per tap: both cost more than the taps' arithmetic on llvmpipe).
+fn spiral(k: i32, dir: vec2<f32>) -> vec2<f32> {
+    return sqrt((f32(k) + 0.5) / f32(SOFT_TAPS)) * dir;
+}
+
+// `d` turned by the golden angle, 2.39996323 rad.
+fn golden_turn(d: vec2<f32>) -> vec2<f32> {
+    let c = -0.737369;
+    let s = 0.675490;
+    return vec2<f32>(d.x * c - d.y * s, d.x * s + d.y * c);
+}
+
+// Distance from the light (directional: from the view's near plane) of NDC depth `z` in `view`.
+fn light_distance(view: ShadowView, z: f32, directional: bool) -> f32 {
+    if directional {
+        // Orthographic, reversed: depth falls by 1 over 1 / |z row| world units from the near plane.
+        let row = vec3<f32>(view.clip[0].z, view.clip[1].z, view.clip[2].z);
+        return (1.0 - z) / max(length(row), 1e-30);
+    }
+    // Reversed-z infinite perspective: z = near / d.
+    return view.clip[3].z / max(z, 1e-30);
+}
+
+// Penumbra radius in texels at a receiver `d_r` from the light behind a blocker at `d_b` (depths
+// along the view's axis; `tw`: the receiver's texel in world units).
+fn penumbra_texels(light: Light, d_r: f32, d_b: f32, tw: f32) -> f32 {
+    let w = max(d_r - d_b, 0.0) * light.direction.w / max(tw, 1e-30);
+    return select(w / max(d_b, 1e-30), w, light.position.w == LIGHT_DIRECTIONAL);
+}
+
+// Texel position and NDC depth of world point `q` in `view`.
+fn to_texels(view: ShadowView, q: vec3<f32>) -> vec3<f32> {
+    let c = view.clip * vec4<f32>(q, 1.0);
+    let n = c.xyz / c.w;
+    return vec3<f32>(vec2<f32>(n.x * 0.5 + 0.5, 0.5 - n.y * 0.5) * view.cascade.w, n.z);
+}
+
+// The depth change per texel across the receiver's plane (normal `ng`, through `q`), so that a
+// tap `o` texels away compares at depth + dot(grad, o). Limited to 8 texels' worth of depth per
+// texel, which a plane seen edge-on from the light would exceed.
+fn receiver_gradient(view: ShadowView, q: vec3<f32>, ng: vec3<f32>, tw: f32) -> vec2<f32> {
+    let a = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(ng.x) > 0.7);
+    let t1 = normalize(cross(ng, a)) * tw;
+    let t2 = normalize(cross(ng, t1)) * tw;
+    let c0 = to_texels(view, q);
+    let e1 = to_texels(view, q + t1) - c0;
+    let e2 = to_texels(view, q + t2) - c0;
+    let det = e1.x * e2.y - e1.y * e2.x;
+    if abs(det) < 1e-6 {
+        return vec2<f32>(0.0);
+    }
+    let g = vec2<f32>(e1.z * e2.y - e1.y * e2.z, e1.x * e2.z - e2.x * e1.z) / det;
+    // Depth of one texel's world size along the light (orthographic) as the scale of the limit.
+    let row = vec3<f32>(view.clip[0].z, view.clip[1].z, view.clip[2].z);
+    let limit = 8.0 * max(length(row) * tw, abs(c0.z) * 0.05);
+    let m = length(g);
+    return select(g, g * (limit / m), m > limit);
+}
+
+// Bilinearly weighted 2x2 comparison at texel position `q` (one gather, or the hardware's
+// filtered comparison).
+fn gathered_compare(q: vec2<f32>, layer: i32, depth: f32) -> f32 {
+    let inv = 1.0 / frame.shadow.x;
+    if HW_COMPARE {
+        return textureSampleCompareLevel(shadow_map, shadow_sampler, q * inv, layer, depth);
+    }
+    let t = q - vec2<f32>(0.5);
+    let f = t - floor(t);
+    // x = (i0, j1), y = (i1, j1), z = (i1, j0), w = (i0, j0).
+    let g = textureGatherCompare(shadow_map, shadow_sampler, (floor(t) + vec2<f32>(1.0)) * inv, layer, depth);
+    return mix(mix(g.w, g.z, f.x), mix(g.x, g.y, f.x), f.y);
+}
+
+fn soft_visibility(
+    view: ShadowView,
+    light: Light,
+    layer: i32,
+    p_texel: vec2<f32>,
+    depth: f32,
+    grad: vec2<f32>,
+    tw_dir: f32,
+    pixel: vec2<f32>,
+) -> f32 {
+    let directional = light.position.w == LIGHT_DIRECTIONAL;
+    let size = i32(view.cascade.w);
+    let d_r = light_distance(view, depth, directional);
+    // Texel size across the view at the receiver: a perspective view's grows with the depth
+    // along its axis (not the distance: off-axis the two part by the angle's cosine).
+    let tw = select(view.cascade.z * d_r, tw_dir, directional);
+    // The widest penumbra here: a blocker at the view's near plane.
+    let search = clamp(penumbra_texels(light, d_r, light_distance(view, 1.0, directional), tw), 1.0, SOFT_MAX_TEXELS);
+    let phi = 6.2831853 * fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
+    let rot = vec2<f32>(cos(phi), sin(phi));
+    // The filter's spiral is turned a further radian from the search's.
+    let rot2 = vec2<f32>(rot.x * 0.540302 - rot.y * 0.841471, rot.x * 0.841471 + rot.y * 0.540302);
+    var blockers = 0.0;
+    var sum = 0.0;
+    var dir = rot;
+    for (var k = 0; k < SOFT_TAPS; k++) {
+        let o = spiral(k, dir) * search;
+        dir = golden_turn(dir);
+        let c = clamp(vec2<i32>(floor(p_texel + o)), vec2<i32>(0), vec2<i32>(size - 1));
+        let stored = textureLoad(shadow_map, c, layer, 0);
+        let nearer = stored > depth + dot(grad, o);
+        blockers += select(0.0, 1.0, nearer);
+        sum += select(0.0, stored, nearer);
+    }
+    if blockers == 0.0 {
+        return 1.0;
+    }
+    let d_b = light_distance(view, sum / blockers, directional);
+    let radius = clamp(penumbra_texels(light, d_r, d_b, tw), 0.5, SOFT_MAX_TEXELS);
+    var vis = 0.0;
+    dir = rot2;
+    for (var k = 0; k < SOFT_TAPS; k++) {
+        let o = spiral(k, dir) * radius;
+        dir = golden_turn(dir);
+        vis += gathered_compare(p_texel + o, layer, depth + dot(grad, o));
+    }
+    return vis / f32(SOFT_TAPS);
 }
 
 fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
@@ -630,14 +772,14 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
                 let first = i32(light.shadow.x);
                 if first >= 0 {
                     let view = light_view(light, p, in.clip.xy, first, i32(light.shadow.y));
-                    vis *= shadow_visibility(p, n_geo, l, light, view);
+                    vis *= shadow_visibility(p, n_geo, l, light, view, in.clip.xy);
                     if shown {
                         cascade = view - first;
                     }
                 }
             } else if shown {
                 // The one shadowed light, view 0.
-                vis *= shadow_visibility(p, n_geo, l, light, 0);
+                vis *= shadow_visibility(p, n_geo, l, light, 0, in.clip.xy);
                 cascade = 0;
             }
         }

@@ -129,13 +129,15 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
     let mut exact = None;
     let scored = score(&mut renderer, &reference, &view, (w, h), &mut exact)?;
     let reference_ms = build_ms + scored.reference_ms;
-    let (metrics, diff, lit) = (scored.metrics, scored.diff, scored.lit);
+    let (metrics, diff, lit) = (&scored.metrics, &scored.diff, &scored.lit);
     let frame = exact.ok_or_else(|| anyhow::anyhow!("no reference frame"))?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     for (name, img) in [
         ("gpu.png", &lit.image),
         ("reference.png", &frame.image),
-        ("diff.png", &diff),
+        ("diff.png", diff),
+        ("shadow.png", &scored.shadow),
+        ("coverage.png", &frame.coverage_image()),
     ] {
         let p = a.out.join(name);
         img.save(&p)

@@ -460,6 +460,7 @@ fn spot_light_shadow_matches_geometry() {
         intensity: 60.0,
         casts_shadows: true,
         range: None,
+        size: 0.0,
     };
     let scene = box_scene(light);
     let mut r = Renderer::new(&ctx, &scene).unwrap();

@@ -44,6 +44,7 @@ fn point(range: Option<f32>) -> Light {
         intensity: 12.0,
         casts_shadows: false,
         range,
+        size: 0.0,
     }
 }
 

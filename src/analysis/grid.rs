@@ -139,6 +139,7 @@ impl Grid {
                                     snap: true,
                                     cascades,
                                     cube_face: 0,
+                                    depth_fit: false,
                                 },
                                 bias,
                             });

@@ -246,7 +246,8 @@ pub struct ViewArgsCmd {
 pub struct CompareArgs {
     /// glTF 2.0 file; the built-in demo scene when omitted.
     pub scene: Option<PathBuf>,
-    /// Folder for gpu.png, reference.png and diff.png.
+    /// Folder for gpu.png, reference.png, diff.png, shadow.png (the GPU shadow view) and
+    /// coverage.png (the reference's visible fraction of the shown light).
     #[arg(long, default_value = ".")]
     pub out: PathBuf,
     /// View and shadow options (as for render).
@@ -328,6 +329,11 @@ pub struct ViewArgs {
     /// Intensity of the sun (the first directional light, or the default sun).
     #[arg(long)]
     pub sun_intensity: Option<f32>,
+    /// Size of every light, for soft shadows (PCSS; 0: hard): a directional light's angular
+    /// diameter in degrees (the sun: 0.53), a point or spot light's radius in scene units.
+    /// Default: each light's own (glTF `extras.light_size`; 0 for the default sun).
+    #[arg(long)]
+    pub light_size: Option<f32>,
     /// Output: the lit image or a debug view.
     #[arg(long = "view", value_enum, default_value = "lit")]
     pub mode: ViewMode,
@@ -376,6 +382,10 @@ pub struct ViewArgs {
     /// would be at the nearest surface in view.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub cascades: u32,
+    /// Fit the sun's cascades to the depths the camera sees (sample-distribution shadow maps:
+    /// a first pass measures them; needs --fit camera), not to the scene's boxes in view.
+    #[arg(long)]
+    pub depth_fit: bool,
     /// Side in texels of a point light's cube faces (0, the default: half of --shadow-map).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=16384))]
     pub cube_face: u32,
@@ -649,6 +659,12 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         }
         i => i,
     };
+    v.light_size = match a.light_size {
+        Some(x) if !(x.is_finite() && (0.0..=1e6).contains(&x)) => {
+            bail!("--light-size must be a number within 0..1e6")
+        }
+        x => x,
+    };
     v.mode = a.mode;
     v.exposure = a.exposure;
     v.ambient = a.ambient;
@@ -683,6 +699,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         snap: !a.no_snap,
         cascades: a.cascades,
         cube_face: a.cube_face,
+        depth_fit: a.depth_fit,
     };
     Ok(v)
 }

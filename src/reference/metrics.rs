@@ -28,6 +28,10 @@ pub struct Metrics {
     pub psnr: f64,
     /// Mean FLIP error (0 = identical, 1 = maximal) of the GPU lit image against the reference.
     pub flip: f64,
+    /// Mean FLIP error of the GPU shadow view (the shown light's visibility, grey) against the
+    /// reference's fraction of that light's emitter visible: how close soft shadows come to
+    /// the area light's (hard ones to the exact edge). None where no shadow view was compared.
+    pub visibility_flip: Option<f64>,
     /// Pixels judged.
     pub judged_pixels: usize,
     /// Judged pixels in the edge band.
@@ -47,6 +51,7 @@ impl Metrics {
             "interior_misclassified": self.interior_misclassified,
             "psnr": self.psnr,
             "flip": self.flip,
+            "visibility_flip": self.visibility_flip,
             "judged_pixels": self.judged_pixels,
             "edge_pixels": self.edge_pixels,
             "coverage_mismatch": self.coverage_mismatch,
@@ -213,7 +218,9 @@ pub fn compare(
     reference: &ReferenceFrame,
 ) -> (Metrics, image::RgbaImage) {
     let c = classify(gpu_shadow, gpu_depth, plan, reference);
-    summarise(&c, gpu_lit, reference)
+    let (mut m, diff) = summarise(&c, gpu_lit, reference);
+    m.visibility_flip = Some(flip(&reference.coverage_image(), gpu_shadow));
+    (m, diff)
 }
 
 /// The metrics and the difference image of classified pixels (see [`compare`]).
@@ -262,6 +269,7 @@ pub fn summarise(
         interior_misclassified: frac(mi, n - ne),
         psnr: psnr(gpu_lit, &reference.image),
         flip: flip(&reference.image, gpu_lit),
+        visibility_flip: None,
         judged_pixels: n,
         edge_pixels: ne,
         coverage_mismatch: c.coverage_mismatch,

@@ -8,6 +8,6 @@ pub mod raycast;
 pub mod score;
 
 pub use bvh::{Bvh, Hit};
-pub use metrics::{classify, compare, summarise, Classified, Metrics, PixelClass};
+pub use metrics::{classify, compare, flip, psnr, summarise, Classified, Metrics, PixelClass};
 pub use raycast::{Pick, Probe, ReferenceFrame, ReferenceScene};
 pub use score::{score, Scored};

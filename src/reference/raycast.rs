@@ -49,6 +49,10 @@ pub struct ReferenceFrame {
     /// Per pixel: None when no surface is hit; else exact visibility of the shadowed light
     /// (facing and unoccluded → true).
     pub visibility: Vec<Option<bool>>,
+    /// Per pixel: None when no surface is hit; else the fraction of the shadowed light's
+    /// emitter visible (`AREA_SAMPLES` shadow rays over it when it has a size, 0 or 1 for a
+    /// punctual light; 0 where the surface faces away): ground truth for soft shadows.
+    pub coverage: Vec<Option<f32>>,
     /// Per pixel: distance along the primary ray (∞ for none).
     pub distance: Vec<f32>,
     /// The reference image (sRGB), exact hard shadows.
@@ -58,8 +62,35 @@ pub struct ReferenceFrame {
     pub curved: Vec<bool>,
 }
 
+/// One reference pixel: (centre visibility, visible fraction) of the shadowed light where a
+/// surface is hit, distance, colour, curved.
+type PixelResult = (Option<(bool, f32)>, f32, [u8; 4], bool);
+
+impl ReferenceFrame {
+    /// The shadowed light's visible fraction as the GPU's shadow view writes visibility: grey
+    /// bytes of fraction × 255 (the view writes linear values to an sRGB target, so the byte
+    /// is the value), the clear colour where no surface is hit.
+    pub fn coverage_image(&self) -> image::RgbaImage {
+        let c = crate::render::core::CLEAR_COLOR;
+        let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];
+        image::RgbaImage::from_fn(self.width, self.height, |x, y| {
+            match self.coverage[(y * self.width + x) as usize] {
+                None => image::Rgba(background),
+                Some(v) => {
+                    let b = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+                    image::Rgba([b, b, b, 255])
+                }
+            }
+        })
+    }
+}
+
 /// cos 1°: a surface whose interpolated normal leaves the face normal by more is curved.
 const CURVED_COS: f32 = 0.999_847_7;
+/// Shadow rays a light with a size casts per shaded point: the emitter is sampled on a fixed
+/// area-uniform golden-angle spiral over its disk (the sun's disk of directions; a sphere light's
+/// disk facing the point).
+pub const AREA_SAMPLES: usize = 128;
 /// Most blended surfaces one primary ray composites (deeper ones are taken as opaque).
 const MAX_BLEND_LAYERS: u32 = 8;
 
@@ -74,6 +105,13 @@ pub struct Probe {
     pub distance: f32,
     /// Exact visibility of the shadowed light (facing it and unoccluded).
     pub visible: bool,
+}
+
+/// Sample `k` of `n` on the unit disk: an area-uniform golden-angle spiral.
+fn spiral(k: usize, n: usize) -> Vec2 {
+    let r = ((k as f32 + 0.5) / n as f32).sqrt();
+    let a = k as f32 * 2.399_963_2;
+    Vec2::new(r * a.cos(), r * a.sin())
 }
 
 /// Light `l` seen from point `p`: unit direction towards it, distance (∞ for a directional
@@ -282,7 +320,9 @@ impl<'a> ReferenceScene<'a> {
         a.lerp(b, fy)
     }
 
-    /// Exact visibility of world point `p` (geometric normal `ng`, facing normal `n`) from light `i`.
+    /// Exact visibility of world point `p` (geometric normal `ng`, facing normal `n`) from light
+    /// `i`: whether its centre is visible, the fraction of its emitter that is (the same for a
+    /// punctual light), the direction towards it and the radiance arriving.
     fn visible(
         &self,
         plan: &FramePlan,
@@ -290,16 +330,42 @@ impl<'a> ReferenceScene<'a> {
         p: Vec3,
         ng: Vec3,
         n_facing: Vec3,
-    ) -> (bool, Vec3, Vec3) {
-        let (dir, dist, radiance) = light_at(&plan.lights[i], p);
+    ) -> (bool, f32, Vec3, Vec3) {
+        let l = &plan.lights[i];
+        let (dir, dist, radiance) = light_at(l, p);
         let facing = n_facing.dot(dir) > 0.0;
         if !facing {
-            return (false, dir, radiance);
+            return (false, 0.0, dir, radiance);
         }
         if !plan.is_shadowed(i) {
-            return (true, dir, radiance);
+            return (true, 1.0, dir, radiance);
         }
-        (!self.occluded(p, ng, dir, dist), dir, radiance)
+        let centre = !self.occluded(p, ng, dir, dist);
+        let size = crate::render::frame::soft_size(l);
+        if size <= 0.0 {
+            return (centre, if centre { 1.0 } else { 0.0 }, dir, radiance);
+        }
+        // The emitter's disk across the direction to it: the sun's directions within its
+        // angular radius (tan = size), a sphere light's disk of radius `size`.
+        let (e1, e2) = dir.any_orthonormal_pair();
+        let open = (0..AREA_SAMPLES)
+            .filter(|&k| {
+                let u = spiral(k, AREA_SAMPLES);
+                let (d, t) = match l.kind {
+                    LightKind::Directional => (
+                        (dir + (e1 * u.x + e2 * u.y) * size).normalize(),
+                        f32::INFINITY,
+                    ),
+                    _ => {
+                        let to = l.position + (e1 * u.x + e2 * u.y) * size - p;
+                        let t = to.length();
+                        (to / t.max(1e-20), t)
+                    }
+                };
+                !self.occluded(p, ng, d, t)
+            })
+            .count();
+        (centre, open as f32 / AREA_SAMPLES as f32, dir, radiance)
     }
 
     /// Whether anything lies between surface point `p` (geometric normal `ng`) and a light
@@ -375,7 +441,7 @@ impl<'a> ReferenceScene<'a> {
         let Some(h) = self.intersect_from(ray, t_min) else {
             return Vec3::new(c[0], c[1], c[2]);
         };
-        let (_, rgb) = self.shade(plan, ray, &h, ambient);
+        let (_, _, rgb) = self.shade(plan, ray, &h, ambient);
         self.blend_behind(plan, ray, &h, plan.display(rgb), ambient, layers)
     }
 
@@ -529,7 +595,7 @@ impl<'a> ReferenceScene<'a> {
         let n = (width * height) as usize;
         let c = crate::render::core::CLEAR_COLOR;
         let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];
-        let results: Vec<(Option<bool>, f32, [u8; 4], bool)> = (0..n)
+        let results: Vec<PixelResult> = (0..n)
             .into_par_iter()
             .map(|i| {
                 let (x, y) = (
@@ -540,11 +606,11 @@ impl<'a> ReferenceScene<'a> {
                 match self.intersect(&ray) {
                     None => (None, f32::INFINITY, background, false),
                     Some(h) => {
-                        let (vis, rgb) = self.shade(plan, &ray, &h, ambient);
+                        let (vis, cover, rgb) = self.shade(plan, &ray, &h, ambient);
                         let rgb = self.blend_behind(plan, &ray, &h, plan.display(rgb), ambient, 0);
                         let (ng, n) = self.hit_normals(&h);
                         (
-                            Some(vis),
+                            Some((vis, cover)),
                             h.t,
                             [
                                 srgb_encode(rgb.x),
@@ -565,14 +631,16 @@ impl<'a> ReferenceScene<'a> {
         ReferenceFrame {
             width,
             height,
-            visibility: results.iter().map(|r| r.0).collect(),
+            visibility: results.iter().map(|r| r.0.map(|v| v.0)).collect(),
+            coverage: results.iter().map(|r| r.0.map(|v| v.1)).collect(),
             distance: results.iter().map(|r| r.1).collect(),
             image,
             curved: results.iter().map(|r| r.3).collect(),
         }
     }
 
-    fn shade(&self, plan: &FramePlan, ray: &Ray, h: &Hit, ambient: Vec3) -> (bool, Vec3) {
+    /// The shown light's centre visibility and emitter fraction, and the lit colour.
+    fn shade(&self, plan: &FramePlan, ray: &Ray, h: &Hit, ambient: Vec3) -> (bool, f32, Vec3) {
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
         let idx = [
@@ -626,17 +694,17 @@ impl<'a> ReferenceScene<'a> {
             1.0
         };
         let mut color = bp.ka * ambient * occlusion + emissive;
-        let mut shadow_vis = true;
+        let (mut shadow_vis, mut shadow_cover) = (true, 1.0);
         for i in 0..plan.lights.len() {
-            let (vis, l, radiance) = self.visible(plan, i, p, ng, n_geo);
+            let (vis, cover, l, radiance) = self.visible(plan, i, p, ng, n_geo);
             if plan.shadow_light == Some(i) {
-                shadow_vis = vis;
+                (shadow_vis, shadow_cover) = (vis, cover);
             }
-            color += shade_blinn_phong(&bp, n, l, v, radiance, if vis { 1.0 } else { 0.0 });
+            color += shade_blinn_phong(&bp, n, l, v, radiance, cover);
         }
         if mat.unlit {
             color = base.truncate();
         }
-        (shadow_vis, color)
+        (shadow_vis, shadow_cover, color)
     }
 }

@@ -14,6 +14,8 @@ pub struct Scored {
     pub diff: image::RgbaImage,
     /// The lit GPU frame (image, plan, timings).
     pub lit: RenderedFrame,
+    /// The GPU's shadow view (the shown light's visibility, grey).
+    pub shadow: image::RgbaImage,
     /// Every pixel's classification (false shadow, false light, edge band).
     pub classified: Classified,
     /// Time spent ray-casting the reference in this call (ms; 0 when `exact` was given).
@@ -22,7 +24,8 @@ pub struct Scored {
 
 /// Renders `view` lit and as shadow visibility (with depth) at `w`×`h` and compares them with the
 /// exact reference, which is ray-cast into `exact` when it is empty (the reference depends on the
-/// camera and lights, not on shadow settings, so one serves every configuration of a view).
+/// camera and lights, sizes included, not on shadow settings, so one serves every configuration
+/// of a view that keeps its lights).
 pub fn score(
     renderer: &mut Renderer,
     reference: &ReferenceScene,
@@ -44,12 +47,14 @@ pub fn score(
     let reference_ms = t0.elapsed().as_secs_f64() * 1e3;
     let depth = shadow.depth.as_deref().unwrap_or(&[]);
     let classified = classify(&shadow.image, depth, &lit.plan, frame);
-    let (metrics, diff) = summarise(&classified, &lit.image, frame);
+    let (mut metrics, diff) = summarise(&classified, &lit.image, frame);
+    metrics.visibility_flip = Some(super::metrics::flip(&frame.coverage_image(), &shadow.image));
     Ok(Scored {
         metrics,
         classified,
         diff,
         lit,
+        shadow: shadow.image,
         reference_ms,
     })
 }

@@ -205,7 +205,7 @@ impl FrameCore {
                         &sv.light_clip_from_world,
                         plan.light_source(sv.light),
                         sv.res,
-                        view.shadow.pcf.lookup_reach(),
+                        crate::render::frame::lookup_reach(view.shadow.pcf, plan.soft),
                         view.mode == ViewMode::ShadowMap,
                     )
                 })

@@ -28,7 +28,8 @@ pub const DEFAULT_SUN_AZIMUTH_DEG: f32 = 35.0;
 pub const DEFAULT_SUN_INTENSITY: f32 = 1.7;
 
 /// The lights a view is shaded with: the scene's `lights`, or the default sun when there are
-/// none; `sun_direction` and `sun_intensity` override the first directional light's.
+/// none; `sun_direction` and `sun_intensity` override the first directional light's, and
+/// `light_size` every light's size.
 pub fn effective_lights(scene_lights: &[Light], view: &View) -> Vec<Light> {
     let mut lights = scene_lights.to_vec();
     if lights.is_empty() {
@@ -50,6 +51,15 @@ pub fn effective_lights(scene_lights: &[Light], view: &View) -> Vec<Light> {
     if let Some(i) = view.sun_intensity.filter(|i| i.is_finite() && *i >= 0.0) {
         if let Some(l) = lights.iter_mut().find(|l| l.kind == LightKind::Directional) {
             l.intensity = i;
+        }
+    }
+    if let Some(s) = view.light_size.filter(|s| s.is_finite() && *s >= 0.0) {
+        for l in &mut lights {
+            l.size = if l.kind == LightKind::Directional {
+                s.to_radians()
+            } else {
+                s
+            };
         }
     }
     lights.truncate(MAX_LIGHTS);
@@ -222,6 +232,9 @@ pub struct FramePlan {
     pub(crate) uniform: FrameUniform,
     /// Whether this frame draws and samples a shadow map.
     pub shadows_on: bool,
+    /// Whether a shadowed light has a size: its lookups are soft (PCSS), and every lookup may
+    /// read up to [`lookup_reach`] texels from its centre.
+    pub soft: bool,
     /// Side of the shadow map in texels.
     pub shadow_map_size: u32,
     /// The camera's world position.
@@ -393,6 +406,7 @@ pub fn plan_frame(
     // Every shadow-casting light gets its views, in light order, while the frame's views last.
     let mut views: Vec<ShadowView> = Vec::new();
     let mut unshadowed = Vec::new();
+    let any_soft = lights.iter().any(|l| l.casts_shadows && soft_size(l) > 0.0);
     for (i, l) in lights.iter().enumerate() {
         if !(l.casts_shadows && l.intensity > 0.0) {
             continue;
@@ -411,7 +425,7 @@ pub fn plan_frame(
             LightKind::Point => {
                 let res = cube_face_size(&view.shadow);
                 let (faces, tan_half) =
-                    fit_point_faces(l.position, bounds, res, point_face_margin(view));
+                    fit_point_faces(l.position, bounds, res, point_face_margin(view, any_soft));
                 let texel = 2.0 * tan_half / res as f32;
                 faces
                     .iter()
@@ -509,18 +523,22 @@ pub fn plan_frame(
         // z: the range (0 = none).
         let cone = Vec4::new(cone.x, cone.y, l.range.unwrap_or(0.0), 0.0);
         let first = views.iter().position(|v| v.light == i);
+        // w: the soft-shadow size (0: hard), as the penumbra formula takes it.
+        let soft = if first.is_some() { soft_size(l) } else { 0.0 };
         let count = views.iter().filter(|v| v.light == i).count();
         u.lights[i] = LightUniform {
             position: l.position.extend(kind),
-            direction: l.direction.normalize_or(Vec3::NEG_Y).extend(0.0),
+            direction: l.direction.normalize_or(Vec3::NEG_Y).extend(soft),
             color: (l.color * l.intensity).extend(0.0),
             cone,
             shadow: Vec4::new(first.map_or(-1.0, |f| f as f32), count as f32, 0.0, 0.0),
         };
     }
+    let soft = shadows_on && views.iter().any(|v| soft_size(&lights[v.light]) > 0.0);
     FramePlan {
         uniform: u,
         shadows_on,
+        soft,
         shadow_map_size: size,
         camera_position: view.camera.position(),
         shader_variant: frame_variant_bits(
@@ -529,6 +547,7 @@ pub fn plan_frame(
             hw_compare,
             view.shadow.pcf,
             views.len(),
+            soft,
         ),
         lights,
         shadow_light,
@@ -627,6 +646,38 @@ pub fn exposure_scale(exposure: Exposure, metered_lux: f32) -> f32 {
     }
 }
 
+/// How much the depths seen are grown (near ÷, far ×) before the cascades are fitted to them.
+pub const DEPTH_FIT_MARGIN: f32 = 1.01;
+
+/// Widest penumbra, in shadow texels of radius, that a soft (PCSS) lookup filters: a larger
+/// light or a finer map is softened this much and no more (`SOFT_MAX_TEXELS` in scene.wgsl).
+pub const SOFT_MAX_TEXELS: f32 = 32.0;
+
+/// A shadowed light's soft-shadow size as the shader's penumbra formula takes it: tan of half
+/// the angular diameter for a directional light, the radius for a point or spot light; 0 for a
+/// punctual light (hard shadows) or a size that is not a finite number above 0.
+pub fn soft_size(l: &Light) -> f32 {
+    let s = if l.size.is_finite() {
+        l.size.max(0.0)
+    } else {
+        0.0
+    };
+    match l.kind {
+        LightKind::Directional => (0.5 * s.min(3.0)).tan(),
+        _ => s,
+    }
+}
+
+/// How many texels from its centre a shadow lookup reads: the PCF kernel's reach, or with soft
+/// shadows the widest penumbra plus its bilinear taps (`SOFT_MAX_TEXELS` + 2).
+pub fn lookup_reach(pcf: Pcf, soft: bool) -> u32 {
+    if soft {
+        pcf.lookup_reach().max(SOFT_MAX_TEXELS as u32 + 2)
+    } else {
+        pcf.lookup_reach()
+    }
+}
+
 /// Side in texels of a point light's cube faces: `cube_face`, or half the map (0), within the map.
 pub fn cube_face_size(s: &ShadowSettings) -> u32 {
     let size = s.map_size.max(1);
@@ -639,9 +690,9 @@ pub fn cube_face_size(s: &ShadowSettings) -> u32 {
 /// How many texels a point light's cube face reaches past its 90° (so that the filter and the
 /// normal offset of a lookup on one face stay inside that face's layer): PCF reach, normal
 /// offset, constant bias, and two of slack.
-fn point_face_margin(view: &View) -> f32 {
+fn point_face_margin(view: &View, soft: bool) -> f32 {
     let s = &view.shadow;
-    s.pcf.lookup_reach() as f32
+    lookup_reach(s.pcf, soft) as f32
         + s.normal_offset.max(0.0).ceil()
         + s.constant_bias.max(0.0).ceil()
         + 2.0
@@ -672,7 +723,19 @@ fn directional_views(
     };
     match view.shadow.fit {
         ShadowFit::Camera => {
-            let frustum = fitting_frustum(fit_cam, aspect, bounds);
+            let mut frustum = fitting_frustum(fit_cam, aspect, bounds);
+            // Sample-distribution fitting: the frustum ends where the depths seen end.
+            if let Some((lo, hi)) = view
+                .visible_depths
+                .filter(|_| view.shadow.depth_fit && view.shadow_fit_camera.is_none())
+                .filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && *hi >= *lo && *lo > 0.0)
+            {
+                let near = (lo / DEPTH_FIT_MARGIN).max(frustum.near);
+                let far = (hi * DEPTH_FIT_MARGIN).min(frustum.far);
+                if far > near {
+                    (frustum.near, frustum.far) = (near, far);
+                }
+            }
             // Split the depths where the view meets the scene, not the whole frustum: a camera
             // high above a compact scene sees nothing near. (Per frame, so only when the count
             // is not fixed at one map.)
@@ -733,6 +796,7 @@ fn frame_variant_bits(
     hw_compare: bool,
     pcf: Pcf,
     views: usize,
+    soft: bool,
 ) -> usize {
     use crate::gpu::shaders::scene as sh;
     let mut bits = 0;
@@ -753,6 +817,7 @@ fn frame_variant_bits(
     for (on, bit) in [
         (hw_compare, sh::BIT_HW_COMPARE),
         (views > 1, sh::BIT_MANY_VIEWS),
+        (soft, sh::BIT_SOFT),
     ] {
         if on {
             bits |= bit;
@@ -775,6 +840,7 @@ mod tests {
             intensity: 100.0,
             casts_shadows: false,
             range: None,
+            size: 0.0,
         };
         let room = Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0));
         // A lamp inside a room is metered at the room's half-diagonal: 100 / 75.
@@ -847,6 +913,7 @@ mod tests {
             intensity: 5.0,
             casts_shadows: true,
             range: None,
+            size: 0.0,
         };
         let spot = Light {
             kind: LightKind::Spot {

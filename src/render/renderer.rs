@@ -9,6 +9,7 @@ use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
 use crate::scene::Scene;
 use ash::vk;
+use glam::Mat4;
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 use std::time::Instant;
@@ -70,7 +71,13 @@ pub struct Renderer {
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
     read_depth: bool,
+    /// The depths the last measured camera saw (`ShadowSettings::depth_fit`).
+    seen_depths: Option<SeenDepths>,
 }
+
+/// A camera (view matrix, field of view, image size) and the (nearest, farthest) view depth it
+/// saw (None: nothing drawn).
+type SeenDepths = (Mat4, f32, (u32, u32), Option<(f32, f32)>);
 
 /// Copies a whole single-level image aspect into a tightly packed buffer.
 pub fn copy_to_buffer(
@@ -152,6 +159,7 @@ impl Renderer {
             cmd,
             fence,
             read_depth: false,
+            seen_depths: None,
         })
     }
 
@@ -238,8 +246,57 @@ impl Renderer {
         Ok(())
     }
 
-    /// Renders `view` at `width`×`height` and reads the result back.
+    /// Renders `view` at `width`×`height` and reads the result back. With
+    /// `ShadowSettings::depth_fit` and no `View::visible_depths`, a camera not seen before is
+    /// first rendered once to measure the depths it sees (kept for the frames that follow).
     pub fn render(
+        &mut self,
+        view: &View,
+        width: u32,
+        height: u32,
+    ) -> Result<RenderedFrame, GpuError> {
+        let fit = view.shadow.depth_fit
+            && view.shadow.enabled
+            && view.visible_depths.is_none()
+            && view.shadow_fit_camera.is_none();
+        if !fit {
+            return self.render_once(view, width, height);
+        }
+        let key = (
+            view.camera.view_from_world(),
+            view.camera.fov_y,
+            (width, height),
+        );
+        let known = self
+            .seen_depths
+            .filter(|s| (s.0, s.1, s.2) == key)
+            .map(|s| s.3);
+        let seen = match known {
+            Some(seen) => seen,
+            None => {
+                let was = self.read_depth;
+                self.read_depth = true;
+                // The depth buffer does not depend on shadows: measure without them.
+                let mut probe = view.clone();
+                probe.shadow.enabled = false;
+                let f = self.render_once(&probe, width, height);
+                self.read_depth = was;
+                let f = f?;
+                let aspect = width as f32 / height.max(1) as f32;
+                let seen = visible_depths(
+                    f.depth.as_deref().unwrap_or(&[]),
+                    &crate::render::frame::camera_projection(&view.camera, aspect),
+                );
+                self.seen_depths = Some((key.0, key.1, key.2, seen));
+                seen
+            }
+        };
+        let mut v = view.clone();
+        v.visible_depths = seen;
+        self.render_once(&v, width, height)
+    }
+
+    fn render_once(
         &mut self,
         view: &View,
         width: u32,
@@ -330,6 +387,28 @@ impl Renderer {
     }
 }
 
+/// The nearest and farthest view depth in a reversed-z depth buffer (0 = nothing drawn) under
+/// the camera projection `proj`; None where nothing was drawn.
+pub fn visible_depths(depth: &[f32], proj: &Mat4) -> Option<(f32, f32)> {
+    let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+    for &z in depth {
+        if z > 0.0 && z.is_finite() {
+            lo = lo.min(z);
+            hi = hi.max(z);
+        }
+    }
+    if hi <= 0.0 {
+        return None;
+    }
+    let inv = proj.inverse();
+    let view_depth = |z: f32| {
+        let p = inv * glam::Vec4::new(0.0, 0.0, z, 1.0);
+        -p.z / p.w
+    };
+    // Reversed-z: the largest value is the nearest.
+    Some((view_depth(hi), view_depth(lo)))
+}
+
 impl Drop for Renderer {
     fn drop(&mut self) {
         unsafe {
@@ -337,5 +416,25 @@ impl Drop for Renderer {
         }
         self.core.ctx.free_command_buffer(self.cmd);
         unsafe { self.core.ctx.device.destroy_fence(self.fence, None) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::projection::perspective_infinite_reversed;
+
+    #[test]
+    fn visible_depths_reads_the_nearest_and_farthest_drawn_depth() {
+        let near = 0.1;
+        let proj = perspective_infinite_reversed(1.0, 1.5, near);
+        // Reversed-z infinite: z = near / d; 0 is the cleared background.
+        let depth = [0.0, near / 3.0, near / 12.5, 0.0, near / 7.0];
+        let (lo, hi) = visible_depths(&depth, &proj).unwrap();
+        assert!(
+            (lo - 3.0).abs() < 1e-4 && (hi - 12.5).abs() < 1e-3,
+            "{lo} {hi}"
+        );
+        assert_eq!(visible_depths(&[0.0; 4], &proj), None);
     }
 }

@@ -147,6 +147,13 @@ pub struct ShadowSettings {
     /// own layer); 0 (the default) is half of `map_size`, so a cube costs 1.5 maps of texels, not
     /// six.
     pub cube_face: u32,
+    /// Sample-distribution fitting (SDSM, Lauritzen et al. 2010): a directional light's cascades
+    /// are split over, and fitted to, the view depths the camera actually sees (the nearest and
+    /// farthest depth in its depth buffer, grown by 1 %) instead of where its frustum meets the
+    /// receivers' boxes, so a view that sees only near things spends every texel near. The
+    /// offscreen renderer measures them with a first pass at each new camera (a frame at a new
+    /// camera costs two); `View::visible_depths` can also be given.
+    pub depth_fit: bool,
 }
 
 /// Most cascades a directional light can have.
@@ -166,6 +173,7 @@ impl Default for ShadowSettings {
             snap: true,
             cascades: 0,
             cube_face: 0,
+            depth_fit: false,
         }
     }
 }
@@ -257,6 +265,10 @@ pub struct View {
     pub sun_direction: Option<Vec3>,
     /// Override for that light's intensity.
     pub sun_intensity: Option<f32>,
+    /// Override for every light's emitter size (soft shadows by PCSS where it is above 0): a
+    /// directional light's angular diameter in degrees (the sun: 0.53), a point or spot light's
+    /// radius in scene units. `None`: each light's own ([`crate::scene::Light::size`]).
+    pub light_size: Option<f32>,
     /// Output.
     pub mode: ViewMode,
     /// Shadow settings.
@@ -279,6 +291,10 @@ pub struct View {
     /// The light whose shadow visibility the shadow view shows (index into the frame's lights);
     /// None or a light without shadow views: the first shadowed light.
     pub shown_light: Option<usize>,
+    /// The nearest and farthest view depth the camera sees (from its depth buffer), which
+    /// `ShadowSettings::depth_fit` fits cascades to; the offscreen renderer measures it when
+    /// None.
+    pub visible_depths: Option<(f32, f32)>,
 }
 
 impl View {
@@ -307,6 +323,7 @@ impl View {
             camera,
             sun_direction: None,
             sun_intensity: None,
+            light_size: None,
             mode: ViewMode::Lit,
             shadow: ShadowSettings::default(),
             ambient: None,
@@ -316,6 +333,7 @@ impl View {
             shadow_fit_camera: None,
             highlight: None,
             shown_light: None,
+            visible_depths: None,
         }
     }
 }

@@ -511,6 +511,18 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                     outer: outer_cone_angle.max(inner_cone_angle + 1e-4),
                 },
             };
+            let size =
+                light_size_extra(l.extras().as_deref().map(|r| r.get())).unwrap_or_else(|e| {
+                    scene.warn(
+                        "LIGHT_SIZE_INVALID",
+                        format!(
+                            "/extensions/KHR_lights_punctual/lights/{}/extras",
+                            l.index()
+                        ),
+                        format!("light {}: {e}; the light casts hard shadows", l.index()),
+                    );
+                    0.0
+                });
             scene.lights.push(Light {
                 kind,
                 position: pos,
@@ -519,6 +531,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 intensity: l.intensity().max(0.0),
                 casts_shadows: true,
                 range: l.range().filter(|r| r.is_finite() && *r > 0.0),
+                size: if kind == LightKind::Directional {
+                    size.to_radians()
+                } else {
+                    size
+                },
             });
         }
         for c in node.children() {
@@ -529,6 +546,23 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         scene.warn("SCENE_EMPTY", "", "the scene has no mesh instances");
     }
     Ok(scene)
+}
+
+/// The emitter size in a glTF light's `extras` (`{"light_size": S}`: degrees of angular
+/// diameter for a directional light, scene units of radius otherwise); 0 without one.
+fn light_size_extra(extras: Option<&str>) -> Result<f32, String> {
+    let Some(json) = extras else {
+        return Ok(0.0);
+    };
+    let v: serde_json::Value =
+        serde_json::from_str(json).map_err(|e| format!("extras are not JSON: {e}"))?;
+    match v.get("light_size") {
+        None => Ok(0.0),
+        Some(s) => match s.as_f64() {
+            Some(x) if x.is_finite() && (0.0..=1e6).contains(&x) => Ok(x as f32),
+            _ => Err(format!("extras.light_size {s} is not a number in 0..1e6")),
+        },
+    }
 }
 
 /// An image's name, its label for messages ("image 3") and its encoded bytes (or why not).
@@ -840,4 +874,18 @@ fn read_primitive(
         p.material = scene.materials.len() - 1;
     }
     Ok(Some(p))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::light_size_extra;
+
+    #[test]
+    fn light_size_comes_from_the_lights_extras() {
+        assert_eq!(light_size_extra(None), Ok(0.0));
+        assert_eq!(light_size_extra(Some(r#"{"other": 1}"#)), Ok(0.0));
+        assert_eq!(light_size_extra(Some(r#"{"light_size": 0.53}"#)), Ok(0.53));
+        assert!(light_size_extra(Some(r#"{"light_size": -1}"#)).is_err());
+        assert!(light_size_extra(Some(r#"{"light_size": "big"}"#)).is_err());
+    }
 }

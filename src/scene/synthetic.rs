@@ -347,6 +347,7 @@ pub fn room_scene() -> Scene {
         intensity: 6.0,
         casts_shadows: true,
         range: None,
+        size: 0.0,
     });
     s.cameras.push(Camera::look_at(
         Vec3::new(3.7, 2.0, 2.7),
@@ -410,6 +411,7 @@ pub fn sun_and_spot_scene() -> Scene {
         intensity: 40.0,
         casts_shadows: true,
         range: None,
+        size: 0.0,
     };
     let sun = Light::sun(Vec3::new(0.4, -1.0, 0.3), 2.0);
     yard_scene("sun and spot", vec![sun, spot])
@@ -439,6 +441,7 @@ pub fn lux_yard_scene() -> Scene {
         intensity: 1e3,
         casts_shadows: true,
         range: None,
+        size: 0.0,
     };
     yard_scene(
         "yard in lux",

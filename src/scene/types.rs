@@ -212,6 +212,11 @@ pub struct Light {
     /// KHR_lights_punctual `range` (point, spot): the intensity is windowed by
     /// clamp(1 − (d/range)⁴, 0, 1) and is zero beyond it; None: unlimited.
     pub range: Option<f32>,
+    /// Size of the emitter, for soft shadows (PCSS): a directional light's angular diameter in
+    /// radians (the sun: 0.0093), a point or spot light's radius in scene units. 0 (glTF's
+    /// punctual lights, the default) casts hard shadows. Read from the glTF light's
+    /// `extras.light_size` (degrees for a directional light, scene units otherwise).
+    pub size: f32,
 }
 
 impl Light {
@@ -259,6 +264,7 @@ impl Light {
             intensity,
             casts_shadows: true,
             range: None,
+            size: 0.0,
         }
     }
 

@@ -248,6 +248,10 @@ mod tests {
         let exact = ReferenceFrame {
             width: w,
             height: h,
+            coverage: visibility
+                .iter()
+                .map(|v| v.map(|v| v as u8 as f32))
+                .collect(),
             visibility,
             distance: vec![10.0; n],
             image: image::RgbaImage::new(w, h),
