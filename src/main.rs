@@ -247,11 +247,18 @@ fn stability(a: app::cli::StabilityArgs) -> anyhow::Result<()> {
 #[cfg(feature = "sweep")]
 fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
     use umbra::analysis::{chart, grid, sweep as sw};
-    let grid = if a.quick {
+    let mut grid = if a.quick {
         grid::Grid::quick()
     } else {
         grid::Grid::full()
     };
+    if let Some(s) = a.light_size {
+        if !(s.is_finite() && s > 0.0 && s <= 1e6) {
+            anyhow::bail!("--light-size must be a number within 0..1e6, above 0");
+        }
+    }
+    grid.sdsm = a.depth_fit;
+    grid.pcss = a.light_size.is_some();
     let configs = grid.configs();
     let specs = if a.scenes.is_empty() {
         vec!["demo".to_string()]
@@ -339,6 +346,7 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
                     width: w,
                     height: h,
                     repeat: a.repeat,
+                    light_size: a.light_size,
                     ..Default::default()
                 },
                 &skip,

@@ -16,12 +16,13 @@ pub const ZERO_ERROR_FLOOR: f64 = 1e-6;
 /// Chart size in pixels.
 pub const SIZE: (u32, u32) = (1100, 720);
 
-const METHODS: [(&str, RGBColor); 5] = [
+const METHODS: [(&str, RGBColor); 6] = [
     ("scene", RGBColor(150, 150, 150)),
     ("camera", RGBColor(31, 119, 180)),
     ("cascades2", RGBColor(44, 160, 44)),
     ("cascades4", RGBColor(214, 39, 40)),
     ("auto", RGBColor(148, 103, 189)),
+    ("sdsm4", RGBColor(255, 127, 14)),
 ];
 
 /// A chart that could not be drawn or written.
@@ -67,7 +68,7 @@ pub fn short_label(r: &Row) -> String {
 pub fn short_label_of(c: &super::grid::Config) -> String {
     label(
         c.shadow.map_size,
-        super::grid::filter_name(c.shadow.pcf),
+        c.filter(),
         &c.method(),
         super::grid::format_name(c.shadow.format),
         c.bias,
@@ -197,6 +198,13 @@ where
             .draw_series(of("pcf5x5").into_iter().map(|p| Circle::new(p, 6, line)))
             .map_err(e)?;
         chart
+            .draw_series(
+                of("pcss")
+                    .into_iter()
+                    .map(|p| TriangleMarker::new(p, 8, line)),
+            )
+            .map_err(e)?;
+        chart
             .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
             .map_err(e)?
             .label(method)
@@ -208,6 +216,7 @@ where
         ("PCF 2x2", 1),
         ("PCF 3x3", 2),
         ("PCF 5x5", 3),
+        ("PCSS", 4),
     ] {
         chart
             .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
@@ -218,7 +227,8 @@ where
                     0 => Cross::new((x, y), 4, grey.stroke_width(2)).into_dyn(),
                     1 => Circle::new((x, y), 3, grey.filled()).into_dyn(),
                     2 => TriangleMarker::new((x, y), 5, grey.filled()).into_dyn(),
-                    _ => Circle::new((x, y), 6, grey.stroke_width(2)).into_dyn(),
+                    3 => Circle::new((x, y), 6, grey.stroke_width(2)).into_dyn(),
+                    _ => TriangleMarker::new((x, y), 8, grey.stroke_width(2)).into_dyn(),
                 }
             });
     }

@@ -18,12 +18,26 @@ pub struct Config {
     pub shadow: ShadowSettings,
     /// Name of its bias preset (`BIAS_PRESETS`).
     pub bias: &'static str,
+    /// PCSS soft shadows for the lights' sizes (`shadow.soft`); the filter is named `pcss`.
+    pub pcss: bool,
 }
 
 impl Config {
     /// The fitting method, the chart's colour: `scene`, `camera`, `cascades2`, `cascades4`…
     pub fn method(&self) -> String {
+        if self.shadow.depth_fit {
+            return format!("sdsm{}", self.shadow.cascades);
+        }
         method_of(self.shadow.fit, self.shadow.cascades)
+    }
+
+    /// The filter: `pcss`, or the PCF kernel's name (`filter_name`).
+    pub fn filter(&self) -> &'static str {
+        if self.pcss {
+            "pcss"
+        } else {
+            filter_name(self.shadow.pcf)
+        }
     }
 
     /// A short unique name, e.g. `2048-d32-pcf2x2-cascades4-default`.
@@ -32,7 +46,7 @@ impl Config {
             "{}-{}-{}-{}-{}",
             self.shadow.map_size,
             format_name(self.shadow.format),
-            filter_name(self.shadow.pcf),
+            self.filter(),
             self.method(),
             self.bias
         )
@@ -81,6 +95,12 @@ pub struct Grid {
     pub biases: Vec<&'static str>,
     /// Fittings: (fit, cascades); cascades 1 = one map.
     pub fits: Vec<(ShadowFit, u32)>,
+    /// Also 4 cascades fitted to the depths seen (`ShadowSettings::depth_fit`, method `sdsm4`),
+    /// for every map, format, filter and bias.
+    pub sdsm: bool,
+    /// Also PCSS (filter `pcss`, for every map, format, bias and fitting), the other
+    /// configurations then hard whatever the lights' sizes.
+    pub pcss: bool,
 }
 
 impl Grid {
@@ -98,6 +118,8 @@ impl Grid {
                 (ShadowFit::Camera, 2),
                 (ShadowFit::Camera, 4),
             ],
+            sdsm: false,
+            pcss: false,
         }
     }
 
@@ -116,7 +138,16 @@ impl Grid {
     /// Every configuration, cheapest axes varying fastest.
     pub fn configs(&self) -> Vec<Config> {
         let mut out = Vec::new();
-        for &(fit, cascades) in &self.fits {
+        let mut fits: Vec<(ShadowFit, u32, bool)> =
+            self.fits.iter().map(|&(f, c)| (f, c, false)).collect();
+        if self.sdsm {
+            fits.push((ShadowFit::Camera, 4, true));
+        }
+        let mut filters: Vec<(Pcf, bool)> = self.filters.iter().map(|&p| (p, false)).collect();
+        if self.pcss {
+            filters.push((Pcf::P2x2, true));
+        }
+        for &(fit, cascades, depth_fit) in &fits {
             for &bias in &self.biases {
                 let (_, c, s, n) = BIAS_PRESETS
                     .iter()
@@ -124,7 +155,7 @@ impl Grid {
                     .find(|b| b.0 == bias)
                     .unwrap_or(BIAS_PRESETS[1]);
                 for &format in &self.formats {
-                    for &pcf in &self.filters {
+                    for &(pcf, pcss) in &filters {
                         for &map_size in &self.maps {
                             out.push(Config {
                                 shadow: ShadowSettings {
@@ -139,9 +170,11 @@ impl Grid {
                                     snap: true,
                                     cascades,
                                     cube_face: 0,
-                                    depth_fit: false,
+                                    depth_fit,
+                                    soft: pcss || !self.pcss,
                                 },
                                 bias,
+                                pcss,
                             });
                         }
                     }
@@ -208,6 +241,34 @@ mod tests {
         assert!(full
             .iter()
             .any(|c| c.name() == "2048-d32-pcf2x2-camera-default"));
+        // Every full-grid configuration keeps soft shadows for lights with a size.
+        assert!(full.iter().all(|c| c.shadow.soft && !c.pcss));
+    }
+
+    #[test]
+    fn depth_fitted_and_pcss_configurations_join_the_grid_on_request() {
+        let g = Grid {
+            sdsm: true,
+            pcss: true,
+            ..Grid::quick()
+        };
+        let all = g.configs();
+        // 4 maps × (3 filters + PCSS) × (4 fittings + sdsm4).
+        assert_eq!(all.len(), 80);
+        let mut names: Vec<String> = all.iter().map(Config::name).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), 80);
+        let sdsm: Vec<_> = all.iter().filter(|c| c.method() == "sdsm4").collect();
+        assert_eq!(sdsm.len(), 16);
+        assert!(sdsm
+            .iter()
+            .all(|c| c.shadow.depth_fit && c.shadow.cascades == 4));
+        // PCSS configurations are soft; the rest hard, whatever the lights' sizes.
+        assert!(all.iter().all(|c| c.shadow.soft == (c.filter() == "pcss")));
+        assert!(all
+            .iter()
+            .any(|c| c.name() == "2048-d32-pcss-sdsm4-default"));
     }
 
     #[test]

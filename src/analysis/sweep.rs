@@ -2,7 +2,7 @@
 //! timestamped frames), wall time, shadow-map memory, and accuracy against the ray-cast
 //! reference. Rows go to CSV (the record a sweep resumes from) and JSON.
 
-use super::grid::{filter_name, format_name, Config};
+use super::grid::{format_name, Config};
 use crate::gpu::GpuError;
 use crate::reference::{ReferenceFrame, ReferenceScene};
 use crate::render::{FrameStats, Renderer, View, ViewMode};
@@ -90,6 +90,9 @@ pub struct SweepOptions {
     /// Configurations measured together (interleaved); their rows are handed over when the batch
     /// is done, which is what an interrupted sweep keeps.
     pub batch: usize,
+    /// Every light's size (`View::light_size`): the reference is then the area light, and
+    /// configurations other than PCSS's cast hard shadows from it.
+    pub light_size: Option<f32>,
 }
 
 impl Default for SweepOptions {
@@ -99,6 +102,7 @@ impl Default for SweepOptions {
             height: 720,
             repeat: 5,
             batch: 48,
+            light_size: None,
         }
     }
 }
@@ -181,6 +185,7 @@ fn run_batch(
         let mut v = View::new(camera);
         v.shadow = c.shadow;
         v.mode = mode;
+        v.light_size = opts.light_size;
         v
     };
     // Accuracy, once per configuration.
@@ -228,7 +233,7 @@ fn run_batch(
             view: view_name.into(),
             config: c.name(),
             method: c.method(),
-            filter: filter_name(c.shadow.pcf).into(),
+            filter: c.filter().into(),
             format: format_name(c.shadow.format).into(),
             bias: c.bias.into(),
             map_texels: c.shadow.map_size,

@@ -100,6 +100,14 @@ pub struct SweepArgs {
     /// The coarse grid (48 configurations instead of 576).
     #[arg(long)]
     pub quick: bool,
+    /// Also 4 cascades fitted to the depths each view sees (method `sdsm4`).
+    #[arg(long)]
+    pub depth_fit: bool,
+    /// Give every light this size (as for render: degrees of a directional light, radius of
+    /// a point or spot light) and add PCSS (filter `pcss`); the reference is the area light,
+    /// the other filters cast hard shadows from it.
+    #[arg(long)]
+    pub light_size: Option<f32>,
     /// Frames timed per configuration (after one warm-up frame).
     #[arg(long, default_value_t = 5)]
     pub repeat: usize,
@@ -700,6 +708,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         cascades: a.cascades,
         cube_face: a.cube_face,
         depth_fit: a.depth_fit,
+        soft: true,
     };
     Ok(v)
 }

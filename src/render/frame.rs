@@ -406,7 +406,7 @@ pub fn plan_frame(
     // Every shadow-casting light gets its views, in light order, while the frame's views last.
     let mut views: Vec<ShadowView> = Vec::new();
     let mut unshadowed = Vec::new();
-    let any_soft = lights.iter().any(|l| l.casts_shadows && soft_size(l) > 0.0);
+    let any_soft = view.shadow.soft && lights.iter().any(|l| l.casts_shadows && soft_size(l) > 0.0);
     for (i, l) in lights.iter().enumerate() {
         if !(l.casts_shadows && l.intensity > 0.0) {
             continue;
@@ -524,7 +524,11 @@ pub fn plan_frame(
         let cone = Vec4::new(cone.x, cone.y, l.range.unwrap_or(0.0), 0.0);
         let first = views.iter().position(|v| v.light == i);
         // w: the soft-shadow size (0: hard), as the penumbra formula takes it.
-        let soft = if first.is_some() { soft_size(l) } else { 0.0 };
+        let soft = if first.is_some() && view.shadow.soft {
+            soft_size(l)
+        } else {
+            0.0
+        };
         let count = views.iter().filter(|v| v.light == i).count();
         u.lights[i] = LightUniform {
             position: l.position.extend(kind),
@@ -534,7 +538,8 @@ pub fn plan_frame(
             shadow: Vec4::new(first.map_or(-1.0, |f| f as f32), count as f32, 0.0, 0.0),
         };
     }
-    let soft = shadows_on && views.iter().any(|v| soft_size(&lights[v.light]) > 0.0);
+    let soft =
+        shadows_on && view.shadow.soft && views.iter().any(|v| soft_size(&lights[v.light]) > 0.0);
     FramePlan {
         uniform: u,
         shadows_on,

@@ -154,6 +154,9 @@ pub struct ShadowSettings {
     /// offscreen renderer measures them with a first pass at each new camera (a frame at a new
     /// camera costs two); `View::visible_depths` can also be given.
     pub depth_fit: bool,
+    /// Soft shadows (PCSS) for lights with a size (`crate::scene::Light::size`); false: hard
+    /// PCF whatever their size (the sweep's hard configurations against an area light).
+    pub soft: bool,
 }
 
 /// Most cascades a directional light can have.
@@ -174,6 +177,7 @@ impl Default for ShadowSettings {
             cascades: 0,
             cube_face: 0,
             depth_fit: false,
+            soft: true,
         }
     }
 }
