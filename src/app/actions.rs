@@ -37,6 +37,10 @@ pub enum Action {
     ExposureUp,
     /// Exposure half a stop down (`,`).
     ExposureDown,
+    /// Cascades fitted to the depths seen on/off (`G`; `ShadowSettings::depth_fit`).
+    ToggleDepthFit,
+    /// Soft shadows (PCSS) for lights with a size on/off (`J`; `ShadowSettings::soft`).
+    ToggleSoft,
 }
 
 /// The sun as elevation/azimuth in degrees.
@@ -150,6 +154,24 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 n => format!("cascades: {n}"),
             }
         }
+        Action::ToggleDepthFit => {
+            s.depth_fit = !s.depth_fit;
+            format!(
+                "cascades fitted to: {}",
+                if s.depth_fit {
+                    "the depths seen (last frame read back)"
+                } else {
+                    "the scene's boxes in view"
+                }
+            )
+        }
+        Action::ToggleSoft => {
+            s.soft = !s.soft;
+            format!(
+                "soft shadows (PCSS) for lights with a size: {}",
+                if s.soft { "on" } else { "off" }
+            )
+        }
         Action::CycleTonemap => {
             view.tonemap = match view.tonemap {
                 Tonemap::Neutral => Tonemap::Aces,
@@ -262,6 +284,12 @@ mod tests {
             })
             .collect();
         assert_eq!(counts, [1, 2, 3, 4, 0]);
+        let fit = v.shadow.depth_fit;
+        apply(Action::ToggleDepthFit, &mut v, &mut sun);
+        assert_eq!(v.shadow.depth_fit, !fit);
+        let soft = v.shadow.soft;
+        apply(Action::ToggleSoft, &mut v, &mut sun);
+        assert_eq!(v.shadow.soft, !soft);
         let curves: Vec<Tonemap> = (0..3)
             .map(|_| {
                 apply(Action::CycleTonemap, &mut v, &mut sun);

@@ -81,6 +81,10 @@ pub struct Controller {
     pub fov_y: f32,
     /// Scene size (bounds diagonal) that scales speeds and the near plane.
     pub scale: f32,
+    /// Near-plane distance of the camera this controller continues from (its own near plane
+    /// while no larger than the scale's: a street-level camera in a town keeps the ground at
+    /// its feet); None after framing.
+    pub near: Option<f32>,
     held: Vec<MoveKey>,
     drag: Option<Button>,
     cursor: Option<(f32, f32)>,
@@ -107,6 +111,7 @@ impl Controller {
             position: Vec3::ZERO,
             fov_y: 45f32.to_radians(),
             scale: 1.0,
+            near: None,
             held: Vec::new(),
             drag: None,
             cursor: None,
@@ -131,6 +136,7 @@ impl Controller {
         c.yaw = (-forward.x).atan2(-forward.z);
         c.position = eye;
         c.fov_y = camera.fov_y;
+        c.near = Some(camera.near).filter(|n| n.is_finite() && *n > 0.0);
         c
     }
 
@@ -138,6 +144,7 @@ impl Controller {
     pub fn frame(&mut self, bounds: &Aabb, aspect: f32) {
         let (center, radius) = bounds.bounding_sphere();
         self.scale = radius * 2.0;
+        self.near = None;
         self.target = center;
         self.distance = framing_distance(radius, self.fov_y, aspect);
         self.mode = Mode::Orbit;
@@ -257,7 +264,9 @@ impl Controller {
     /// The camera for the current state.
     pub fn camera(&self) -> Camera {
         let eye = self.eye();
-        let near = (self.scale * 1e-3).max(1e-5);
+        let near = (self.scale * 1e-3)
+            .min(self.near.unwrap_or(f32::INFINITY))
+            .max(1e-5);
         Camera::look_at(eye, eye + self.forward(), self.fov_y, near)
     }
 }

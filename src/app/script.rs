@@ -10,8 +10,8 @@
 
 /// Key names a script may press (each one of the viewer's bindings).
 pub const KEYS: &[&str] = &[
-    "up", "down", "left", "right", "[", "]", "k", "+", "-", "v", "h", "n", "l", "t", "comma",
-    "period", "f", "tab", "c", "p",
+    "up", "down", "left", "right", "[", "]", "k", "+", "-", "v", "h", "n", "g", "j", "l", "t",
+    "comma", "period", "f", "tab", "c", "p",
 ];
 
 /// Most steps one script may expand to (a typo such as `*1000000000` is an error, not a hang).

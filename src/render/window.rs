@@ -4,7 +4,9 @@
 
 use super::camera_pass::DEPTH_FORMAT;
 use super::core::{Attachment, FrameCore, MsaaTargets};
-use super::renderer::{copy_to_buffer, rgba_from_readback, transfer_to_host_barrier};
+use super::renderer::{
+    copy_to_buffer, rgba_from_readback, transfer_to_host_barrier, visible_depths,
+};
 use super::settings::{SceneOptions, View};
 use super::swapchain::Swapchain;
 use crate::gpu::barrier::{access_info, Access};
@@ -64,6 +66,11 @@ pub struct WindowRenderer {
     wanted: (u32, u32),
     screenshot: Option<Buffer>,
     last_gpu: Option<(f64, f64)>,
+    /// Per frame slot: a depth readback buffer and, while a copy into it is in flight, the
+    /// camera projection and pixel count it was drawn with (`ShadowSettings::depth_fit`).
+    depth_reads: Vec<(Option<Buffer>, Option<(glam::Mat4, usize)>)>,
+    /// The nearest and farthest view depth of the latest frame read back.
+    seen_depths: Option<(f32, f32)>,
 }
 
 impl WindowRenderer {
@@ -119,6 +126,8 @@ impl WindowRenderer {
             wanted: (width, height),
             screenshot: None,
             last_gpu: None,
+            depth_reads: (0..FRAMES_IN_FLIGHT).map(|_| (None, None)).collect(),
+            seen_depths: None,
         };
         r.ensure_depth()?;
         Ok(r)
@@ -166,7 +175,8 @@ impl WindowRenderer {
             DEPTH_FORMAT,
             e,
             1,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            // Read back for depth fitting.
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
         )?;
         let at = Attachment::of(&image);
         self.depth = Some((image, at));
@@ -180,7 +190,10 @@ impl WindowRenderer {
         self.ensure_depth()
     }
 
-    /// Draws one frame of `view`; with `screenshot`, also returns the presented pixels.
+    /// Draws one frame of `view`; with `screenshot`, also returns the presented pixels. With
+    /// `ShadowSettings::depth_fit` (and no `View::visible_depths`) each frame's depth is read
+    /// back and fits the cascades of a later frame (the latest completed: one or two frames
+    /// behind a moving camera).
     pub fn draw(&mut self, view: &View, screenshot: bool) -> Result<DrawResult, GpuError> {
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
@@ -190,6 +203,26 @@ impl WindowRenderer {
         if let Some(t) = self.core.gpu_times(f) {
             self.last_gpu = Some(t);
         }
+        let slot = &mut self.depth_reads[f];
+        if let (Some(buf), Some((proj, n))) = (slot.0.as_mut(), slot.1.take()) {
+            if let Some(bytes) = buf.mapped() {
+                self.seen_depths =
+                    visible_depths(bytemuck::cast_slice::<u8, f32>(&bytes[..n * 4]), &proj);
+            }
+        }
+        let fit = view.shadow.depth_fit
+            && view.shadow.enabled
+            && view.visible_depths.is_none()
+            && view.shadow_fit_camera.is_none();
+        let fitted;
+        let view = if fit {
+            let mut v = view.clone();
+            v.visible_depths = self.seen_depths;
+            fitted = v;
+            &fitted
+        } else {
+            view
+        };
         let extent = self.swapchain.extent;
         if extent.width == 0 || extent.height == 0 || self.swapchain.raw == vk::SwapchainKHR::null()
         {
@@ -202,6 +235,21 @@ impl WindowRenderer {
         };
         unsafe { d.reset_fences(&[sync.fence]) }.vk("vkResetFences")?;
         let plan = self.core.prepare(f, view, extent.width, extent.height)?;
+        let pixels = extent.width as usize * extent.height as usize;
+        if fit
+            && self.depth_reads[f]
+                .0
+                .as_ref()
+                .is_none_or(|b| b.size < pixels as u64 * 4)
+        {
+            self.depth_reads[f].0 = Some(Buffer::new(
+                &ctx,
+                "depth readback",
+                pixels as u64 * 4,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?);
+        }
         let want_copy = screenshot && self.swapchain.can_copy;
         if want_copy {
             let need = extent.width as u64 * extent.height as u64 * 4;
@@ -234,10 +282,29 @@ impl WindowRenderer {
                 &mut color,
                 depth,
                 self.msaa.as_mut(),
-                false,
+                fit,
                 extent,
             )
             .casters;
+        if fit {
+            depth.transition(d, cmd, Access::TransferSrc);
+            copy_to_buffer(
+                d,
+                cmd,
+                depth.image,
+                vk::ImageAspectFlags::DEPTH,
+                extent,
+                self.depth_reads[f].0.as_ref().expect("buffer").raw,
+            );
+            let aspect = extent.width as f32 / extent.height.max(1) as f32;
+            self.depth_reads[f].1 = Some((
+                super::frame::camera_projection(&view.camera, aspect),
+                pixels,
+            ));
+            if !want_copy {
+                transfer_to_host_barrier(d, cmd);
+            }
+        }
         if want_copy {
             color.transition(d, cmd, Access::TransferSrc);
             copy_to_buffer(
