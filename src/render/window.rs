@@ -53,6 +53,10 @@ pub enum DrawResult {
     },
 }
 
+/// A frame slot's depth readback buffer and, while a copy is in flight, the camera projection
+/// and pixel count it holds.
+type DepthRead = (Option<Buffer>, Option<(glam::Mat4, usize)>);
+
 /// Draws views of a scene into a window's swapchain.
 pub struct WindowRenderer {
     core: FrameCore,
@@ -68,7 +72,7 @@ pub struct WindowRenderer {
     last_gpu: Option<(f64, f64)>,
     /// Per frame slot: a depth readback buffer and, while a copy into it is in flight, the
     /// camera projection and pixel count it was drawn with (`ShadowSettings::depth_fit`).
-    depth_reads: Vec<(Option<Buffer>, Option<(glam::Mat4, usize)>)>,
+    depth_reads: Vec<DepthRead>,
     /// The nearest and farthest view depth of the latest frame read back.
     seen_depths: Option<(f32, f32)>,
 }
