@@ -144,6 +144,23 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
             .with_context(|| format!("writing {}", p.display()))?;
     }
     let mut j = metrics.to_json();
+    // Misclassification along view depth, and where the shown light's cascades split.
+    let by_depth =
+        umbra::reference::misclassified_by_depth(&scored.classified, &frame, &lit.plan, 24);
+    let splits: Vec<f32> = {
+        let v = lit.plan.primary_views();
+        v[..v.len().saturating_sub(1)]
+            .iter()
+            .map(|v| v.far)
+            .collect()
+    };
+    j["by_depth"] = serde_json::json!(by_depth
+        .iter()
+        .map(|b| serde_json::json!({"near": b.near, "far": b.far, "judged": b.judged, "misclassified": b.wrong}))
+        .collect::<Vec<_>>());
+    j["cascade_splits"] = serde_json::json!(splits);
+    #[cfg(feature = "sweep")]
+    write_depth_profile(&a.out, &scene.name, &by_depth, &splits)?;
     j["scene"] = serde_json::json!(scene.name);
     j["size"] = serde_json::json!([w, h]);
     j["shadow_map"] = serde_json::json!(view.shadow.map_size);
@@ -156,6 +173,52 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
         .map(|(s, c)| s + c));
     println!("{j}");
     Ok(())
+}
+
+/// `DIR/depth_profile.svg|png`: misclassified fraction per view-depth bin (log-log), the
+/// cascade splits marked on the line.
+#[cfg(all(feature = "reference", feature = "sweep"))]
+fn write_depth_profile(
+    out: &std::path::Path,
+    name: &str,
+    bins: &[umbra::reference::DepthBin],
+    splits: &[f32],
+) -> anyhow::Result<()> {
+    use umbra::analysis::lines::{write_lines, LineChart, Series};
+    let centre = |b: &umbra::reference::DepthBin| ((b.near * b.far).sqrt()) as f64;
+    let points: Vec<(f64, f64)> = bins
+        .iter()
+        .filter(|b| b.judged > 0)
+        .map(|b| (centre(b), b.fraction()))
+        .collect();
+    let at = |d: f32| {
+        bins.iter()
+            .find(|b| b.near <= d && d <= b.far)
+            .map_or(0.0, |b| b.fraction())
+    };
+    let chart = LineChart {
+        title: format!("{name}: misclassified pixels along view depth"),
+        x_desc: "view depth (scene units)".into(),
+        y_desc: "misclassified fraction of judged pixels (0 drawn at 1e-5)".into(),
+        x_log: true,
+        y_floor: 1e-5,
+        series: vec![Series {
+            label: "misclassified".into(),
+            points,
+        }],
+        thresholds: Vec::new(),
+        marks: splits
+            .iter()
+            .enumerate()
+            .map(|(k, &d)| (format!("split {}", k + 1), (d as f64, at(d))))
+            .collect(),
+    };
+    write_lines(
+        &chart,
+        &out.join("depth_profile.svg"),
+        &out.join("depth_profile.png"),
+    )
+    .map_err(|e| anyhow::anyhow!("depth profile chart: {e}"))
 }
 
 #[cfg(feature = "viewer")]

@@ -207,6 +207,89 @@ pub fn classify(
     }
 }
 
+/// Judged and misclassified pixels within one range of view depth (`misclassified_by_depth`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthBin {
+    /// Nearest view depth of the bin.
+    pub near: f32,
+    /// Farthest view depth of the bin.
+    pub far: f32,
+    /// Pixels judged.
+    pub judged: usize,
+    /// Of which misclassified.
+    pub wrong: usize,
+}
+
+impl DepthBin {
+    /// Misclassified fraction (0 when nothing was judged).
+    pub fn fraction(&self) -> f64 {
+        if self.judged == 0 {
+            0.0
+        } else {
+            self.wrong as f64 / self.judged as f64
+        }
+    }
+}
+
+/// Misclassification along the view depth of the shadow-fitting camera (the plan's cascade
+/// axis): the judged pixels in `bins` log-spaced ranges between the nearest and farthest judged
+/// depth, each with its count of misclassified pixels, so a spike at a cascade split shows.
+pub fn misclassified_by_depth(
+    c: &Classified,
+    reference: &ReferenceFrame,
+    plan: &FramePlan,
+    bins: usize,
+) -> Vec<DepthBin> {
+    let (w, h) = (c.width, c.height);
+    let inv = plan.clip_from_world.inverse();
+    let eye = plan.camera_position;
+    let from = plan.uniform.shadow_light.truncate();
+    let forward = plan.uniform.camera_forward.truncate();
+    let mut depths = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            if c.class[i] == PixelClass::Unjudged {
+                continue;
+            }
+            let n = pixel_to_ndc(x as f32 + 0.5, y as f32 + 0.5, w, h);
+            let q = inv * Vec4::new(n.x, n.y, 0.5, 1.0);
+            let dir = ((q.truncate() / q.w) - eye).normalize_or_zero();
+            let p = eye + dir * reference.distance[i];
+            let d = (p - from).dot(forward);
+            if d.is_finite() && d > 0.0 {
+                depths.push((d, c.class[i] != PixelClass::Correct));
+            }
+        }
+    }
+    let (lo, hi) = depths
+        .iter()
+        .fold((f32::INFINITY, 0.0f32), |(a, b), &(d, _)| {
+            (a.min(d), b.max(d))
+        });
+    let bins = bins.max(1);
+    if depths.is_empty() {
+        return Vec::new();
+    }
+    let hi = hi.max(lo * 1.0001);
+    let edge = |k: usize| lo * (hi / lo).powf(k as f32 / bins as f32);
+    let mut out: Vec<DepthBin> = (0..bins)
+        .map(|k| DepthBin {
+            near: edge(k),
+            far: edge(k + 1),
+            judged: 0,
+            wrong: 0,
+        })
+        .collect();
+    for (d, wrong) in depths {
+        let k = (((d / lo).ln() / (hi / lo).ln()) * bins as f32).floor() as usize;
+        let b = &mut out[k.min(bins - 1)];
+        b.judged += 1;
+        b.wrong += wrong as usize;
+    }
+    out
+}
+
 /// Compares a GPU frame (lit image, shadow view, depth buffer) with the reference for the same
 /// plan. Returns the metrics and a difference image: the reference in grey, false shadow red,
 /// false light blue.

@@ -8,6 +8,9 @@ pub mod raycast;
 pub mod score;
 
 pub use bvh::{Bvh, Hit};
-pub use metrics::{classify, compare, flip, psnr, summarise, Classified, Metrics, PixelClass};
+pub use metrics::{
+    classify, compare, flip, misclassified_by_depth, psnr, summarise, Classified, DepthBin,
+    Metrics, PixelClass,
+};
 pub use raycast::{Pick, Probe, ReferenceFrame, ReferenceScene};
 pub use score::{score, Scored};
