@@ -18,9 +18,10 @@ use umbra::scene::{Camera, Light, Scene};
 const W: u32 = 320;
 const H: u32 = 180;
 
-fn yard() -> Scene {
+/// A scene named `name` with a 2 km ground.
+fn ground(name: &str) -> Scene {
     let mut s = Scene {
-        name: "wall yard".into(),
+        name: name.into(),
         ..Default::default()
     };
     add_object(
@@ -30,6 +31,11 @@ fn yard() -> Scene {
         colored(Vec3::splat(0.7), 1.0),
         Mat4::IDENTITY,
     );
+    s
+}
+
+fn yard() -> Scene {
+    let mut s = ground("wall yard");
     for (name, half, at) in [
         (
             "wall",
@@ -178,17 +184,7 @@ fn four_cascades_fitted_to_the_depths_seen_split_within_them() {
 /// each spans about the same pixels), alternating sides: shadow edges at every view depth, the
 /// cascade splits included, under a sun from the side 30° high.
 fn ladder() -> Scene {
-    let mut s = Scene {
-        name: "ladder".into(),
-        ..Default::default()
-    };
-    add_object(
-        &mut s,
-        "ground",
-        plane(2000.0, 200.0),
-        colored(Vec3::splat(0.7), 1.0),
-        Mat4::IDENTITY,
-    );
+    let mut s = ground("ladder");
     for k in 0..17 {
         let d = 4.0 * 1.3f32.powi(k);
         let half = 0.04 * d;

@@ -9,7 +9,7 @@ mod common;
 
 use common::*;
 use glam::{Mat4, Vec3, Vec4};
-use umbra::reference::{classify, PixelClass, ReferenceFrame, ReferenceScene};
+use umbra::reference::{classify, PixelClass, ReferenceScene};
 use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
 use umbra::scene::shapes::{add_object, add_texture, colored, plane, quad};
 use umbra::scene::{AlphaMode, Camera, Light, Material, Scene, Texture, TextureRef};
@@ -90,19 +90,6 @@ struct Judged {
     ground_shadow_gpu: usize,
 }
 
-/// Whether pixel (x, y) sees the ground (the reference's first hit is the y = 0 plane).
-fn sees_ground(f: &RenderedFrame, exact: &ReferenceFrame, x: u32, y: u32) -> bool {
-    let (_, d) = pixel_ray(&f.plan.clip_from_scene(), x, y, W, H);
-    // Reference distances run from the eye.
-    let o = f.plan.camera_position + f.plan.origin;
-    if d.y >= 0.0 {
-        return false;
-    }
-    let t = -o.y / d.y;
-    let dist = exact.distance[(y * W + x) as usize];
-    (dist - t).abs() < 1e-3 * t
-}
-
 fn judge(scene: &Scene) -> (Judged, RenderedFrame) {
     let ctx = context();
     let mut r = Renderer::new(&ctx, scene).unwrap();
@@ -123,7 +110,7 @@ fn judge(scene: &Scene) -> (Judged, RenderedFrame) {
             j.wrong += matches!(class, PixelClass::FalseShadow | PixelClass::FalseLight) as usize;
         }
         let (x, y) = (i as u32 % W, i as u32 / W);
-        if sees_ground(&f, &exact, x, y) {
+        if ground_point(&f.plan, &exact.distance, (x, y), (W, H)).is_some() {
             j.ground_shadow_exact += (exact.visibility[i] == Some(false)) as usize;
             j.ground_shadow_gpu += (f.image.get_pixel(x, y)[0] < 128) as usize;
         }

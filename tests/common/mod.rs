@@ -108,6 +108,25 @@ pub fn pixel_ray(clip_from_world: &Mat4, x: u32, y: u32, w: u32, h: u32) -> (Vec
     (a, (b - a).normalize())
 }
 
+/// The point of the ground plane y = 0 seen at pixel (x, y) of a `w`×`h` frame planned by `plan`,
+/// when the reference's first hit there (`distance`, from the eye) is that plane.
+pub fn ground_point(
+    plan: &umbra::render::FramePlan,
+    distance: &[f32],
+    (x, y): (u32, u32),
+    (w, h): (u32, u32),
+) -> Option<Vec3> {
+    let (_, d) = pixel_ray(&plan.clip_from_scene(), x, y, w, h);
+    // Reference distances run from the eye.
+    let o = plan.camera_position + plan.origin;
+    if d.y >= 0.0 {
+        return None;
+    }
+    let t = -o.y / d.y;
+    let dist = distance[(y * w + x) as usize];
+    ((dist - t).abs() < 1e-3 * t).then(|| o + d * t)
+}
+
 /// sRGB byte → linear.
 pub fn srgb_to_linear(b: u8) -> f32 {
     let c = b as f32 / 255.0;
