@@ -12,30 +12,14 @@ use common::*;
 use glam::{Mat4, Vec3};
 use umbra::reference::{misclassified_by_depth, score, ReferenceScene};
 use umbra::render::{Renderer, View};
-use umbra::scene::shapes::{add_object, colored, cuboid, plane};
+use umbra::scene::shapes::{add_object, colored, cuboid};
 use umbra::scene::{Camera, Light, Scene};
 
 const W: u32 = 320;
 const H: u32 = 180;
 
-/// A scene named `name` with a 2 km ground.
-fn ground(name: &str) -> Scene {
-    let mut s = Scene {
-        name: name.into(),
-        ..Default::default()
-    };
-    add_object(
-        &mut s,
-        "ground",
-        plane(2000.0, 200.0),
-        colored(Vec3::splat(0.7), 1.0),
-        Mat4::IDENTITY,
-    );
-    s
-}
-
 fn yard() -> Scene {
-    let mut s = ground("wall yard");
+    let mut s = ground_scene(2000.0, "wall yard");
     for (name, half, at) in [
         (
             "wall",
@@ -184,7 +168,7 @@ fn four_cascades_fitted_to_the_depths_seen_split_within_them() {
 /// each spans about the same pixels), alternating sides: shadow edges at every view depth, the
 /// cascade splits included, under a sun from the side 30° high.
 fn ladder() -> Scene {
-    let mut s = ground("ladder");
+    let mut s = ground_scene(2000.0, "ladder");
     for k in 0..17 {
         let d = 4.0 * 1.3f32.powi(k);
         let half = 0.04 * d;

@@ -12,7 +12,7 @@ use glam::{Mat4, Vec3};
 use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
 use umbra::render::{Renderer, ShadowFormat, ShadowSettings, View, ViewMode};
-use umbra::scene::shapes::{add_object, colored, cuboid, plane};
+use umbra::scene::shapes::{add_object, colored, cuboid};
 use umbra::scene::{Camera, Light, LightKind, Scene};
 
 /// Width of the unjudged band around exact shadow edges, in shadow texels.
@@ -37,25 +37,9 @@ fn box_aabb() -> Aabb {
     Aabb::new(Vec3::new(-h.x, 0.0, -h.z), Vec3::new(h.x, 2.0 * h.y, h.z))
 }
 
-/// A 60 m grey ground plane at y = 0, and nothing else.
-fn ground_scene(name: &str) -> Scene {
-    let mut s = Scene {
-        name: name.into(),
-        ..Default::default()
-    };
-    add_object(
-        &mut s,
-        "ground",
-        plane(60.0, 1.0),
-        colored(Vec3::splat(0.8), 1.0),
-        Mat4::IDENTITY,
-    );
-    s
-}
-
 fn caster_scene(light: Light, half: Vec3) -> Scene {
     CASTER_HALF.with(|c| c.set(half));
-    let mut s = ground_scene("caster on plane");
+    let mut s = ground_scene(60.0, "caster on plane");
     add_object(
         &mut s,
         "caster",
@@ -299,7 +283,7 @@ fn d16_shadow_map_matches_geometry_too() {
 #[test]
 fn no_acne_on_a_plane_from_10_to_90_degrees() {
     let ctx = context();
-    let s = ground_scene("plane");
+    let s = ground_scene(60.0, "plane");
     let mut r = Renderer::new(&ctx, &s).unwrap();
     let cases = (10..=90)
         .step_by(10)

@@ -538,8 +538,8 @@ pub fn plan_frame(
             shadow: Vec4::new(first.map_or(-1.0, |f| f as f32), count as f32, 0.0, 0.0),
         };
     }
-    let soft =
-        shadows_on && view.shadow.soft && views.iter().any(|v| soft_size(&lights[v.light]) > 0.0);
+    // Soft where a shadowed light's uniform carries a size (set above).
+    let soft = shadows_on && u.lights.iter().any(|l| l.direction.w > 0.0);
     FramePlan {
         uniform: u,
         shadows_on,

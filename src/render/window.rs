@@ -305,9 +305,6 @@ impl WindowRenderer {
                 super::frame::camera_projection(&view.camera, aspect),
                 pixels,
             ));
-            if !want_copy {
-                transfer_to_host_barrier(d, cmd);
-            }
         }
         if want_copy {
             color.transition(d, cmd, Access::TransferSrc);
@@ -319,6 +316,8 @@ impl WindowRenderer {
                 extent,
                 self.screenshot.as_ref().expect("buffer").raw,
             );
+        }
+        if fit || want_copy {
             transfer_to_host_barrier(d, cmd);
         }
         color.transition(d, cmd, Access::Present);

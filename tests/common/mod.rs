@@ -127,6 +127,23 @@ pub fn ground_point(
     ((dist - t).abs() < 1e-3 * t).then(|| o + d * t)
 }
 
+/// A scene named `name` holding a grey ground plane `size` across at y = 0, and nothing else.
+pub fn ground_scene(size: f32, name: &str) -> umbra::scene::Scene {
+    use umbra::scene::shapes::{add_object, colored, plane};
+    let mut s = umbra::scene::Scene {
+        name: name.into(),
+        ..Default::default()
+    };
+    add_object(
+        &mut s,
+        "ground",
+        plane(size, 1.0),
+        colored(Vec3::splat(0.8), 1.0),
+        Mat4::IDENTITY,
+    );
+    s
+}
+
 /// sRGB byte → linear.
 pub fn srgb_to_linear(b: u8) -> f32 {
     let c = b as f32 / 255.0;
