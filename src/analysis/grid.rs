@@ -57,6 +57,9 @@ impl Config {
 pub fn method_of(fit: ShadowFit, cascades: u32) -> String {
     match (fit, cascades) {
         (ShadowFit::Scene, _) => "scene".into(),
+        (ShadowFit::Sphere, 0) => "sphere-auto".into(),
+        (ShadowFit::Sphere, 1) => "sphere".into(),
+        (ShadowFit::Sphere, n) => format!("sphere-cascades{n}"),
         (ShadowFit::Camera, 0) => "auto".into(),
         (ShadowFit::Camera, 1) => "camera".into(),
         (ShadowFit::Camera, n) => format!("cascades{n}"),
@@ -172,6 +175,7 @@ impl Grid {
                                     cube_face: 0,
                                     depth_fit,
                                     soft: pcss || !self.pcss,
+                                    ..ShadowSettings::default()
                                 },
                                 bias,
                                 pcss,

@@ -378,12 +378,18 @@ pub struct ViewArgs {
     /// Normal-offset bias in shadow texels.
     #[arg(long, default_value_t = ShadowSettings::default().normal_offset, allow_hyphen_values = true)]
     pub normal_offset: f32,
-    /// Fit the light frustum to the camera view or the whole scene.
-    #[arg(long, value_parser = ["camera", "scene"], default_value = "camera")]
+    /// Fit the light frustum to the receivers the camera sees (`camera`), to the bounding sphere
+    /// of the camera's frustum within the scene (`sphere`: a size that does not follow the
+    /// camera's moves, so less shimmer in motion, coarser texels), or to the whole scene.
+    #[arg(long, value_parser = ["camera", "sphere", "scene"], default_value = "camera")]
     pub fit: String,
     /// Do not snap the light frustum to whole texels.
     #[arg(long)]
     pub no_snap: bool,
+    /// Steps per doubling of the snapped light frustum's size: fewer steps, less shimmer in
+    /// motion, coarser texels (1: powers of two).
+    #[arg(long, default_value_t = ShadowSettings::default().extent_steps, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub extent_steps: u32,
     /// Cascades of the sun's shadow map (1–4; with `--fit camera`): each covers a slice of the
     /// view depth with its own map, so near shadows keep their detail in large scenes. 0 (the
     /// default) chooses 1, 2 or 4 per frame from how much coarser than a pixel one map's texels
@@ -699,12 +705,13 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         constant_bias: a.bias_constant,
         slope_bias: a.bias_slope,
         normal_offset: a.normal_offset,
-        fit: if a.fit == "scene" {
-            ShadowFit::Scene
-        } else {
-            ShadowFit::Camera
+        fit: match a.fit.as_str() {
+            "scene" => ShadowFit::Scene,
+            "sphere" => ShadowFit::Sphere,
+            _ => ShadowFit::Camera,
         },
         snap: !a.no_snap,
+        extent_steps: a.extent_steps,
         cascades: a.cascades,
         cube_face: a.cube_face,
         depth_fit: a.depth_fit,

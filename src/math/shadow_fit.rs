@@ -3,9 +3,13 @@
 //! Directional lights: the orthographic light frustum covers the receivers the camera can see
 //! (camera frustum ∩ scene bounds, computed exactly by clipping the two convex solids against each
 //! other) and reaches towards the light far enough to include every caster in the scene bounds.
-//! With `snap`, the square extent is quantised to steps of 2^(1/8) and the origin is snapped to
+//! With `snap`, the square extent is quantised to steps of 2^(1/8) (`extent_steps`: steps per
+//! doubling) and the origin is snapped to
 //! whole shadow texels in a light space that only rotates with the light, so camera motion moves
-//! the map by whole texels and shadow edges do not shimmer.
+//! the map by whole texels and shadow edges do not shimmer between the extent's steps. With
+//! `sphere`, the map covers the bounding sphere of the camera's frustum instead (stable cascades):
+//! its size no longer follows where the camera is or looks, so it steps far less often, for
+//! coarser texels.
 
 use super::projection::{orthographic_reversed, perspective_infinite_reversed};
 use super::Aabb;
@@ -181,6 +185,11 @@ pub struct DirectionalFitInput {
     pub map_size: u32,
     /// Quantise the extent and snap the origin to whole texels.
     pub snap: bool,
+    /// Cover the bounding sphere of the camera's frustum (within the scene) instead of the
+    /// receivers it sees: a size that does not change as the camera moves or turns.
+    pub sphere: bool,
+    /// With `snap`, steps per doubling of the extent's geometric ladder (8: 2^(1/8) apart).
+    pub extent_steps: u32,
 }
 
 /// A fitted directional-light projection.
@@ -226,10 +235,57 @@ pub fn light_view_rotation(direction: Vec3) -> Mat4 {
     Mat4::look_to_rh(Vec3::ZERO, d, up)
 }
 
-/// Quantises `x > 0` up to the next step of a geometric ladder with 8 steps per doubling.
-pub fn quantize_extent(x: f32) -> f32 {
-    let steps = (x.log2() * 8.0).ceil();
-    (steps / 8.0).exp2()
+/// Quantises `x > 0` up to the next step of a geometric ladder with `per_octave` steps per
+/// doubling (at least 1).
+pub fn quantize_extent(x: f32, per_octave: u32) -> f32 {
+    let k = per_octave.max(1) as f32;
+    let steps = (x.log2() * k).ceil();
+    (steps / k).exp2()
+}
+
+/// The bounding sphere of a frustum slice: its centre's view depth and its radius. Both depend
+/// only on the slice's near and far distances, field of view and aspect, not on where the camera
+/// is or where it looks.
+pub fn slice_sphere(near: f32, far: f32, fov_y: f32, aspect: f32) -> (f32, f32) {
+    // Half-diagonal of the slice's cross-section per unit depth.
+    let k2 = (fov_y * 0.5).tan().powi(2) * (1.0 + aspect * aspect);
+    // Equidistant from the near and far corners, or on the far plane when that is nearer.
+    let z = (0.5 * (near + far) * (1.0 + k2)).clamp(near, far);
+    let r = ((z - near).powi(2) + near * near * k2)
+        .max((far - z).powi(2) + far * far * k2)
+        .sqrt();
+    (z, r)
+}
+
+/// The sphere fit's square in light space (side, centre x, centre y): it covers the bounding
+/// sphere of the camera's frustum slice, so its side does not change as the camera moves or turns
+/// (only with its depth range, field of view and aspect); where the scene is narrower than that
+/// side along an axis the square is centred on the scene there, else it follows the sphere within
+/// the scene's bounds. A fit that hugged the visible receivers would change size every frame the
+/// camera moves, and every change of texel size re-rasterises every shadow edge (shimmer).
+fn stable_square(
+    c: &CameraFrustum,
+    view: &Mat4,
+    scene_l: &Aabb,
+    min_extent: f32,
+) -> (f32, f32, f32) {
+    let (z, r) = slice_sphere(c.near, c.far, c.fov_y, c.aspect);
+    let world_from_view = c.view_from_world.inverse();
+    let centre = view.transform_point3(world_from_view.transform_point3(Vec3::new(0.0, 0.0, -z)));
+    let (sw, sh) = (scene_l.max.x - scene_l.min.x, scene_l.max.y - scene_l.min.y);
+    let side = (2.0 * r).min(sw.max(sh)).max(min_extent);
+    let place = |lo: f32, hi: f32, at: f32| {
+        if hi - lo <= side {
+            0.5 * (lo + hi)
+        } else {
+            at.clamp(lo + 0.5 * side, hi - 0.5 * side)
+        }
+    };
+    (
+        side,
+        place(scene_l.min.x, scene_l.max.x, centre.x),
+        place(scene_l.min.y, scene_l.max.y, centre.y),
+    )
 }
 
 /// Fits an orthographic light projection (see the module documentation).
@@ -257,17 +313,22 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
     let size = input.map_size.max(1) as f32;
     // Guard against a degenerate (flat or point) receiver set.
     let min_extent = (scene.diagonal() * 1e-4).max(1e-4);
-    let raw = (recv.max.x - recv.min.x)
-        .max(recv.max.y - recv.min.y)
-        .max(min_extent);
-    let cx = 0.5 * (recv.min.x + recv.max.x);
-    let cy = 0.5 * (recv.min.y + recv.max.y);
+    let (raw, cx, cy) = match (&input.camera, input.sphere) {
+        (Some(c), true) => stable_square(c, &view, &scene_l, min_extent),
+        _ => (
+            (recv.max.x - recv.min.x)
+                .max(recv.max.y - recv.min.y)
+                .max(min_extent),
+            0.5 * (recv.min.x + recv.max.x),
+            0.5 * (recv.min.y + recv.max.y),
+        ),
+    };
     // z: from the farthest receiver to the caster nearest the light (light looks down −z).
     let z_far = recv.min.z;
     let z_near = scene_l.max.z;
     let (lo_x, lo_y, extent, texel, mut zf, mut zn);
     if input.snap {
-        extent = quantize_extent(raw * (1.0 + 4.0 / size));
+        extent = quantize_extent(raw * (1.0 + 4.0 / size), input.extent_steps);
         texel = extent / size;
         lo_x = ((cx - 0.5 * extent) / texel).floor() * texel;
         lo_y = ((cy - 0.5 * extent) / texel).floor() * texel;
@@ -414,6 +475,8 @@ mod tests {
                 camera: None,
                 map_size: 2048,
                 snap,
+                sphere: false,
+                extent_steps: 8,
             });
             let fit = fit_directional(&DirectionalFitInput {
                 direction: dir,
@@ -421,6 +484,8 @@ mod tests {
                 camera: Some(cam),
                 map_size: 2048,
                 snap,
+                sphere: false,
+                extent_steps: 8,
             });
             let e = fit.light_box.extent();
             let w = whole.light_box.extent();
@@ -454,6 +519,8 @@ mod tests {
             camera: Some(camera(Vec3::new(3.0, 4.0, 9.0), Vec3::ZERO)),
             map_size: 1024,
             snap: true,
+            sphere: false,
+            extent_steps: 8,
         });
         for i in 1..20 {
             let dx = i as f32 * base.texel_world * 0.09;
@@ -466,6 +533,8 @@ mod tests {
                 )),
                 map_size: 1024,
                 snap: true,
+                sphere: false,
+                extent_steps: 8,
             });
             assert_eq!(moved.texel_world, base.texel_world);
             let shift = (moved.light_box.min - base.light_box.min) / base.texel_world;
@@ -482,7 +551,7 @@ mod tests {
         let mut last = 0.0;
         for i in 1..1000 {
             let x = i as f32 * 0.037;
-            let q = quantize_extent(x);
+            let q = quantize_extent(x, 8);
             assert!(q >= x * 0.9999 && q <= x * 1.0906 + 1e-6, "{x} {q}");
             assert!(q >= last);
             last = q;
@@ -497,5 +566,65 @@ mod tests {
         assert!(tan_half > 0.5f32.tan());
         let edge = project(&m, Vec3::new(5.0 * 0.5f32.tan(), 0.0, 0.0));
         assert!(edge.x.abs() < 1.0 && edge.x.abs() > 0.8);
+    }
+
+    #[test]
+    fn slice_sphere_holds_the_slice_tightly() {
+        for (near, far, fov) in [(0.1f32, 4.0f32, 0.8f32), (1.0, 1.5, 1.2), (0.5, 100.0, 0.3)] {
+            let c = CameraFrustum {
+                view_from_world: Mat4::IDENTITY,
+                fov_y: fov,
+                aspect: 16.0 / 9.0,
+                near,
+                far,
+            };
+            let (z, r) = slice_sphere(near, far, fov, 16.0 / 9.0);
+            let centre = Vec3::new(0.0, 0.0, -z);
+            let d: Vec<f32> = c.corners().iter().map(|p| p.distance(centre)).collect();
+            let widest = d.iter().copied().fold(0.0, f32::max);
+            // Every corner inside, the farthest on the sphere.
+            assert!((widest / r - 1.0).abs() < 1e-4, "{d:?} vs {r}");
+        }
+    }
+
+    #[test]
+    fn sphere_fit_keeps_its_size_as_the_camera_moves_and_turns() {
+        let dir = Vec3::new(-0.3, -1.0, -0.2).normalize();
+        let fit = |eye: Vec3, target: Vec3, sphere: bool| {
+            let cam = CameraFrustum {
+                far: 4.0,
+                ..camera(eye, target)
+            };
+            let f = fit_directional(&DirectionalFitInput {
+                direction: dir,
+                scene_bounds: scene(),
+                camera: Some(cam),
+                map_size: 1024,
+                snap: true,
+                sphere,
+                extent_steps: 8,
+            });
+            // Every receiver it sees lands inside the map.
+            for p in frustum_box_intersection(&cam, &scene()) {
+                let q = project(&f.light_clip_from_world, p);
+                assert!(q.x.abs() <= 1.0 + 1e-4 && q.y.abs() <= 1.0 + 1e-4, "{q}");
+            }
+            f.texel_world
+        };
+        let poses = [
+            (Vec3::new(0.0, 1.5, 0.0), Vec3::new(3.0, 0.0, 1.0)),
+            (Vec3::new(-4.0, 2.0, 5.0), Vec3::new(-4.0, 0.0, 1.0)),
+            (Vec3::new(6.0, 1.0, -6.0), Vec3::new(9.0, 1.5, -6.5)),
+            (Vec3::new(2.0, 2.5, 2.0), Vec3::new(2.5, 0.0, 2.2)),
+        ];
+        let sphere: Vec<f32> = poses.iter().map(|&(e, t)| fit(e, t, true)).collect();
+        assert!(sphere.iter().all(|&t| t == sphere[0]), "{sphere:?}");
+        // The receivers' fit changes size with the same moves, and is finer.
+        let tight: Vec<f32> = poses.iter().map(|&(e, t)| fit(e, t, false)).collect();
+        assert!(tight.iter().any(|&t| t != tight[0]), "{tight:?}");
+        assert!(
+            tight.iter().all(|&t| t <= sphere[0]),
+            "{tight:?} vs {sphere:?}"
+        );
     }
 }

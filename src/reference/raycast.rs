@@ -60,11 +60,15 @@ pub struct ReferenceFrame {
     /// Per pixel: the surface seen is curved (its interpolated normal leaves the flat face's by
     /// more than 1°); false for flat faces and for the background.
     pub curved: Vec<bool>,
+    /// Per pixel: the cosine between the surface's interpolated normal (facing the viewer) and
+    /// the direction to the shadowed light, the n·l that decides whether it faces the light; 1
+    /// where no surface is hit or no light is shadowed.
+    pub incidence: Vec<f32>,
 }
 
 /// One reference pixel: (centre visibility, visible fraction) of the shadowed light where a
-/// surface is hit, distance, colour, curved.
-type PixelResult = (Option<(bool, f32)>, f32, [u8; 4], bool);
+/// surface is hit, distance, colour, curved, incidence.
+type PixelResult = (Option<(bool, f32)>, f32, [u8; 4], bool, f32);
 
 impl ReferenceFrame {
     /// The shadowed light's visible fraction as the GPU's shadow view writes visibility: grey
@@ -382,6 +386,50 @@ impl<'a> ReferenceScene<'a> {
         )
     }
 
+    /// Whether a caster of light `i` lies within `radius` of surface point `p` (geometric normal
+    /// `ng`) across the light's direction: shadow rays start from 32 points of a disk of that
+    /// radius around `p` (across the direction to the light, moved along it onto `p`'s tangent
+    /// plane). A shadow map resolves
+    /// casters to its lookup's reach, so a false shadow with such a caster nearby is a shadow
+    /// drawn too wide, not the receiver shadowing itself.
+    pub fn caster_within(
+        &self,
+        plan: &FramePlan,
+        i: usize,
+        p: Vec3,
+        ng: Vec3,
+        radius: f32,
+    ) -> bool {
+        let Some(l) = plan.lights.get(i) else {
+            return false;
+        };
+        let (dir, _, _) = light_at(l, p);
+        let cos = ng.dot(dir);
+        if cos.abs() < 1e-3 {
+            return false;
+        }
+        let side = if cos >= 0.0 { ng } else { -ng };
+        let (e1, e2) = dir.any_orthonormal_pair();
+        (0..32).any(|k| {
+            let u = spiral(k, 32) * radius;
+            let o = e1 * u.x + e2 * u.y;
+            // Onto the tangent plane along the light's direction.
+            let start = p + o - dir * (ng.dot(o) / cos) + side * self.eps;
+            let (d, t) = match l.kind {
+                LightKind::Directional => (dir, f32::INFINITY),
+                _ => {
+                    let to = l.position - start;
+                    let t = to.length();
+                    (to / t.max(1e-20), t)
+                }
+            };
+            self.bvh
+                .occluded_where(&Ray::new(start, d), self.eps, t - self.eps, &|h: &Hit| {
+                    self.stops(h, true)
+                })
+        })
+    }
+
     /// The nearest surface along a primary ray from `t_min` (alpha-masked texels let it
     /// through).
     fn intersect_from(&self, ray: &Ray, t_min: f32) -> Option<Hit> {
@@ -604,11 +652,16 @@ impl<'a> ReferenceScene<'a> {
                 );
                 let ray = primary_ray(&inv, eye, x, y, width, height);
                 match self.intersect(&ray) {
-                    None => (None, f32::INFINITY, background, false),
+                    None => (None, f32::INFINITY, background, false, 1.0),
                     Some(h) => {
                         let (vis, cover, rgb) = self.shade(plan, &ray, &h, ambient);
                         let rgb = self.blend_behind(plan, &ray, &h, plan.display(rgb), ambient, 0);
                         let (ng, n) = self.hit_normals(&h);
+                        let incidence = plan.shadow_light.map_or(1.0, |i| {
+                            let (_, flip) = face_viewer(ng, n, ray.dir);
+                            let facing = if flip { -n } else { n };
+                            facing.dot(light_at(&plan.lights[i], ray.at(h.t)).0)
+                        });
                         (
                             Some((vis, cover)),
                             h.t,
@@ -619,6 +672,7 @@ impl<'a> ReferenceScene<'a> {
                                 255,
                             ],
                             ng.dot(n).abs() < CURVED_COS,
+                            incidence,
                         )
                     }
                 }
@@ -636,6 +690,7 @@ impl<'a> ReferenceScene<'a> {
             distance: results.iter().map(|r| r.1).collect(),
             image,
             curved: results.iter().map(|r| r.3).collect(),
+            incidence: results.iter().map(|r| r.4).collect(),
         }
     }
 

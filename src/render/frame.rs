@@ -724,10 +724,12 @@ fn directional_views(
             camera,
             map_size: size,
             snap: view.shadow.snap,
+            sphere: view.shadow.fit == ShadowFit::Sphere,
+            extent_steps: view.shadow.extent_steps,
         })
     };
     match view.shadow.fit {
-        ShadowFit::Camera => {
+        ShadowFit::Camera | ShadowFit::Sphere => {
             let mut frustum = fitting_frustum(fit_cam, aspect, bounds);
             // Sample-distribution fitting: the frustum ends where the depths seen end.
             if let Some((lo, hi)) = view

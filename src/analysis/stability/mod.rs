@@ -28,8 +28,11 @@ pub const SCHEMA: &str = "umbra-stability/1";
 /// Pixel counts of one frame classified against the exact reference. Acne is false shadow that
 /// does not belong to a misplaced shadow edge or a silhouette: a false-shadow region (8-connected)
 /// that touches no exactly shadowed pixel, no edge band (2 pixels around exact edges,
-/// `reference::metrics::EDGE_PIXELS`) and no silhouette (where one pixel sample of a surface seen
-/// edge-on decides). A shadow drawn too wide, which at grazing sun reaches far past any pixel
+/// `reference::metrics::EDGE_PIXELS`), no silhouette (where one pixel sample of a surface seen
+/// edge-on decides), not the frame's border band of the same width (an exact edge may lie just
+/// outside the frame, where no band is drawn), and has no caster within the shadow lookup's reach
+/// across the light ([`near_casters`]: the shadow of a caster the map resolves only to its texels,
+/// drawn too wide, whose exact shadow may be hidden behind the caster or thinner than a pixel). A shadow drawn too wide, which at grazing sun reaches far past any pixel
 /// band, is false shadow at the edge, not acne. Planar and curved split the judged
 /// pixels by the receiver (curved: interpolated normal more than 1° off the face normal).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -50,12 +53,32 @@ pub struct Counts {
     pub false_light_interior: usize,
     /// False light within the edge bands (peter-panning shows here first).
     pub false_light_edge: usize,
+    /// Judged pixels on receivers within [`EDGE_ON_DEGREES`] of edge-on to the light.
+    pub edge_on: usize,
+    /// Of those, acne and false light away from edges (counted in the totals above too).
+    pub edge_on_interior: usize,
 }
+
+/// Receivers turned less than this many degrees towards the light (|n·l| < sin 5°) are
+/// *edge-on*: a map texel spreads over more than 11 texel lengths of them (projective aliasing),
+/// so their shadow comes from a texel or two however fine the map, and their lighting is under
+/// 9 % of full. The degenerate cases judge them apart (reported, not bounded); the same 5° is the
+/// issue's own limit for curved receivers.
+pub const EDGE_ON_DEGREES: f32 = 5.0;
 
 impl Counts {
     /// Counts the classes of `c` against the exact frame it was classified with.
     pub fn of(c: &Classified, exact: &ReferenceFrame) -> Self {
+        Self::with_casters(c, exact, &[])
+    }
+
+    /// As [`Counts::of`], where `near_caster[i]` says that false-shadow pixel `i` has a caster
+    /// within the shadow lookup's reach across the light (see [`near_casters`]): that pixel is
+    /// the caster's shadow drawn too wide, not acne (it attaches no neighbour: acne spreads over
+    /// receivers near casters too).
+    pub fn with_casters(c: &Classified, exact: &ReferenceFrame, near_caster: &[bool]) -> Self {
         let attached = attached_false_shadow(c, exact);
+        let near = |i: usize| near_caster.get(i).copied().unwrap_or(false);
         let mut k = Counts::default();
         for (i, class) in c.class.iter().enumerate() {
             if *class == PixelClass::Unjudged {
@@ -68,8 +91,21 @@ impl Counts {
             } else {
                 k.planar += 1;
             }
+            let edge_on = exact
+                .incidence
+                .get(i)
+                .is_some_and(|c| c.abs() < EDGE_ON_DEGREES.to_radians().sin());
+            if edge_on {
+                k.edge_on += 1;
+                let interior = match *class {
+                    PixelClass::FalseShadow => !attached[i] && !near(i),
+                    PixelClass::FalseLight => !c.edge[i],
+                    _ => false,
+                };
+                k.edge_on_interior += interior as usize;
+            }
             match *class {
-                PixelClass::FalseShadow if attached[i] => k.false_shadow_edge += 1,
+                PixelClass::FalseShadow if attached[i] || near(i) => k.false_shadow_edge += 1,
                 PixelClass::FalseShadow if bent => k.acne_curved += 1,
                 PixelClass::FalseShadow => k.acne_planar += 1,
                 PixelClass::FalseLight if c.edge[i] => k.false_light_edge += 1,
@@ -126,11 +162,19 @@ fn attached_false_shadow(c: &Classified, exact: &ReferenceFrame) -> Vec<bool> {
             .filter(move |&(nx, ny)| nx >= 0 && ny >= 0 && nx < w && ny < h)
             .map(move |(nx, ny)| (ny * w + nx) as usize)
     };
+    // Within the edge band's width of the frame's border, an exact edge may lie just outside
+    // the frame, where no band was drawn: attachment there cannot be ruled out.
+    let band = crate::reference::metrics::EDGE_PIXELS as i64;
+    let at_border = |i: usize| {
+        let (x, y) = (i as i64 % w, i as i64 / w);
+        x < band || y < band || x >= w - band || y >= h - band
+    };
     let seeds: Vec<usize> = (0..c.class.len())
         .filter(|&i| {
             let d = exact.distance[i];
             fs(i)
                 && (c.edge[i]
+                    || at_border(i)
                     || neighbours(i).any(|j| {
                         exact.visibility[j] == Some(false)
                             || c.class[j] == PixelClass::Unjudged
@@ -190,7 +234,64 @@ pub fn classify_view(
     let frame =
         exact.get_or_insert_with(|| reference.render(&f.plan, size.0, size.1, f.plan.ambient));
     let c = classify(&f.image, f.depth.as_deref().unwrap_or(&[]), &f.plan, frame);
-    Ok((Counts::of(&c, frame), f))
+    let near = near_casters(reference, view, &f, &c, size);
+    Ok((Counts::with_casters(&c, frame, &near), f))
+}
+
+/// Shadow texels around a lookup that can decide it: the filter's reach, the normal offset (which
+/// moves the lookup across the light by up to that many texels) and one for rasterising casters
+/// at texel centres.
+pub fn lookup_reach_texels(s: &crate::render::ShadowSettings, soft: bool) -> f32 {
+    crate::render::frame::lookup_reach(s.pcf, soft) as f32 + s.normal_offset.max(0.0) + 1.0
+}
+
+/// Per pixel of `c`: a false shadow with a caster of the shadowed light within
+/// [`lookup_reach_texels`] of its surface point across the light
+/// ([`ReferenceScene::caster_within`]), the texel being that of the finest shadow view holding
+/// the point. Only false-shadow pixels are tested; the rest are false.
+pub fn near_casters(
+    reference: &ReferenceScene,
+    view: &View,
+    f: &RenderedFrame,
+    c: &Classified,
+    (w, h): (u32, u32),
+) -> Vec<bool> {
+    let mut near = vec![false; c.class.len()];
+    let Some(light) = f.plan.shadow_light else {
+        return near;
+    };
+    let views = f.plan.light_views(light);
+    let reach = lookup_reach_texels(&view.shadow, f.plan.soft);
+    let idx: Vec<usize> = (0..c.class.len())
+        .filter(|&i| c.class[i] == PixelClass::FalseShadow)
+        .collect();
+    let pixels: Vec<(f32, f32)> = idx
+        .iter()
+        .map(|&i| ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5))
+        .collect();
+    let probes = reference.probe(&f.plan, &pixels, w, h);
+    let point_light = f
+        .plan
+        .lights
+        .get(light)
+        .filter(|l| l.kind != crate::scene::LightKind::Directional)
+        .map(|l| l.position);
+    for (&i, probe) in idx.iter().zip(probes) {
+        let Some(p) = probe else { continue };
+        let holds = |v: &&crate::render::ShadowView| {
+            let q = crate::math::shadow_fit::project(&v.light_clip_from_world, p.position);
+            q.x.abs() <= 1.0 && q.y.abs() <= 1.0 && (0.0..=1.0).contains(&q.z)
+        };
+        let Some(v) = views.iter().find(holds).or(views.last()) else {
+            continue;
+        };
+        let texel = match point_light {
+            Some(at) => v.texel_world * at.distance(p.position),
+            None => v.texel_world,
+        };
+        near[i] = reference.caster_within(&f.plan, light, p.position, p.normal, reach * texel);
+    }
+    near
 }
 
 /// `view` of `scene` classified on a renderer and a reference of its own, for probes that change
@@ -256,6 +357,7 @@ mod tests {
             distance: vec![10.0; n],
             image: image::RgbaImage::new(w, h),
             curved: vec![false; n],
+            incidence: vec![1.0; n],
         };
         let mut class = vec![PixelClass::Correct; n];
         for &(x, y) in gpu_shadow {
@@ -287,5 +389,41 @@ mod tests {
         let k = Counts::of(&c, &e);
         assert_eq!((k.acne_planar, k.false_shadow_edge), (0, 40));
         assert_eq!(k.judged, 96);
+    }
+
+    #[test]
+    fn false_shadow_at_the_frame_border_is_not_acne() {
+        // The same speck on the bottom row: an exact edge may lie just below the frame.
+        let (c, e) = frame(&[(8, 7), (9, 7), (8, 4)]);
+        let k = Counts::of(&c, &e);
+        assert_eq!((k.acne_planar, k.false_shadow_edge), (1, 2));
+    }
+
+    #[test]
+    fn false_shadow_beside_a_caster_is_not_acne() {
+        // Two specks in the lit middle; the reference finds a caster within the lookup's reach
+        // of one of them (its exact shadow hidden or thinner than a pixel): only the other is
+        // acne.
+        let (c, e) = frame(&[(8, 4), (7, 2)]);
+        let mut near = vec![false; 96];
+        near[4 * 12 + 8] = true;
+        let k = Counts::with_casters(&c, &e, &near);
+        assert_eq!((k.acne_planar, k.false_shadow_edge), (1, 1));
+    }
+
+    #[test]
+    fn edge_on_receivers_are_counted_apart() {
+        // Columns 8–11 turned 3° towards the light (edge-on), one speck of acne there and one on
+        // a receiver facing the light.
+        let (mut c, mut e) = frame(&[(9, 4), (6, 3)]);
+        for (i, inc) in e.incidence.iter_mut().enumerate() {
+            if i % 12 >= 8 {
+                *inc = 3f32.to_radians().sin();
+            }
+        }
+        c.class[4 * 12 + 10] = PixelClass::FalseLight;
+        let k = Counts::of(&c, &e);
+        assert_eq!((k.edge_on, k.edge_on_interior), (32, 2));
+        assert_eq!((k.acne_planar, k.false_light_interior), (2, 1));
     }
 }

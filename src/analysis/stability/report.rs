@@ -5,7 +5,7 @@ use super::degenerate::{degenerate, DegenerateRow};
 use super::light::{contact_gaps, light_angles, AngleRow, ContactRow};
 use super::precision::{precision, PrecisionRow};
 use super::shimmer::{camera_path, methods, shimmer, ShimmerSeries};
-use super::{StabilityOptions, SCHEMA};
+use super::{StabilityOptions, EDGE_ON_DEGREES, SCHEMA};
 use crate::analysis::chart::ChartError;
 use crate::analysis::lines::{write_lines, LineChart, Series};
 use crate::gpu::{Context, GpuError};
@@ -338,7 +338,7 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
         let twin = r
             .shimmer
             .iter()
-            .find(|t| t.snapped && t.cascades == s.cascades);
+            .find(|t| t.snapped && t.cascades == s.cascades && t.fit == s.fit);
         if let Some(t) = twin {
             v.push(Verdict {
                 criterion: format!(
@@ -759,7 +759,13 @@ pub fn markdown(r: &StabilityReport) -> String {
         "\n## Shimmer along the flythrough ({} frames)\n\n![shimmer](shimmer.png)\n",
         r.path_frames
     );
-    let mut t = Table::new(&["method", "mean flipped", "worst frame", "points per frame"]);
+    let mut t = Table::new(&[
+        "method",
+        "mean flipped",
+        "worst frame",
+        "points per frame",
+        "mean finest texel",
+    ]);
     for s in &r.shimmer {
         let pts = s.points.iter().sum::<usize>() / s.points.len().max(1);
         t.row(vec![
@@ -767,6 +773,7 @@ pub fn markdown(r: &StabilityReport) -> String {
             format!("{:.2e}", s.mean_fraction),
             format!("{:.2e}", s.max_fraction),
             pts.to_string(),
+            format!("{:.3e}", s.mean_texel),
         ]);
     }
     m += &t.render(true);
@@ -812,6 +819,15 @@ pub fn markdown(r: &StabilityReport) -> String {
          buffer at the same view distance (analytic: umbra has no standard-z path).\n"
     );
     let _ = writeln!(m, "## Degenerate views and input\n");
+    let _ = writeln!(
+        m,
+        "Interior misclassified: away from exact shadow edges, on receivers turned at least {EDGE_ON_DEGREES}° \
+         towards the light (bound {:.1} %). Receivers closer to edge-on (walls under a sun overhead, \
+         the ground under a sun on the horizon) are reported apart: a map texel spreads over more \
+         than 11 texel lengths of them, so a texel or two decides their whole shadow, and they get \
+         under 9 % of the light.\n",
+        100.0 * super::degenerate::INTERIOR_BOUND
+    );
     let mut t = Table::new(&[
         "case",
         "documented result",
@@ -819,6 +835,7 @@ pub fn markdown(r: &StabilityReport) -> String {
         "validation",
         "finite",
         "interior misclassified",
+        "edge-on receivers (pixels): misclassified",
         "GPU ms",
         "result",
     ]);
@@ -831,6 +848,7 @@ pub fn markdown(r: &StabilityReport) -> String {
                 .map_or("off".into(), |n| format!("{n} messages")),
             d.finite.to_string(),
             pct(d.interior_misclassified),
+            format!("{} ({})", pct(d.edge_on_misclassified), d.counts.edge_on),
             d.gpu_ms.map_or("n/a".into(), |g| format!("{g:.1}")),
             if d.ok { "pass" } else { "**FAIL**" }.into(),
         ]);
