@@ -70,8 +70,8 @@ fn builtin_scene_meets_the_thresholds_at_the_defaults() {
         assert!(g <= 2.0, "gap {g} texels at {}°", c.elevation_deg);
     }
     // Shimmer: snapped single map 1.0e-7 flipped per frame (1 point in 59 frames); 4 snapped
-    // cascades 9.9e-5 (the dithered blend bands move with the camera); unsnapped 1.0e-3 and
-    // 5.8e-4.
+    // cascades 9.9e-5 fitted afresh each frame, 5.2e-5 held (the dithered blend bands move with
+    // the camera); unsnapped 1.0e-3 and 5.8e-4.
     for s in &r.shimmer {
         if s.snapped {
             assert!(
@@ -84,7 +84,7 @@ fn builtin_scene_meets_the_thresholds_at_the_defaults() {
             let twin = r
                 .shimmer
                 .iter()
-                .find(|t| t.snapped && t.cascades == s.cascades && t.fit == s.fit)
+                .find(|t| t.snapped && !t.held && t.cascades == s.cascades && t.fit == s.fit)
                 .unwrap();
             assert!(
                 s.mean_fraction >= 2.0 * twin.mean_fraction,
@@ -113,6 +113,11 @@ fn builtin_scene_meets_the_thresholds_at_the_defaults() {
         single.mean_texel
     );
     assert!(method("single map, snapped to powers of 2").mean_texel >= single.mean_texel);
+    // Held across frames (as the viewer renders), the cascades' extents and splits step by
+    // doublings: measured 5.2e-5 against 9.9e-5 fitted afresh every frame.
+    let held = method("4 cascades, snapped, held").mean_fraction;
+    let fresh = method("4 cascades, snapped").mean_fraction;
+    assert!(held < 0.75 * fresh, "{held:e} vs {fresh:e}");
     // Precision: 10⁴ and 10⁶ units out stay with the origin's misclassification (measured
     // 0.95× at both, against 5.1× at 10⁶ before transforms were rebased to the render origin):
     // the world's f32 step there (6.25 cm) is past the 1.4 cm texel, the GPU's is not.

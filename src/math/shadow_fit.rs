@@ -190,6 +190,23 @@ pub struct DirectionalFitInput {
     pub sphere: bool,
     /// With `snap`, steps per doubling of the extent's geometric ladder (8: 2^(1/8) apart).
     pub extent_steps: u32,
+    /// With `snap`, the extent the previous frame used (a camera in motion): kept while it
+    /// covers what this frame needs at most one doubling too coarse, else stepped from by whole
+    /// doublings ([`held_extent`]).
+    pub hold: Option<f32>,
+}
+
+/// The extent a frame in motion uses when the previous one used `held` and this one needs
+/// `need`: `held` while need ≤ held ≤ 2·need, else the nearest held·2^k at least `need` (k may be
+/// negative), so the size changes once per doubling of the need, in either direction.
+pub fn held_extent(held: f32, need: f32) -> f32 {
+    if !(held.is_finite() && held > 0.0 && need.is_finite() && need > 0.0) {
+        return need;
+    }
+    if held >= need && held <= 2.0 * need {
+        return held;
+    }
+    held * (need / held).log2().ceil().exp2()
 }
 
 /// A fitted directional-light projection.
@@ -328,7 +345,11 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
     let z_near = scene_l.max.z;
     let (lo_x, lo_y, extent, texel, mut zf, mut zn);
     if input.snap {
-        extent = quantize_extent(raw * (1.0 + 4.0 / size), input.extent_steps);
+        let need = raw * (1.0 + 4.0 / size);
+        extent = match input.hold {
+            Some(h) => held_extent(h, need),
+            None => quantize_extent(need, input.extent_steps),
+        };
         texel = extent / size;
         lo_x = ((cx - 0.5 * extent) / texel).floor() * texel;
         lo_y = ((cy - 0.5 * extent) / texel).floor() * texel;
@@ -477,6 +498,7 @@ mod tests {
                 snap,
                 sphere: false,
                 extent_steps: 8,
+                hold: None,
             });
             let fit = fit_directional(&DirectionalFitInput {
                 direction: dir,
@@ -486,6 +508,7 @@ mod tests {
                 snap,
                 sphere: false,
                 extent_steps: 8,
+                hold: None,
             });
             let e = fit.light_box.extent();
             let w = whole.light_box.extent();
@@ -521,6 +544,7 @@ mod tests {
             snap: true,
             sphere: false,
             extent_steps: 8,
+            hold: None,
         });
         for i in 1..20 {
             let dx = i as f32 * base.texel_world * 0.09;
@@ -535,6 +559,7 @@ mod tests {
                 snap: true,
                 sphere: false,
                 extent_steps: 8,
+                hold: None,
             });
             assert_eq!(moved.texel_world, base.texel_world);
             let shift = (moved.light_box.min - base.light_box.min) / base.texel_world;
@@ -603,6 +628,7 @@ mod tests {
                 snap: true,
                 sphere,
                 extent_steps: 8,
+                hold: None,
             });
             // Every receiver it sees lands inside the map.
             for p in frustum_box_intersection(&cam, &scene()) {
@@ -626,5 +652,29 @@ mod tests {
             tight.iter().all(|&t| t <= sphere[0]),
             "{tight:?} vs {sphere:?}"
         );
+    }
+
+    #[test]
+    fn held_extent_steps_by_doublings() {
+        // Kept while it covers at most one doubling too coarse.
+        assert_eq!(held_extent(4.0, 3.0), 4.0);
+        assert_eq!(held_extent(4.0, 2.0), 4.0);
+        assert_eq!(held_extent(4.0, 4.0), 4.0);
+        // Stepped by whole doublings, to the nearest at least the need.
+        assert_eq!(held_extent(4.0, 1.9), 2.0);
+        assert_eq!(held_extent(4.0, 0.9), 1.0);
+        assert_eq!(held_extent(4.0, 4.1), 8.0);
+        assert_eq!(held_extent(4.0, 17.0), 32.0);
+        // A zoom in by 4.75x steps twice (on the 2^(1/8) ladder: 18 times).
+        let mut h = quantize_extent(4.75, 8);
+        let mut steps = 0;
+        for i in 1..=100 {
+            let need = 4.75f32.powf(1.0 - i as f32 / 100.0);
+            let next = held_extent(h, need);
+            assert!(next >= need && next <= 2.0 * need + 1e-6);
+            steps += (next != h) as u32;
+            h = next;
+        }
+        assert_eq!(steps, 2);
     }
 }

@@ -4,7 +4,7 @@
 
 use super::gpu_scene::Viewpoint;
 use super::settings::{
-    Exposure, Pcf, ShadowFit, ShadowSettings, Tonemap, View, AUTO_AMBIENT, MAX_CASCADES,
+    Exposure, HeldLight, Pcf, ShadowFit, ShadowSettings, Tonemap, View, AUTO_AMBIENT, MAX_CASCADES,
     UNIT_AMBIENT,
 };
 use super::shadow_pass::CasterPlan;
@@ -14,7 +14,7 @@ use super::uniforms::{
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
 use crate::math::shadow_fit::{
     cascade_splits, fit_directional, fit_point_faces, fit_spot, frustum_box_intersection,
-    CameraFrustum, DirectionalFit, DirectionalFitInput,
+    held_extent, CameraFrustum, DirectionalFit, DirectionalFitInput,
 };
 use crate::math::Aabb;
 use crate::scene::{Camera, Light, LightKind};
@@ -117,6 +117,8 @@ pub struct ShadowView {
     /// Side in texels of the square at its layer's origin it fills (the map size, or less for a
     /// point light's cube faces).
     pub res: u32,
+    /// For cascades: the view depths (near, far) their light's cascades were split over.
+    pub depth_range: Option<(f32, f32)>,
 }
 
 impl ShadowView {
@@ -129,6 +131,7 @@ impl ShadowView {
             blend: f32::INFINITY,
             light: 0,
             res: 0,
+            depth_range: None,
         }
     }
 }
@@ -149,13 +152,13 @@ pub fn auto_cascades(ratio: f32) -> usize {
     }
 }
 
-/// `n` cascades over the view depths `range` of `frustum`, each fitted by `fit` to its slice
-/// (widened to cover the previous cascade's blend band), nearest first.
+/// `n` cascades over the view depths `range` of `frustum`, each fitted by `fit(index, slice)` to
+/// its slice (widened to cover the previous cascade's blend band), nearest first.
 fn cascade_views(
     frustum: &CameraFrustum,
     range: (f32, f32),
     n: usize,
-    fit: impl Fn(Option<CameraFrustum>) -> DirectionalFit,
+    fit: impl Fn(usize, Option<CameraFrustum>) -> DirectionalFit,
 ) -> Vec<ShadowView> {
     let splits = cascade_splits(range.0, range.1, n, CASCADE_SPLIT_LAMBDA);
     (0..n)
@@ -164,12 +167,16 @@ fn cascade_views(
                 0 => splits[0],
                 _ => splits[c] - CASCADE_BLEND * (splits[c] - splits[c - 1]),
             };
-            let f = fit(Some(CameraFrustum {
-                near,
-                far: splits[c + 1],
-                ..*frustum
-            }));
+            let f = fit(
+                c,
+                Some(CameraFrustum {
+                    near,
+                    far: splits[c + 1],
+                    ..*frustum
+                }),
+            );
             let mut v = ShadowView::whole(f.light_clip_from_world, f.texel_world);
+            v.depth_range = Some(range);
             if c + 1 < n {
                 v.far = splits[c + 1];
                 v.blend = splits[c + 1] - CASCADE_BLEND * (splits[c + 1] - splits[c]);
@@ -415,7 +422,17 @@ pub fn plan_frame(
         let mut own = match l.kind {
             // Fewer cascades where the views run short.
             LightKind::Directional if room > 0 => directional_views(
-                l, bounds, receivers, view, fit_camera, aspect, height_px, room,
+                l,
+                bounds,
+                receivers,
+                view,
+                fit_camera,
+                aspect,
+                height_px,
+                room,
+                view.shadow_hold
+                    .as_ref()
+                    .and_then(|h| h.light(i, l.direction)),
             ),
             LightKind::Directional => Vec::new(),
             LightKind::Spot { outer, .. } => {
@@ -715,9 +732,14 @@ fn directional_views(
     aspect: f32,
     height_px: u32,
     max: usize,
+    held: Option<&HeldLight>,
 ) -> Vec<ShadowView> {
+    let held_range = held.and_then(|h| h.depth_range);
+    let held = held.map(|h| h.extents.as_slice());
     let size = view.shadow.map_size.max(1);
-    let fit = |camera| {
+    // The previous frame's extent of view `c` of `n`, when it had the same views.
+    let hold = |c: usize, n: usize| held.filter(|h| h.len() == n).map(|h| h[c]);
+    let fit_held = |camera, hold: Option<f32>| {
         fit_directional(&DirectionalFitInput {
             direction: l.direction,
             scene_bounds: *bounds,
@@ -726,8 +748,10 @@ fn directional_views(
             snap: view.shadow.snap,
             sphere: view.shadow.fit == ShadowFit::Sphere,
             extent_steps: view.shadow.extent_steps,
+            hold,
         })
     };
+    let fit = |camera| fit_held(camera, None);
     match view.shadow.fit {
         ShadowFit::Camera | ShadowFit::Sphere => {
             let mut frustum = fitting_frustum(fit_cam, aspect, bounds);
@@ -750,7 +774,14 @@ fn directional_views(
                 1 => (frustum.near, frustum.far),
                 _ if view.shadow.snap => {
                     let (n, f) = receiver_depths(&frustum, bounds, receivers);
-                    quantise_depth_range(n, f, (frustum.near, frustum.far))
+                    match held_range {
+                        // In motion the range, and so the splits, step by doublings too.
+                        Some((hn, hf)) => {
+                            let near = (1.0 / held_extent(1.0 / hn, 1.0 / n)).max(frustum.near);
+                            (near, held_extent(hf, f).min(frustum.far).max(near))
+                        }
+                        None => quantise_depth_range(n, f, (frustum.near, frustum.far)),
+                    }
                 }
                 _ => receiver_depths(&frustum, bounds, receivers),
             };
@@ -767,10 +798,15 @@ fn directional_views(
             }
             .min(max);
             if n == 1 {
-                let f = single.unwrap_or_else(|| fit(Some(frustum)));
+                let f = match hold(0, 1) {
+                    Some(h) => fit_held(Some(frustum), Some(h)),
+                    None => single.unwrap_or_else(|| fit(Some(frustum))),
+                };
                 vec![ShadowView::whole(f.light_clip_from_world, f.texel_world)]
             } else {
-                cascade_views(&frustum, (near, far), n, fit)
+                cascade_views(&frustum, (near, far), n, |c, camera| {
+                    fit_held(camera, hold(c, n))
+                })
             }
         }
         ShadowFit::Scene => {

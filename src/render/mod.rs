@@ -20,8 +20,8 @@ pub(crate) mod window;
 pub use frame::{effective_lights, metered_illuminance, FramePlan, ScenePlanner, ShadowView};
 pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 pub use settings::{
-    Exposure, Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowSettings, Tonemap, View, ViewMode,
-    AUTO_AMBIENT, MAX_CASCADES, UNIT_AMBIENT,
+    Exposure, HeldLight, Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings,
+    Tonemap, View, ViewMode, AUTO_AMBIENT, MAX_CASCADES, UNIT_AMBIENT,
 };
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
 #[cfg(feature = "viewer")]

@@ -312,6 +312,65 @@ pub struct View {
     /// `ShadowSettings::depth_fit` fits cascades to; the offscreen renderer measures it when
     /// None.
     pub visible_depths: Option<(f32, f32)>,
+    /// The previous frame's snapped shadow extents, for a camera in motion (the viewer sets it
+    /// each frame; see [`ShadowHold`]). None: every frame fitted afresh, as a still is.
+    pub shadow_hold: Option<ShadowHold>,
+}
+
+/// The snapped extents a frame's directional lights used (per light: its direction, the side of
+/// each of its views, nearest first, and the depth range its cascades were split over), carried
+/// to the next frame. A light with the same direction and the same number of views keeps each
+/// extent while it still covers what the new frame needs at most one doubling too coarse, and
+/// otherwise steps from it by whole doublings; the cascades' depth range likewise (so their
+/// splits hold still): in motion a map changes size once per doubling of what the camera needs
+/// instead of once per 2^(1/8), and each change moves every shadow edge (shimmer). A still (no
+/// hold) keeps the fine ladder of `ShadowSettings::extent_steps`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShadowHold {
+    /// Per light of the frame's light list (by index): what a directional one used.
+    pub lights: Vec<Option<HeldLight>>,
+}
+
+/// What one directional light's views used in a frame (see [`ShadowHold`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldLight {
+    /// The direction the light travelled.
+    pub direction: Vec3,
+    /// The side of each of its views, nearest first.
+    pub extents: Vec<f32>,
+    /// The view-depth range its cascades were split over (None for one map).
+    pub depth_range: Option<(f32, f32)>,
+}
+
+impl ShadowHold {
+    /// The extents `plan` used.
+    pub fn from_plan(plan: &crate::render::FramePlan) -> Self {
+        let lights = plan
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                (l.kind == crate::scene::LightKind::Directional && !plan.light_views(i).is_empty())
+                    .then(|| {
+                        let views = plan.light_views(i);
+                        HeldLight {
+                            direction: l.direction,
+                            extents: views.iter().map(|v| v.texel_world * v.res as f32).collect(),
+                            depth_range: views[0].depth_range,
+                        }
+                    })
+            })
+            .collect();
+        Self { lights }
+    }
+
+    /// What light `i` used, if it travelled along `direction` then too.
+    pub fn light(&self, i: usize, direction: Vec3) -> Option<&HeldLight> {
+        self.lights
+            .get(i)
+            .and_then(Option::as_ref)
+            .filter(|h| h.direction == direction)
+    }
 }
 
 impl View {
@@ -351,6 +410,7 @@ impl View {
             highlight: None,
             shown_light: None,
             visible_depths: None,
+            shadow_hold: None,
         }
     }
 }

@@ -7,7 +7,7 @@ use super::core::{Attachment, FrameCore, MsaaTargets};
 use super::renderer::{
     copy_to_buffer, rgba_from_readback, transfer_to_host_barrier, visible_depths,
 };
-use super::settings::{SceneOptions, View};
+use super::settings::{SceneOptions, ShadowHold, View};
 use super::swapchain::Swapchain;
 use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
@@ -75,6 +75,10 @@ pub struct WindowRenderer {
     depth_reads: Vec<DepthRead>,
     /// The nearest and farthest view depth of the latest frame read back.
     seen_depths: Option<(f32, f32)>,
+    /// The last frame's shadow extents, held by the next while the camera moves.
+    held: Option<ShadowHold>,
+    /// The last frame's camera and size (a change means the camera is moving).
+    last_shot: Option<(crate::scene::Camera, u32, u32)>,
 }
 
 impl WindowRenderer {
@@ -132,6 +136,8 @@ impl WindowRenderer {
             last_gpu: None,
             depth_reads: (0..FRAMES_IN_FLIGHT).map(|_| (None, None)).collect(),
             seen_depths: None,
+            held: None,
+            last_shot: None,
         };
         r.ensure_depth()?;
         Ok(r)
@@ -218,16 +224,20 @@ impl WindowRenderer {
             && view.shadow.enabled
             && view.visible_depths.is_none()
             && view.shadow_fit_camera.is_none();
-        let fitted;
-        let view = if fit {
-            let mut v = view.clone();
-            v.visible_depths = self.seen_depths;
-            fitted = v;
-            &fitted
-        } else {
-            view
-        };
         let extent = self.swapchain.extent;
+        // A camera in motion holds the previous frame's shadow extents (less shimmer); one that
+        // stands still for a frame is fitted afresh, as a still is.
+        let shot = (view.camera, extent.width, extent.height);
+        let moving = self.last_shot.is_some_and(|last| last != shot);
+        self.last_shot = Some(shot);
+        let mut v = view.clone();
+        if fit {
+            v.visible_depths = self.seen_depths;
+        }
+        if moving && v.shadow_hold.is_none() {
+            v.shadow_hold = self.held.take();
+        }
+        let view = &v;
         if extent.width == 0 || extent.height == 0 || self.swapchain.raw == vk::SwapchainKHR::null()
         {
             return Ok(DrawResult::Skipped);
@@ -239,6 +249,7 @@ impl WindowRenderer {
         };
         unsafe { d.reset_fences(&[sync.fence]) }.vk("vkResetFences")?;
         let plan = self.core.prepare(f, view, extent.width, extent.height)?;
+        self.held = Some(ShadowHold::from_plan(&plan));
         let pixels = extent.width as usize * extent.height as usize;
         if fit
             && self.depth_reads[f]

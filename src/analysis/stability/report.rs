@@ -320,8 +320,10 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
             pass: Some(worst.is_some_and(|(g, _)| g <= CONTACT_BOUND_TEXELS)),
         });
     }
-    let snapped: Vec<&ShimmerSeries> = r.shimmer.iter().filter(|s| s.snapped).collect();
-    for s in &snapped {
+    // Judged: what a camera in motion gets (held across frames, as the viewer renders); the
+    // fits made afresh every frame are reported beside them.
+    let judged: Vec<&ShimmerSeries> = r.shimmer.iter().filter(|s| s.snapped && s.held).collect();
+    for s in &judged {
         v.push(Verdict {
             criterion: format!(
                 "shimmer ≤ {SHIMMER_BOUND:e} flipped points per frame ({})",
@@ -338,7 +340,7 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
         let twin = r
             .shimmer
             .iter()
-            .find(|t| t.snapped && t.cascades == s.cascades && t.fit == s.fit);
+            .find(|t| t.snapped && !t.held && t.cascades == s.cascades && t.fit == s.fit);
         if let Some(t) = twin {
             v.push(Verdict {
                 criterion: format!(

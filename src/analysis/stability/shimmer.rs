@@ -14,7 +14,7 @@ use crate::math::bezier::CubicBezier;
 use crate::math::projection::pixel_to_ndc;
 use crate::math::Aabb;
 use crate::render::frame::camera_projection;
-use crate::render::{Renderer, ShadowFit, ShadowSettings, View};
+use crate::render::{Renderer, ShadowFit, ShadowHold, ShadowSettings, View};
 use crate::scene::Camera;
 use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
@@ -26,46 +26,78 @@ pub struct Method {
     pub name: String,
     /// Its settings.
     pub shadow: ShadowSettings,
+    /// Flown as the viewer flies: each frame holds the previous frame's extents
+    /// (`View::shadow_hold`); else every frame is fitted afresh, as a still is.
+    pub held: bool,
 }
 
-/// The methods compared: a single map fitted to the camera snapped and unsnapped, four cascades
-/// snapped and unsnapped, a single map fitted to the frustum's bounding sphere (snapped), a single
-/// map whose extent steps by powers of 2 (`ShadowSettings::extent_steps` = 1), and the defaults
-/// (automatic cascade count). (Cascades fitted to spheres are left out: their splits
-/// follow the receivers' depth range, which steps as the camera moves, and each step changes
-/// every cascade: 1.38·10⁻⁴ against 0.99·10⁻⁴ fitted to the receivers on the built-in scene.)
+/// The methods compared. Fitted afresh every frame (as stills are): a single map fitted to the
+/// camera, snapped and unsnapped; four cascades, snapped and unsnapped; a single map fitted to
+/// the frustum's bounding sphere; a single map whose extent steps by powers of 2
+/// (`ShadowSettings::extent_steps` = 1). Held across frames (as the viewer renders,
+/// `View::shadow_hold`): the snapped single map, the snapped cascades, and the defaults
+/// (automatic cascade count). (Cascades fitted to spheres are left out: their splits follow the
+/// receivers' depth range, which steps as the camera moves, and each step changes every cascade:
+/// 1.38·10⁻⁴ against 0.99·10⁻⁴ fitted to the receivers on the built-in scene.)
 pub fn methods(defaults: &ShadowSettings) -> Vec<Method> {
-    let mut out = Vec::new();
-    for (name, cascades, snap, fit) in [
-        ("single map, snapped", 1, true, ShadowFit::Camera),
-        ("single map, unsnapped", 1, false, ShadowFit::Camera),
-        ("4 cascades, snapped", 4, true, ShadowFit::Camera),
-        ("4 cascades, unsnapped", 4, false, ShadowFit::Camera),
-        ("single map, sphere fit", 1, true, ShadowFit::Sphere),
-    ] {
-        out.push(Method {
-            name: name.into(),
-            shadow: ShadowSettings {
-                cascades,
-                snap,
-                fit,
-                ..*defaults
-            },
-        });
-    }
-    out.push(Method {
-        name: "single map, snapped to powers of 2".into(),
-        shadow: ShadowSettings {
-            cascades: 1,
-            extent_steps: 1,
-            ..*defaults
-        },
-    });
-    out.push(Method {
-        name: "defaults".into(),
-        shadow: *defaults,
-    });
-    out
+    let s = |cascades: u32, snap: bool, fit: ShadowFit, extent_steps: u32| ShadowSettings {
+        cascades,
+        snap,
+        fit,
+        extent_steps,
+        ..*defaults
+    };
+    let steps = defaults.extent_steps;
+    [
+        (
+            "single map, snapped",
+            s(1, true, ShadowFit::Camera, steps),
+            false,
+        ),
+        (
+            "single map, unsnapped",
+            s(1, false, ShadowFit::Camera, steps),
+            false,
+        ),
+        (
+            "4 cascades, snapped",
+            s(4, true, ShadowFit::Camera, steps),
+            false,
+        ),
+        (
+            "4 cascades, unsnapped",
+            s(4, false, ShadowFit::Camera, steps),
+            false,
+        ),
+        (
+            "single map, sphere fit",
+            s(1, true, ShadowFit::Sphere, steps),
+            false,
+        ),
+        (
+            "single map, snapped to powers of 2",
+            s(1, true, ShadowFit::Camera, 1),
+            false,
+        ),
+        (
+            "single map, snapped, held",
+            s(1, true, ShadowFit::Camera, steps),
+            true,
+        ),
+        (
+            "4 cascades, snapped, held",
+            s(4, true, ShadowFit::Camera, steps),
+            true,
+        ),
+        ("defaults, held (the viewer)", *defaults, true),
+    ]
+    .into_iter()
+    .map(|(name, shadow, held)| Method {
+        name: name.into(),
+        shadow,
+        held,
+    })
+    .collect()
 }
 
 /// The flythrough (over `frames` frames; the suite takes 4 s at 60 fps): a cubic Bézier from the view's eye, dipping low past the scene's centre (close
@@ -113,6 +145,8 @@ pub struct ShimmerSeries {
     pub cascades: u32,
     /// Origin snapped to whole texels, extent quantised.
     pub snapped: bool,
+    /// Each frame held the previous frame's extents (as the viewer renders).
+    pub held: bool,
     /// Fitted to the receivers the camera sees (`camera`) or to its frustum's bounding sphere
     /// (`sphere`).
     pub fit: String,
@@ -143,12 +177,20 @@ pub fn shimmer(
     let mut out = Vec::new();
     for m in methods {
         let (mut points, mut flipped, mut texels) = (Vec::new(), Vec::new(), 0.0);
+        // Held: frame i holds frame i-1's extents, and frame i+1 (fitted to camera i+1,
+        // rendered at camera i's pixels) holds frame i's.
+        let mut hold = None;
         for pair in path.windows(2) {
             let mut v = view.clone();
             v.shadow = m.shadow;
             v.camera = pair[0];
             v.shadow_fit_camera = None;
+            v.shadow_hold = hold.clone();
             let a = shadow_frame(renderer, &v, size)?;
+            if m.held {
+                hold = Some(ShadowHold::from_plan(&a.plan));
+                v.shadow_hold = hold.clone();
+            }
             v.shadow_fit_camera = Some(pair[1]);
             let b = shadow_frame(renderer, &v, size)?;
             texels += finest_texel(&a);
@@ -191,6 +233,7 @@ pub fn shimmer(
             method: m.name.clone(),
             cascades: m.shadow.cascades,
             snapped: m.shadow.snap,
+            held: m.held,
             fit: format!("{:?}", m.shadow.fit).to_lowercase(),
             mean_fraction: fr.iter().sum::<f64>() / fr.len().max(1) as f64,
             mean_texel: texels / fr.len().max(1) as f64,
