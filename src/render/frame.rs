@@ -721,7 +721,8 @@ fn point_face_margin(view: &View, soft: bool) -> f32 {
 }
 
 /// The views of directional light `l`: one map, or cascades when fitted to the camera (count
-/// from the settings, or automatic; at most `max`).
+/// from the settings, or automatic; at most `max`). `held`: what this light's views used the
+/// frame before, for a camera in motion (`View::shadow_hold`).
 #[allow(clippy::too_many_arguments)]
 fn directional_views(
     l: &Light,
