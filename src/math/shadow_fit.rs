@@ -280,7 +280,7 @@ pub fn slice_sphere(near: f32, far: f32, fov_y: f32, aspect: f32) -> (f32, f32) 
 /// side along an axis the square is centred on the scene there, else it follows the sphere within
 /// the scene's bounds. A fit that hugged the visible receivers would change size every frame the
 /// camera moves, and every change of texel size re-rasterises every shadow edge (shimmer).
-fn stable_square(
+fn sphere_square(
     c: &CameraFrustum,
     view: &Mat4,
     scene_l: &Aabb,
@@ -331,7 +331,7 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
     // Guard against a degenerate (flat or point) receiver set.
     let min_extent = (scene.diagonal() * 1e-4).max(1e-4);
     let (raw, cx, cy) = match (&input.camera, input.sphere) {
-        (Some(c), true) => stable_square(c, &view, &scene_l, min_extent),
+        (Some(c), true) => sphere_square(c, &view, &scene_l, min_extent),
         _ => (
             (recv.max.x - recv.min.x)
                 .max(recv.max.y - recv.min.y)

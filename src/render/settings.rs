@@ -115,7 +115,7 @@ pub enum ShadowFit {
     /// To the camera like `Camera`, but each map (or cascade) covers the bounding sphere of its
     /// slice of the camera frustum, within the scene's bounds: its size does not change as the
     /// camera moves or turns (only with the depth range, field of view and aspect), so snapped
-    /// maps step, and shimmer, far less often, for coarser texels than `Camera` (1.3–2× on the
+    /// maps step, and shimmer, far less often, for coarser texels than `Camera` (1.2–2× on the
     /// built-in and sample scenes' first views).
     Sphere,
 }
