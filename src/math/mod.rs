@@ -4,6 +4,7 @@
 pub mod bezier;
 pub mod bounds;
 pub mod interp;
+pub mod mips;
 pub mod precision;
 pub mod projection;
 pub mod ray;

@@ -209,6 +209,19 @@ pub fn held_extent(held: f32, need: f32) -> f32 {
     held * (need / held).log2().ceil().exp2()
 }
 
+/// What a range bound held in motion becomes when this frame needs `need`: `held` while it
+/// covers the need, else widened by whole doublings (`held`·2^k, k ≥ 1) until it does. It never
+/// narrows: a camera in motion keeps its cascade splits until the receivers leave them.
+pub fn widened(held: f32, need: f32) -> f32 {
+    if !(held.is_finite() && held > 0.0 && need.is_finite() && need > 0.0) {
+        return need;
+    }
+    if held >= need {
+        return held;
+    }
+    held * (need / held).log2().ceil().exp2()
+}
+
 /// A fitted directional-light projection.
 #[derive(Clone, Copy, Debug)]
 pub struct DirectionalFit {
@@ -652,6 +665,16 @@ mod tests {
             tight.iter().all(|&t| t <= sphere[0]),
             "{tight:?} vs {sphere:?}"
         );
+    }
+
+    #[test]
+    fn widened_only_grows_by_doublings() {
+        assert_eq!(widened(4.0, 3.0), 4.0);
+        assert_eq!(widened(4.0, 0.5), 4.0);
+        assert_eq!(widened(4.0, 4.0), 4.0);
+        assert_eq!(widened(4.0, 5.0), 8.0);
+        assert_eq!(widened(4.0, 17.0), 32.0);
+        assert_eq!(widened(f32::NAN, 3.0), 3.0);
     }
 
     #[test]

@@ -13,8 +13,8 @@ use super::uniforms::{
 };
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
 use crate::math::shadow_fit::{
-    cascade_splits, fit_directional, fit_point_faces, fit_spot, frustum_box_intersection,
-    held_extent, CameraFrustum, DirectionalFit, DirectionalFitInput,
+    cascade_splits, fit_directional, fit_point_faces, fit_spot, frustum_box_intersection, widened,
+    CameraFrustum, DirectionalFit, DirectionalFitInput,
 };
 use crate::math::Aabb;
 use crate::scene::{Camera, Light, LightKind};
@@ -776,10 +776,12 @@ fn directional_views(
                 _ if view.shadow.snap => {
                     let (n, f) = receiver_depths(&frustum, bounds, receivers);
                     match held_range {
-                        // In motion the range, and so the splits, step by doublings too.
+                        // In motion the range, and so the splits, hold still until the
+                        // receivers leave it, then widen by doublings; they narrow again when
+                        // the camera stops (a step changes every cascade at once).
                         Some((hn, hf)) => {
-                            let near = (1.0 / held_extent(1.0 / hn, 1.0 / n)).max(frustum.near);
-                            (near, held_extent(hf, f).min(frustum.far).max(near))
+                            let near = (1.0 / widened(1.0 / hn, 1.0 / n)).max(frustum.near);
+                            (near, widened(hf, f).max(near))
                         }
                         None => quantise_depth_range(n, f, (frustum.near, frustum.far)),
                     }

@@ -7,6 +7,7 @@ use super::uniforms::{MaterialUniform, SceneImmediates};
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
 use crate::gpu::{Buffer, Image};
+use crate::math::mips::mip_chain;
 use crate::math::Aabb;
 use crate::scene::clusters::{self, Cluster};
 use crate::scene::topology::{is_closed, plane_of};
@@ -90,6 +91,14 @@ fn packed_occlusion(
         height: occlusion.height,
         rgba,
     }
+}
+
+/// A texture the materials use: an image in a colour space (sRGB: true), or an occlusion image
+/// packed with a metallic-roughness one (`packed_occlusion`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum TextureJob {
+    Image(usize, bool),
+    Packed((Option<usize>, usize)),
 }
 
 /// The vertex streams: positions (binding 0; the shadow pass reads only this one) and the
@@ -541,9 +550,46 @@ impl GpuScene {
             bytemuck::cast_slice(&indices),
         )?;
 
-        // Textures, created per (image, colour space) actually used.
+        // Textures, created per (image, colour space) actually used, and per packed
+        // (metallic-roughness, occlusion) pair; their mip chains computed on all cores first.
+        let mut jobs: Vec<TextureJob> = Vec::new();
+        for m in &scene.materials {
+            let (orm_ref, orm_merged) = orm_slot(m, scene.textures.len());
+            let used = |t: Option<crate::scene::TextureRef>, srgb| {
+                t.filter(|t| t.texture < scene.textures.len())
+                    .map(|t| TextureJob::Image(t.texture, srgb))
+            };
+            jobs.extend(used(m.base_color_texture, true));
+            jobs.extend(used(m.normal_texture, false));
+            match orm_merged {
+                Some(t) => jobs.push(TextureJob::Packed(t)),
+                None => jobs.extend(used(orm_ref, false)),
+            }
+            jobs.extend(used(m.emissive_texture, true));
+        }
+        let mut seen = std::collections::HashSet::new();
+        jobs.retain(|j| seen.insert(*j));
+        // A few at a time: a 2048² chain is 21 MiB, and they are dropped once uploaded.
+        let batch = std::thread::available_parallelism().map_or(1, |n| n.get());
         let mut textures: Vec<Image> = Vec::new();
-        let mut tex_index: HashMap<(usize, bool), usize> = HashMap::new();
+        let mut tex_index: HashMap<TextureJob, usize> = HashMap::new();
+        for part in jobs.chunks(batch.max(1)) {
+            let done = crate::parallel::map(part, |j| match *j {
+                TextureJob::Image(i, srgb) => {
+                    let t = &scene.textures[i];
+                    (t.name.clone(), mip_chain(t.width, t.height, &t.rgba, srgb))
+                }
+                TextureJob::Packed((mr, o)) => {
+                    let t = packed_occlusion(&scene.textures[o], mr.map(|i| &scene.textures[i]));
+                    (t.name, mip_chain(t.width, t.height, &t.rgba, false))
+                }
+            });
+            for (j, (name, chain)) in part.iter().zip(done) {
+                let srgb = matches!(j, TextureJob::Image(_, true));
+                textures.push(Image::texture_mips(ctx, &name, &chain, srgb)?);
+                tex_index.insert(*j, textures.len() - 1);
+            }
+        }
         let white_srgb = Image::texture_rgba8(ctx, "default white sRGB", 1, 1, &[255; 4], true)?;
         let white_linear = Image::texture_rgba8(ctx, "default white", 1, 1, &[255; 4], false)?;
         let flat_normal = Image::texture_rgba8(
@@ -554,23 +600,15 @@ impl GpuScene {
             &[128, 128, 255, 255],
             false,
         )?;
+        let defaults = textures.len();
         textures.extend([white_srgb, white_linear, flat_normal]);
-        let mut get_tex = |t: Option<crate::scene::TextureRef>,
-                           srgb: bool,
-                           fallback: usize,
-                           textures: &mut Vec<Image>|
-         -> Result<vk::ImageView, GpuError> {
-            let Some(t) = t.filter(|t| t.texture < scene.textures.len()) else {
-                return Ok(textures[fallback].view);
-            };
-            if let Some(&i) = tex_index.get(&(t.texture, srgb)) {
-                return Ok(textures[i].view);
-            }
-            let src = &scene.textures[t.texture];
-            let img = Image::texture_rgba8(ctx, &src.name, src.width, src.height, &src.rgba, srgb)?;
-            textures.push(img);
-            tex_index.insert((t.texture, srgb), textures.len() - 1);
-            Ok(textures[textures.len() - 1].view)
+        let get_tex = |t: Option<crate::scene::TextureRef>,
+                       srgb: bool,
+                       fallback: usize,
+                       textures: &Vec<Image>|
+         -> vk::ImageView {
+            t.and_then(|t| tex_index.get(&TextureJob::Image(t.texture, srgb)))
+                .map_or(textures[defaults + fallback].view, |&i| textures[i].view)
         };
 
         let material_layout = set_layout(ctx, sh::BINDINGS, 1, "material set layout")?;
@@ -579,8 +617,6 @@ impl GpuScene {
         let mut samplers = SamplerCache::new(ctx, anisotropy);
 
         let mut material_buffers = Vec::new();
-        // Occlusion packed with metallic-roughness, per (metallic-roughness, occlusion) image.
-        let mut orm_index: HashMap<(Option<usize>, usize), usize> = HashMap::new();
         for (i, m) in scene.materials.iter().enumerate() {
             let (orm_ref, orm_merged) = orm_slot(m, scene.textures.len());
             let u = MaterialUniform {
@@ -616,23 +652,13 @@ impl GpuScene {
                 MemoryLocation::CpuToGpu,
             )?;
             buf.write(0, bytemuck::bytes_of(&u))?;
-            let base = get_tex(m.base_color_texture, true, 0, &mut textures)?;
-            let normal = get_tex(m.normal_texture, false, 2, &mut textures)?;
-            let mr = if let Some(t) = orm_merged {
-                if let Some(&i) = orm_index.get(&t) {
-                    textures[i].view
-                } else {
-                    let o = packed_occlusion(&scene.textures[t.1], t.0.map(|i| &scene.textures[i]));
-                    textures.push(Image::texture_rgba8(
-                        ctx, &o.name, o.width, o.height, &o.rgba, false,
-                    )?);
-                    orm_index.insert(t, textures.len() - 1);
-                    textures[textures.len() - 1].view
-                }
-            } else {
-                get_tex(orm_ref, false, 1, &mut textures)?
+            let base = get_tex(m.base_color_texture, true, 0, &textures);
+            let normal = get_tex(m.normal_texture, false, 2, &textures);
+            let mr = match orm_merged {
+                Some(t) => textures[tex_index[&TextureJob::Packed(t)]].view,
+                None => get_tex(orm_ref, false, 1, &textures),
             };
-            let emissive = get_tex(m.emissive_texture, true, 0, &mut textures)?;
+            let emissive = get_tex(m.emissive_texture, true, 0, &textures);
             let buf_info = [vk::DescriptorBufferInfo {
                 buffer: buf.raw,
                 offset: 0,
