@@ -949,6 +949,46 @@ mod tests {
         assert_eq!(p.shader_variant, sh::BIT_SINGLE_LIGHT);
     }
     #[test]
+    fn held_cascades_keep_their_splits_until_the_receivers_leave_them() {
+        let s = demo_scene();
+        let sun = [Light::sun(Vec3::new(0.3, -1.0, 0.2), 1.0)];
+        let cam = s.default_camera(1.5);
+        let (c, eye) = (s.bounds().center(), cam.position());
+        let at = |k: f32| Camera::look_at(c + (eye - c) * k, c, cam.fov_y, cam.near);
+        let mut v = View::new(cam);
+        v.shadow.cascades = 4;
+        let plan = |v: &View| plan_frame(&sun, &s.bounds(), &[], v, 1.5, 720, false);
+        let range = |p: &FramePlan| p.primary_views()[0].depth_range.unwrap();
+        let splits = |p: &FramePlan| p.primary_views().iter().map(|v| v.far).collect::<Vec<_>>();
+        let first = plan(&v);
+        let r0 = range(&first);
+        // Closer in, fitted afresh, the range narrows: its far end comes more than a doubling
+        // nearer (measured 63.4 -> 30.8).
+        v.camera = at(0.3);
+        let fresh = range(&plan(&v));
+        assert!(fresh.1 < 0.5 * r0.1, "{fresh:?} vs {r0:?}");
+        // Held, its far end stays where it was (its near end follows the receivers closer, by
+        // doublings, down to the fitting frustum's near plane: measured 26.9 -> 15.0).
+        v.shadow_hold = Some(crate::render::ShadowHold::from_plan(&first));
+        let held = range(&plan(&v));
+        assert_eq!(held.1, r0.1, "{held:?} vs {r0:?}");
+        assert!(held.0 <= fresh.0 && held.0 < r0.0, "{held:?} vs {fresh:?}");
+        // A camera that has not moved keeps the very same splits.
+        v.camera = cam;
+        assert_eq!(splits(&plan(&v)), splits(&first));
+        // Drawn back until the receivers pass its far end, it widens by a whole doubling.
+        v.camera = at(2.0);
+        let need = range(&{
+            let mut u = v.clone();
+            u.shadow_hold = None;
+            plan(&u)
+        });
+        let wide = range(&plan(&v));
+        assert!(need.1 > r0.1, "{need:?} vs {r0:?}");
+        assert_eq!(wide.1, r0.1 * (need.1 / r0.1).log2().ceil().exp2(), "{need:?}");
+    }
+
+    #[test]
     fn every_casting_light_gets_views_while_they_last() {
         let s = demo_scene();
         let point = |x: f32| Light {

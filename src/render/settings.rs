@@ -321,8 +321,8 @@ pub struct View {
 /// each of its views, nearest first, and the depth range its cascades were split over), carried
 /// to the next frame. A light with the same direction and the same number of views keeps each
 /// extent while it still covers what the new frame needs at most one doubling too coarse, and
-/// otherwise steps from it by whole doublings; the cascades' depth range likewise (so their
-/// splits hold still): in motion a map changes size once per doubling of what the camera needs
+/// otherwise steps from it by whole doublings; the cascades' depth range is kept while it covers
+/// the receivers and otherwise only widens, by doublings (so their splits hold still): in motion a map changes size once per doubling of what the camera needs
 /// instead of once per 2^(1/8), and each change moves every shadow edge (shimmer). A still (no
 /// hold) keeps the fine ladder of `ShadowSettings::extent_steps`.
 #[derive(Clone, Debug, Default, PartialEq)]
