@@ -985,7 +985,11 @@ mod tests {
         });
         let wide = range(&plan(&v));
         assert!(need.1 > r0.1, "{need:?} vs {r0:?}");
-        assert_eq!(wide.1, r0.1 * (need.1 / r0.1).log2().ceil().exp2(), "{need:?}");
+        assert_eq!(
+            wide.1,
+            r0.1 * (need.1 / r0.1).log2().ceil().exp2(),
+            "{need:?}"
+        );
     }
 
     #[test]
