@@ -622,6 +622,7 @@ pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
         anisotropy: a.anisotropy,
         culling: !a.no_culling,
         msaa: a.msaa,
+        cpu_mips: None,
     }
 }
 

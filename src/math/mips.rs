@@ -69,40 +69,31 @@ pub fn mip_chain(width: u32, height: u32, rgba: &[u8], srgb: bool) -> MipChain {
     let base = w0 as usize * h0 as usize * 4;
     let m = base.min(rgba.len());
     bytes[..m].copy_from_slice(&rgba[..m]);
-    // Each level is filtered from the one above it, kept in 16-bit linear light.
+    // Each level is filtered from the one above it, kept in 16-bit linear light (level 1 read
+    // straight from the 8-bit base, so no 16-bit copy of the largest level is made).
     let dec = decode_table();
-    let mut cur: Vec<u16> = bytes[..base]
-        .chunks_exact(4)
-        .flat_map(|p| {
-            let c = |v: u8| {
-                if srgb {
-                    dec[v as usize]
-                } else {
-                    v as u16 * 257
-                }
-            };
-            [c(p[0]), c(p[1]), c(p[2]), p[3] as u16 * 257]
-        })
-        .collect();
     let enc = encode_table();
+    let mut cur: Vec<u16> = Vec::new();
     for k in 1..levels.len() {
         let (pw, ph, _) = levels[k - 1];
         let (lw, lh, off) = levels[k];
-        let (pw, ph) = (pw as usize, ph as usize);
-        let mut next = vec![0u16; lw as usize * lh as usize * 4];
-        for y in 0..lh as usize {
-            let (r0, r1) = ((2 * y).min(ph - 1) * pw, (2 * y + 1).min(ph - 1) * pw);
-            for x in 0..lw as usize {
-                let (c0, c1) = ((2 * x).min(pw - 1), (2 * x + 1).min(pw - 1));
-                for ch in 0..4 {
-                    let s = cur[(r0 + c0) * 4 + ch] as u32
-                        + cur[(r0 + c1) * 4 + ch] as u32
-                        + cur[(r1 + c0) * 4 + ch] as u32
-                        + cur[(r1 + c1) * 4 + ch] as u32;
-                    next[(y * lw as usize + x) * 4 + ch] = ((s + 2) / 4) as u16;
-                }
-            }
-        }
+        let next = if k == 1 {
+            let base = &bytes[..base];
+            downsample(
+                |i| {
+                    let v = base[i];
+                    if srgb && i % 4 != 3 {
+                        dec[v as usize] as u32
+                    } else {
+                        v as u32 * 257
+                    }
+                },
+                (pw, ph),
+                (lw, lh),
+            )
+        } else {
+            downsample(|i| cur[i] as u32, (pw, ph), (lw, lh))
+        };
         for (i, v) in next.iter().enumerate() {
             bytes[off + i] = if srgb && i % 4 != 3 {
                 enc[*v as usize]
@@ -113,6 +104,29 @@ pub fn mip_chain(width: u32, height: u32, rgba: &[u8], srgb: bool) -> MipChain {
         cur = next;
     }
     MipChain { levels, bytes }
+}
+
+/// One level of `to` texels, each the rounded mean of the 2×2 block of the `from`-sized level
+/// above it (`src(i)`: channel value i of that level, row by row, 16-bit linear; the last row or
+/// column repeated where a side is odd).
+fn downsample(src: impl Fn(usize) -> u32, from: (u32, u32), to: (u32, u32)) -> Vec<u16> {
+    let (pw, ph) = (from.0 as usize, from.1 as usize);
+    let (lw, lh) = (to.0 as usize, to.1 as usize);
+    let mut next = vec![0u16; lw * lh * 4];
+    for y in 0..lh {
+        let (r0, r1) = ((2 * y).min(ph - 1) * pw, (2 * y + 1).min(ph - 1) * pw);
+        for x in 0..lw {
+            let (c0, c1) = ((2 * x).min(pw - 1), (2 * x + 1).min(pw - 1));
+            for ch in 0..4 {
+                let s = src((r0 + c0) * 4 + ch)
+                    + src((r0 + c1) * 4 + ch)
+                    + src((r1 + c0) * 4 + ch)
+                    + src((r1 + c1) * 4 + ch);
+                next[(y * lw + x) * 4 + ch] = ((s + 2) / 4) as u16;
+            }
+        }
+    }
+    next
 }
 
 #[cfg(test)]

@@ -569,24 +569,31 @@ impl GpuScene {
         }
         let mut seen = std::collections::HashSet::new();
         jobs.retain(|j| seen.insert(*j));
-        // A few at a time: a 2048² chain is 21 MiB, and they are dropped once uploaded.
+        // Mip chains computed here (`SceneOptions::cpu_mips`: by default on CPU devices), a few
+        // textures at a time on all cores (a 2048² chain is 21 MiB, dropped once uploaded), or
+        // blitted on the device.
+        let cpu_mips = options.resolved_cpu_mips(ctx);
         let batch = std::thread::available_parallelism().map_or(1, |n| n.get());
         let mut textures: Vec<Image> = Vec::new();
         let mut tex_index: HashMap<TextureJob, usize> = HashMap::new();
         for part in jobs.chunks(batch.max(1)) {
-            let done = crate::parallel::map(part, |j| match *j {
-                TextureJob::Image(i, srgb) => {
-                    let t = &scene.textures[i];
-                    (t.name.clone(), mip_chain(t.width, t.height, &t.rgba, srgb))
-                }
-                TextureJob::Packed((mr, o)) => {
-                    let t = packed_occlusion(&scene.textures[o], mr.map(|i| &scene.textures[i]));
-                    (t.name, mip_chain(t.width, t.height, &t.rgba, false))
-                }
-            });
-            for (j, (name, chain)) in part.iter().zip(done) {
+            let done = crate::parallel::map(part, |j| {
+                let t = match *j {
+                    TextureJob::Image(i, _) => std::borrow::Cow::Borrowed(&scene.textures[i]),
+                    TextureJob::Packed((mr, o)) => std::borrow::Cow::Owned(packed_occlusion(
+                        &scene.textures[o],
+                        mr.map(|i| &scene.textures[i]),
+                    )),
+                };
                 let srgb = matches!(j, TextureJob::Image(_, true));
-                textures.push(Image::texture_mips(ctx, &name, &chain, srgb)?);
+                let chain = cpu_mips.then(|| mip_chain(t.width, t.height, &t.rgba, srgb));
+                (t, chain, srgb)
+            });
+            for (j, (t, chain, srgb)) in part.iter().zip(done) {
+                textures.push(match chain {
+                    Some(c) => Image::texture_mips(ctx, &t.name, &c, srgb)?,
+                    None => Image::texture_blitted(ctx, &t.name, t.width, t.height, &t.rgba, srgb)?,
+                });
                 tex_index.insert(*j, textures.len() - 1);
             }
         }

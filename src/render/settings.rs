@@ -210,6 +210,12 @@ pub struct SceneOptions {
     /// `README.md`'s measured share of the frame). A count the device lacks falls to the
     /// largest it has below it (`resolved_samples`).
     pub msaa: Option<u32>,
+    /// Where textures' mip chains are made: `Some(true)` on the CPU at upload
+    /// (`crate::math::mips::mip_chain`, the same bytes on every device), `Some(false)` by linear
+    /// blits on the device. `None`: the CPU on CPU devices (on lavapipe the blits run on the CPU
+    /// too, after compiling blitter shaders that Mesa's shader cache does not keep: ~200 ms of
+    /// every start), blits on GPUs.
+    pub cpu_mips: Option<bool>,
 }
 
 impl Default for SceneOptions {
@@ -218,6 +224,7 @@ impl Default for SceneOptions {
             anisotropy: None,
             culling: true,
             msaa: None,
+            cpu_mips: None,
         }
     }
 }
@@ -236,6 +243,12 @@ impl SceneOptions {
             n /= 2;
         }
         n.max(1)
+    }
+
+    /// Whether mip chains are made on the CPU on `ctx`'s device (`cpu_mips`, or its default).
+    pub fn resolved_cpu_mips(&self, ctx: &crate::gpu::Context) -> bool {
+        self.cpu_mips
+            .unwrap_or(ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU)
     }
 
     /// The anisotropy to use on `ctx`'s device (1.0 = off), clamped to what it supports.
