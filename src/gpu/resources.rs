@@ -311,36 +311,161 @@ impl Image {
         chain: &crate::math::mips::MipChain,
         srgb: bool,
     ) -> Result<Self, GpuError> {
-        let format = if srgb {
-            vk::Format::R8G8B8A8_SRGB
-        } else {
-            vk::Format::R8G8B8A8_UNORM
-        };
-        let mips = chain.levels.len().max(1) as u32;
         let (width, height, _) = chain.levels.first().copied().unwrap_or((1, 1, 0));
+        let levels: Vec<_> = chain
+            .levels
+            .iter()
+            .map(|&(w, h, o)| (w, h, o as u64))
+            .collect();
+        let mips = levels.len().max(1) as u32;
+        Self::upload_rgba8(
+            ctx,
+            name,
+            srgb,
+            (width, height, mips),
+            &chain.bytes,
+            &levels,
+            |d, cmd, img| {
+                image_barrier(
+                    d,
+                    cmd,
+                    img,
+                    vk::ImageAspectFlags::COLOR,
+                    0..mips,
+                    Access::TransferDst,
+                    Access::FragmentSampled,
+                );
+            },
+        )
+    }
+
+    /// A sampled RGBA8 texture with a full mip chain generated on the device by linear blits (a
+    /// single level where the format cannot be blitted with linear filtering), for GPUs, where
+    /// blits cost next to nothing. Left in `FragmentSampled` layout.
+    pub fn texture_blitted(
+        ctx: &Arc<Context>,
+        name: &str,
+        width: u32,
+        height: u32,
+        rgba: &[u8],
+        srgb: bool,
+    ) -> Result<Self, GpuError> {
+        let can_blit = ctx.format_features(rgba8_format(srgb)).contains(
+            vk::FormatFeatureFlags::BLIT_SRC
+                | vk::FormatFeatureFlags::BLIT_DST
+                | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
+        );
+        let mips = if can_blit {
+            crate::math::mip_levels(width, height)
+        } else {
+            1
+        };
+        let base = [(width, height, 0u64)];
+        Self::upload_rgba8(
+            ctx,
+            name,
+            srgb,
+            (width, height, mips),
+            rgba,
+            &base,
+            |d, cmd, img| unsafe {
+                let (mut w, mut h) = (width as i32, height as i32);
+                for level in 1..mips {
+                    image_barrier(
+                        d,
+                        cmd,
+                        img,
+                        vk::ImageAspectFlags::COLOR,
+                        level - 1..level,
+                        Access::TransferDst,
+                        Access::TransferSrc,
+                    );
+                    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+                    let layer = |mip_level| vk::ImageSubresourceLayers {
+                        aspect_mask: vk::ImageAspectFlags::COLOR,
+                        mip_level,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    };
+                    let blit = [vk::ImageBlit::default()
+                        .src_subresource(layer(level - 1))
+                        .src_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }])
+                        .dst_subresource(layer(level))
+                        .dst_offsets([
+                            vk::Offset3D::default(),
+                            vk::Offset3D { x: nw, y: nh, z: 1 },
+                        ])];
+                    d.cmd_blit_image(
+                        cmd,
+                        img,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        img,
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        &blit,
+                        vk::Filter::LINEAR,
+                    );
+                    image_barrier(
+                        d,
+                        cmd,
+                        img,
+                        vk::ImageAspectFlags::COLOR,
+                        level - 1..level,
+                        Access::TransferSrc,
+                        Access::FragmentSampled,
+                    );
+                    (w, h) = (nw, nh);
+                }
+                image_barrier(
+                    d,
+                    cmd,
+                    img,
+                    vk::ImageAspectFlags::COLOR,
+                    mips - 1..mips,
+                    Access::TransferDst,
+                    Access::FragmentSampled,
+                );
+            },
+        )
+    }
+
+    /// Creates a sampled RGBA8 image of `size` = (width, height, mip levels) and, in one
+    /// submission, copies `levels` (width, height, byte offset in `bytes`, level by level from 0)
+    /// into it, all levels moved to `TransferDst` first; `then` records what follows the copies
+    /// (their layout changes, blits) on the image.
+    fn upload_rgba8(
+        ctx: &Arc<Context>,
+        name: &str,
+        srgb: bool,
+        size: (u32, u32, u32),
+        bytes: &[u8],
+        levels: &[(u32, u32, u64)],
+        then: impl FnOnce(&ash::Device, vk::CommandBuffer, vk::Image),
+    ) -> Result<Self, GpuError> {
+        let (width, height, mips) = size;
         let img = Image::new(
             ctx,
             name,
-            format,
+            rgba8_format(srgb),
             vk::Extent2D { width, height },
             mips,
-            vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+            vk::ImageUsageFlags::SAMPLED
+                | vk::ImageUsageFlags::TRANSFER_DST
+                | vk::ImageUsageFlags::TRANSFER_SRC,
         )?;
         let mut staging = Buffer::new(
             ctx,
             &format!("{name} staging"),
-            chain.bytes.len().max(4) as u64,
+            bytes.len().max(4) as u64,
             vk::BufferUsageFlags::TRANSFER_SRC,
             MemoryLocation::CpuToGpu,
         )?;
-        staging.write(0, &chain.bytes)?;
-        let regions: Vec<vk::BufferImageCopy> = chain
-            .levels
+        staging.write(0, bytes)?;
+        let regions: Vec<vk::BufferImageCopy> = levels
             .iter()
             .enumerate()
             .map(|(level, &(w, h, offset))| {
                 vk::BufferImageCopy::default()
-                    .buffer_offset(offset as u64)
+                    .buffer_offset(offset)
                     .image_subresource(vk::ImageSubresourceLayers {
                         aspect_mask: vk::ImageAspectFlags::COLOR,
                         mip_level: level as u32,
@@ -372,154 +497,18 @@ impl Image {
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                 &regions,
             );
-            image_barrier(
-                d,
-                cmd,
-                img.raw,
-                vk::ImageAspectFlags::COLOR,
-                0..mips,
-                Access::TransferDst,
-                Access::FragmentSampled,
-            );
+            then(d, cmd, img.raw);
         })?;
         Ok(img)
     }
+}
 
-    /// A sampled RGBA8 texture with a full mip chain generated on the device by linear blits (a
-    /// single level where the format cannot be blitted with linear filtering), for GPUs, where
-    /// blits cost next to nothing. Left in `FragmentSampled` layout.
-    pub fn texture_blitted(
-        ctx: &Arc<Context>,
-        name: &str,
-        width: u32,
-        height: u32,
-        rgba: &[u8],
-        srgb: bool,
-    ) -> Result<Self, GpuError> {
-        let format = if srgb {
-            vk::Format::R8G8B8A8_SRGB
-        } else {
-            vk::Format::R8G8B8A8_UNORM
-        };
-        let feats = ctx.format_features(format);
-        let can_blit = feats.contains(
-            vk::FormatFeatureFlags::BLIT_SRC
-                | vk::FormatFeatureFlags::BLIT_DST
-                | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
-        );
-        let mips = if can_blit {
-            crate::math::mip_levels(width, height)
-        } else {
-            1
-        };
-        let extent = vk::Extent2D { width, height };
-        let img = Image::new(
-            ctx,
-            name,
-            format,
-            extent,
-            mips,
-            vk::ImageUsageFlags::SAMPLED
-                | vk::ImageUsageFlags::TRANSFER_DST
-                | vk::ImageUsageFlags::TRANSFER_SRC,
-        )?;
-        let mut staging = Buffer::new(
-            ctx,
-            &format!("{name} staging"),
-            rgba.len() as u64,
-            vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
-        )?;
-        staging.write(0, rgba)?;
-        let d = &ctx.device;
-        ctx.immediate(|cmd| unsafe {
-            image_barrier(
-                d,
-                cmd,
-                img.raw,
-                vk::ImageAspectFlags::COLOR,
-                0..mips,
-                Access::Undefined,
-                Access::TransferDst,
-            );
-            let region = [vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                })
-                .image_extent(vk::Extent3D {
-                    width,
-                    height,
-                    depth: 1,
-                })];
-            d.cmd_copy_buffer_to_image(
-                cmd,
-                staging.raw,
-                img.raw,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &region,
-            );
-            let (mut w, mut h) = (width as i32, height as i32);
-            for level in 1..mips {
-                image_barrier(
-                    d,
-                    cmd,
-                    img.raw,
-                    vk::ImageAspectFlags::COLOR,
-                    level - 1..level,
-                    Access::TransferDst,
-                    Access::TransferSrc,
-                );
-                let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-                let blit = [vk::ImageBlit::default()
-                    .src_subresource(vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        mip_level: level - 1,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    })
-                    .src_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }])
-                    .dst_subresource(vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        mip_level: level,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    })
-                    .dst_offsets([vk::Offset3D::default(), vk::Offset3D { x: nw, y: nh, z: 1 }])];
-                d.cmd_blit_image(
-                    cmd,
-                    img.raw,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    img.raw,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &blit,
-                    vk::Filter::LINEAR,
-                );
-                image_barrier(
-                    d,
-                    cmd,
-                    img.raw,
-                    vk::ImageAspectFlags::COLOR,
-                    level - 1..level,
-                    Access::TransferSrc,
-                    Access::FragmentSampled,
-                );
-                w = nw;
-                h = nh;
-            }
-            image_barrier(
-                d,
-                cmd,
-                img.raw,
-                vk::ImageAspectFlags::COLOR,
-                mips - 1..mips,
-                Access::TransferDst,
-                Access::FragmentSampled,
-            );
-        })?;
-        Ok(img)
+/// The RGBA8 format of a texture in the sRGB or linear colour space.
+fn rgba8_format(srgb: bool) -> vk::Format {
+    if srgb {
+        vk::Format::R8G8B8A8_SRGB
+    } else {
+        vk::Format::R8G8B8A8_UNORM
     }
 }
 

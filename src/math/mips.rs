@@ -3,6 +3,7 @@
 //! (alpha is always linear). On lavapipe this replaces a chain of linear blits, whose blitter
 //! shaders llvmpipe compiles afresh in every process (its shader cache does not keep them).
 
+use super::tonemap::{linear_to_srgb, srgb_to_linear};
 use std::sync::OnceLock;
 
 /// A full mip chain: level 0 first, each level's RGBA8 texels row by row, levels back to back.
@@ -20,7 +21,7 @@ fn decode_table() -> &'static [u16; 256] {
     T.get_or_init(|| {
         let mut t = [0u16; 256];
         for (i, v) in t.iter_mut().enumerate() {
-            *v = (srgb_to_linear(i as f64 / 255.0) * 65535.0).round() as u16;
+            *v = (srgb_to_linear(i as f32 / 255.0) * 65535.0).round() as u16;
         }
         t
     })
@@ -31,25 +32,9 @@ fn encode_table() -> &'static [u8] {
     static T: OnceLock<Vec<u8>> = OnceLock::new();
     T.get_or_init(|| {
         (0..=65535u32)
-            .map(|l| (linear_to_srgb(l as f64 / 65535.0) * 255.0).round() as u8)
+            .map(|l| (linear_to_srgb(l as f32 / 65535.0) * 255.0).round() as u8)
             .collect()
     })
-}
-
-fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn linear_to_srgb(l: f64) -> f64 {
-    if l <= 0.003_130_8 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    }
 }
 
 /// The full chain of a `width`×`height` RGBA8 image (`rgba` row by row; short data reads as

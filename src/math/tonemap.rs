@@ -45,6 +45,24 @@ impl Tonemap {
 /// Largest exposed value the curves take (f16's largest finite value; brighter reads as this).
 pub const HDR_MAX: f32 = 65504.0;
 
+/// The sRGB transfer function's decoding: an encoded value in [0, 1] → linear light.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The sRGB transfer function's encoding: linear light in [0, 1] → an encoded value in [0, 1].
+pub fn linear_to_srgb(l: f32) -> f32 {
+    if l <= 0.003_130_8 {
+        l * 12.92
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    }
+}
+
 /// Khronos PBR Neutral tone mapping (the Khronos 3D Commerce group's published formula).
 pub fn pbr_neutral(c: Vec3) -> Vec3 {
     const START: f32 = 0.8 - 0.04;

@@ -198,22 +198,8 @@ fn face_viewer(ng: Vec3, n_geo: Vec3, dir: Vec3) -> (Vec3, bool) {
     }
 }
 
-fn srgb_decode(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 fn srgb_encode(c: f32) -> u8 {
-    let c = c.clamp(0.0, 1.0);
-    let s = if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round() as u8
+    (crate::math::tonemap::linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0).round() as u8
 }
 
 impl<'a> ReferenceScene<'a> {
@@ -260,7 +246,7 @@ impl<'a> ReferenceScene<'a> {
         let bvh = Bvh::build(&tris);
         let mut srgb_lut = [0.0; 256];
         for (i, v) in srgb_lut.iter_mut().enumerate() {
-            *v = srgb_decode(i as f32 / 255.0);
+            *v = crate::math::tonemap::srgb_to_linear(i as f32 / 255.0);
         }
         let eps = (scene.bounds().diagonal() * 2e-5).max(1e-6);
         Self {
