@@ -288,20 +288,6 @@ impl Image {
         Ok(image)
     }
 
-    /// A sampled RGBA8 texture with its full mip chain computed on the CPU
-    /// (`crate::math::mips::mip_chain`). Left in `FragmentSampled` layout.
-    pub fn texture_rgba8(
-        ctx: &Arc<Context>,
-        name: &str,
-        width: u32,
-        height: u32,
-        rgba: &[u8],
-        srgb: bool,
-    ) -> Result<Self, GpuError> {
-        let chain = crate::math::mips::mip_chain(width, height, rgba, srgb);
-        Self::texture_mips(ctx, name, &chain, srgb)
-    }
-
     /// A sampled RGBA8 texture with the levels of `chain`, uploaded by one copy per level (no
     /// blits: lavapipe's blitter compiles its shaders afresh in every process). Left in
     /// `FragmentSampled` layout.
@@ -312,19 +298,14 @@ impl Image {
         srgb: bool,
     ) -> Result<Self, GpuError> {
         let (width, height, _) = chain.levels.first().copied().unwrap_or((1, 1, 0));
-        let levels: Vec<_> = chain
-            .levels
-            .iter()
-            .map(|&(w, h, o)| (w, h, o as u64))
-            .collect();
-        let mips = levels.len().max(1) as u32;
+        let mips = chain.levels.len().max(1) as u32;
         Self::upload_rgba8(
             ctx,
             name,
             srgb,
             (width, height, mips),
             &chain.bytes,
-            &levels,
+            &chain.levels,
             |d, cmd, img| {
                 image_barrier(
                     d,
@@ -339,10 +320,11 @@ impl Image {
         )
     }
 
-    /// A sampled RGBA8 texture with a full mip chain generated on the device by linear blits (a
-    /// single level where the format cannot be blitted with linear filtering), for GPUs, where
-    /// blits cost next to nothing. Left in `FragmentSampled` layout.
-    pub fn texture_blitted(
+    /// A sampled RGBA8 texture from its base level, the rest of its mip chain generated on the
+    /// device by linear blits (a single level where the format cannot be blitted with linear
+    /// filtering), for GPUs, where blits cost next to nothing; a 1×1 image has no other level.
+    /// Left in `FragmentSampled` layout.
+    pub fn texture_rgba8(
         ctx: &Arc<Context>,
         name: &str,
         width: u32,
@@ -360,7 +342,7 @@ impl Image {
         } else {
             1
         };
-        let base = [(width, height, 0u64)];
+        let base = [(width, height, 0)];
         Self::upload_rgba8(
             ctx,
             name,
@@ -438,7 +420,7 @@ impl Image {
         srgb: bool,
         size: (u32, u32, u32),
         bytes: &[u8],
-        levels: &[(u32, u32, u64)],
+        levels: &[(u32, u32, usize)],
         then: impl FnOnce(&ash::Device, vk::CommandBuffer, vk::Image),
     ) -> Result<Self, GpuError> {
         let (width, height, mips) = size;
@@ -465,7 +447,7 @@ impl Image {
             .enumerate()
             .map(|(level, &(w, h, offset))| {
                 vk::BufferImageCopy::default()
-                    .buffer_offset(offset)
+                    .buffer_offset(offset as u64)
                     .image_subresource(vk::ImageSubresourceLayers {
                         aspect_mask: vk::ImageAspectFlags::COLOR,
                         mip_level: level as u32,

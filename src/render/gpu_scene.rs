@@ -101,6 +101,29 @@ enum TextureJob {
     Packed((Option<usize>, usize)),
 }
 
+/// The textures material `m` samples in its four slots (base colour and emissive in sRGB;
+/// normal, metallic-roughness with occlusion packed in), None where a slot is empty (the shader
+/// reads `DEFAULT_TEXTURES` there); `textures`: how many the scene has.
+fn texture_jobs(m: &crate::scene::Material, textures: usize) -> [Option<TextureJob>; 4] {
+    let (orm_ref, orm_merged) = orm_slot(m, textures);
+    let image = |t: Option<crate::scene::TextureRef>, srgb| {
+        t.filter(|t| t.texture < textures)
+            .map(|t| TextureJob::Image(t.texture, srgb))
+    };
+    [
+        image(m.base_color_texture, true),
+        image(m.normal_texture, false),
+        orm_merged
+            .map(TextureJob::Packed)
+            .or_else(|| image(orm_ref, false)),
+        image(m.emissive_texture, true),
+    ]
+}
+
+/// Per slot of `texture_jobs`, the default texture an empty slot reads (index into the defaults:
+/// white sRGB, white linear, flat normal): white for colours and factors, a flat normal.
+const DEFAULT_TEXTURES: [usize; 4] = [0, 2, 1, 0];
+
 /// The vertex streams: positions (binding 0; the shadow pass reads only this one) and the
 /// interleaved attributes (binding 1): locations 0 position, 1 normal, 2 uv, 3 tangent.
 pub fn vertex_layout() -> (
@@ -552,21 +575,12 @@ impl GpuScene {
 
         // Textures, created per (image, colour space) actually used, and per packed
         // (metallic-roughness, occlusion) pair; their mip chains computed on all cores first.
-        let mut jobs: Vec<TextureJob> = Vec::new();
-        for m in &scene.materials {
-            let (orm_ref, orm_merged) = orm_slot(m, scene.textures.len());
-            let used = |t: Option<crate::scene::TextureRef>, srgb| {
-                t.filter(|t| t.texture < scene.textures.len())
-                    .map(|t| TextureJob::Image(t.texture, srgb))
-            };
-            jobs.extend(used(m.base_color_texture, true));
-            jobs.extend(used(m.normal_texture, false));
-            match orm_merged {
-                Some(t) => jobs.push(TextureJob::Packed(t)),
-                None => jobs.extend(used(orm_ref, false)),
-            }
-            jobs.extend(used(m.emissive_texture, true));
-        }
+        let mut jobs: Vec<TextureJob> = scene
+            .materials
+            .iter()
+            .flat_map(|m| texture_jobs(m, scene.textures.len()))
+            .flatten()
+            .collect();
         let mut seen = std::collections::HashSet::new();
         jobs.retain(|j| seen.insert(*j));
         // Mip chains computed here (`SceneOptions::cpu_mips`: by default on CPU devices), a few
@@ -592,7 +606,7 @@ impl GpuScene {
             for (j, (t, chain, srgb)) in part.iter().zip(done) {
                 textures.push(match chain {
                     Some(c) => Image::texture_mips(ctx, &t.name, &c, srgb)?,
-                    None => Image::texture_blitted(ctx, &t.name, t.width, t.height, &t.rgba, srgb)?,
+                    None => Image::texture_rgba8(ctx, &t.name, t.width, t.height, &t.rgba, srgb)?,
                 });
                 tex_index.insert(*j, textures.len() - 1);
             }
@@ -609,14 +623,6 @@ impl GpuScene {
         )?;
         let defaults = textures.len();
         textures.extend([white_srgb, white_linear, flat_normal]);
-        let get_tex = |t: Option<crate::scene::TextureRef>,
-                       srgb: bool,
-                       fallback: usize,
-                       textures: &Vec<Image>|
-         -> vk::ImageView {
-            t.and_then(|t| tex_index.get(&TextureJob::Image(t.texture, srgb)))
-                .map_or(textures[defaults + fallback].view, |&i| textures[i].view)
-        };
 
         let material_layout = set_layout(ctx, sh::BINDINGS, 1, "material set layout")?;
         let (pool, sets) =
@@ -625,7 +631,7 @@ impl GpuScene {
 
         let mut material_buffers = Vec::new();
         for (i, m) in scene.materials.iter().enumerate() {
-            let (orm_ref, orm_merged) = orm_slot(m, scene.textures.len());
+            let (orm_ref, _) = orm_slot(m, scene.textures.len());
             let u = MaterialUniform {
                 base_color: m.base_color,
                 emissive: m.emissive.extend(m.normal_scale),
@@ -659,13 +665,10 @@ impl GpuScene {
                 MemoryLocation::CpuToGpu,
             )?;
             buf.write(0, bytemuck::bytes_of(&u))?;
-            let base = get_tex(m.base_color_texture, true, 0, &textures);
-            let normal = get_tex(m.normal_texture, false, 2, &textures);
-            let mr = match orm_merged {
-                Some(t) => textures[tex_index[&TextureJob::Packed(t)]].view,
-                None => get_tex(orm_ref, false, 1, &textures),
-            };
-            let emissive = get_tex(m.emissive_texture, true, 0, &textures);
+            let jobs = texture_jobs(m, scene.textures.len());
+            let [base, normal, mr, emissive]: [vk::ImageView; 4] = std::array::from_fn(|k| {
+                textures[jobs[k].map_or(defaults + DEFAULT_TEXTURES[k], |j| tex_index[&j])].view
+            });
             let buf_info = [vk::DescriptorBufferInfo {
                 buffer: buf.raw,
                 offset: 0,
