@@ -62,7 +62,9 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
     })?;
     let mut validator = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::IMMEDIATES,
+        // f16 packing (`pack2x16float`: GLSL.std.450 PackHalf2x16, core in Vulkan).
+        naga::valid::Capabilities::IMMEDIATES
+            | naga::valid::Capabilities::SHADER_FLOAT16_IN_FLOAT32,
     );
     let info = validator.validate(&module).map_err(|e| {
         format!(

@@ -91,6 +91,8 @@ struct ShadowView {
 
 struct Frame {
     clip_from_world: mat4x4<f32>,
+    // Its inverse (the deferred resolve rebuilds world positions from depth).
+    world_from_clip: mat4x4<f32>,
     // xyz: camera position in world
     camera_position: vec4<f32>,
     // rgb: ambient intensity Ia
@@ -511,6 +513,108 @@ fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0)
     return vec4<f32>(highlight(display(shade(in, front_facing, base_color(in.uv, in.color)).color)), 1.0);
 }
 
+// Deferred shading of draws whose triangles are smaller than llvmpipe's 4x4 shading block (the
+// renderer's `deferred::plan`, CPU devices only). llvmpipe shades every 4x4 block a triangle
+// touches, so a helmet of 1.5-pixel triangles runs the material shader several times per pixel
+// it keeps; these draws instead store what `shade` reads from their varyings (fs_gbuffer: no
+// texture reads, no lighting), and fs_resolve shades each covered pixel once, per material,
+// where the stencil holds that material's mark. Two RGBA32UI targets:
+//   a: depth (f32 bits: the world position is rebuilt from it), TEXCOORD_0 (f32 bits),
+//      d(uv)/dx (2 x f16)
+//   b: normal and tangent (octahedral, 2 x snorm16 each), d(uv)/dy (2 x f16), flags: 1 tangent
+//      sign >= 0, 2 front face, 4 tangent non-zero
+// Deferred draws have no vertex colours and read TEXCOORD_0 only.
+struct GBuffer {
+    @location(0) a: vec4<u32>,
+    @location(1) b: vec4<u32>,
+}
+
+// Octahedral encoding of direction `v` (any length > 0) in [-1, 1]^2.
+fn oct_encode(v: vec3<f32>) -> vec2<f32> {
+    let p = v.xy / max(abs(v.x) + abs(v.y) + abs(v.z), 1e-30);
+    let folded = (vec2<f32>(1.0) - abs(p.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
+    return select(p, folded, v.z < 0.0);
+}
+
+// The unit direction `oct_encode` encoded.
+fn oct_decode(e: vec2<f32>) -> vec3<f32> {
+    var v = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
+    let t = max(-v.z, 0.0);
+    v.x += select(t, -t, v.x >= 0.0);
+    v.y += select(t, -t, v.y >= 0.0);
+    return normalize(v);
+}
+
+// Two derivatives as f16 (clamped to its range).
+fn pack_grad(d: vec2<f32>) -> u32 {
+    return pack2x16float(clamp(d, vec2<f32>(-65504.0), vec2<f32>(65504.0)));
+}
+
+@fragment
+fn fs_gbuffer(in: VsOut, @builtin(front_facing) front_facing: bool) -> GBuffer {
+    let dx = dpdx(in.uv.xy);
+    let dy = dpdy(in.uv.xy);
+    let flags = select(0u, 1u, in.tangent.w >= 0.0) | select(0u, 2u, front_facing)
+        | select(0u, 4u, dot(in.tangent.xyz, in.tangent.xyz) > 0.0);
+    var out: GBuffer;
+    out.a = vec4<u32>(bitcast<u32>(in.clip.z), bitcast<u32>(in.uv.x), bitcast<u32>(in.uv.y), pack_grad(dx));
+    out.b = vec4<u32>(
+        pack2x16snorm(oct_encode(in.normal)),
+        pack2x16snorm(oct_encode(in.tangent.xyz)),
+        pack_grad(dy),
+        flags,
+    );
+    return out;
+}
+
+@group(2) @binding(0) var gbuffer_a: texture_2d<u32>;
+@group(2) @binding(1) var gbuffer_b: texture_2d<u32>;
+
+// The derivative of slot i's coordinates for a change `d` of TEXCOORD_0 (the transform's linear
+// part).
+fn slot_grad(i: u32, d: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(dot(material.uv[2u * i].xy, d), dot(material.uv[2u * i + 1u].xy, d));
+}
+
+// Drawn on the full-screen triangle (its uv unused: the pixel is the fragment's position).
+@fragment
+fn fs_resolve(full: FullscreenOut) -> @location(0) vec4<f32> {
+    let frag = full.clip;
+    let c = vec2<i32>(frag.xy);
+    let a = textureLoad(gbuffer_a, c, 0);
+    let b = textureLoad(gbuffer_b, c, 0);
+    let size = vec2<f32>(textureDimensions(gbuffer_a));
+    // The pixel centre at the stored depth, back to world space (clip y is up, rows go down).
+    let ndc = vec4<f32>(frag.x / size.x * 2.0 - 1.0, 1.0 - frag.y / size.y * 2.0, bitcast<f32>(a.x), 1.0);
+    let world = frame.world_from_clip * ndc;
+    let flags = b.w;
+    var in: VsOut;
+    in.clip = frag;
+    in.world_position = world.xyz / world.w;
+    in.normal = oct_decode(unpack2x16snorm(b.x));
+    in.uv = vec4<f32>(bitcast<f32>(a.y), bitcast<f32>(a.z), 0.0, 0.0);
+    in.uv = vec4<f32>(in.uv.xy, in.uv.xy);
+    let tangent = select(vec3<f32>(0.0), oct_decode(unpack2x16snorm(b.y)), (flags & 4u) != 0u);
+    in.tangent = vec4<f32>(tangent, select(-1.0, 1.0, (flags & 1u) != 0u));
+    in.color = vec4<f32>(1.0);
+    let front_facing = (flags & 2u) != 0u;
+    let dx = unpack2x16float(a.w);
+    let dy = unpack2x16float(b.z);
+    var base = material.base_color;
+    if HAS_BASE_TEX {
+        base *= textureSampleGrad(base_color_tex, base_color_sampler, slot_uv(0u, in.uv), slot_grad(0u, dx), slot_grad(0u, dy));
+    }
+    var t = Texels(vec3<f32>(0.5, 0.5, 1.0), vec4<f32>(1.0), vec3<f32>(1.0));
+    if HAS_NORMAL_MAP {
+        t.normal = textureSampleGrad(normal_tex, normal_sampler, slot_uv(1u, in.uv), slot_grad(1u, dx), slot_grad(1u, dy)).xyz;
+    }
+    if HAS_OTHER_TEX {
+        t.mr = textureSampleGrad(metal_rough_tex, metal_rough_sampler, slot_uv(2u, in.uv), slot_grad(2u, dx), slot_grad(2u, dy));
+        t.emissive = textureSampleGrad(emissive_tex, emissive_sampler, slot_uv(3u, in.uv), slot_grad(3u, dx), slot_grad(3u, dy)).rgb;
+    }
+    return vec4<f32>(display(shade_texels(in, front_facing, base, t).color), 1.0);
+}
+
 // Exposure and tone mapping, folded into the lit image's output (no HDR target: nothing else
 // reads one). The same curves as src/math/tonemap.rs. The sRGB attachment encodes the result.
 fn display(c: vec3<f32>) -> vec3<f32> {
@@ -696,12 +800,33 @@ struct Shaded {
     cascade: i32,
 }
 
+// What a fragment reads from the material's textures besides the base colour (white where a slot
+// is empty): the normal map's texel, metallic-roughness (occlusion in r) and emissive.
+struct Texels {
+    normal: vec3<f32>,
+    mr: vec4<f32>,
+    emissive: vec3<f32>,
+}
+
 // Blinn-Phong with normal mapping and shadows for the fragment `in` of base colour `base`.
 fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
+    var t = Texels(vec3<f32>(0.5, 0.5, 1.0), vec4<f32>(1.0), vec3<f32>(1.0));
+    if HAS_NORMAL_MAP {
+        t.normal = textureSample(normal_tex, normal_sampler, slot_uv(1u, in.uv)).xyz;
+    }
+    if HAS_OTHER_TEX {
+        t.mr = textureSample(metal_rough_tex, metal_rough_sampler, slot_uv(2u, in.uv));
+        t.emissive = textureSample(emissive_tex, emissive_sampler, slot_uv(3u, in.uv)).rgb;
+    }
+    return shade_texels(in, front_facing, base, t);
+}
+
+// `shade` once the textures are read (the deferred resolve reads them with explicit gradients).
+fn shade_texels(in: VsOut, front_facing: bool, base: vec4<f32>, texels: Texels) -> Shaded {
     var n_geo = normalize(in.normal);
     var n = n_geo;
     if HAS_NORMAL_MAP {
-        let normal_sample = textureSample(normal_tex, normal_sampler, slot_uv(1u, in.uv)).xyz;
+        let normal_sample = texels.normal;
         let t_raw = in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz);
         if dot(t_raw, t_raw) > 1e-12 {
             let t = normalize(t_raw);
@@ -715,10 +840,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
         n_geo = -n_geo;
         n = -n;
     }
-    var mr = vec4<f32>(1.0);
-    if HAS_OTHER_TEX {
-        mr = textureSample(metal_rough_tex, metal_rough_sampler, slot_uv(2u, in.uv));
-    }
+    let mr = texels.mr;
     let metallic = clamp(material.params.x * mr.b, 0.0, 1.0);
     let roughness = clamp(material.params.y * mr.g, 0.03, 1.0);
     // glTF metallic-roughness -> Blinn-Phong (same mapping as src/scene/material.rs).
@@ -729,7 +851,7 @@ fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     let ka = base.rgb;
     var emissive = material.emissive.rgb;
     if HAS_OTHER_TEX {
-        emissive *= textureSample(emissive_tex, emissive_sampler, slot_uv(3u, in.uv)).rgb;
+        emissive *= texels.emissive;
     }
 
     let p = in.world_position;

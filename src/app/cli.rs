@@ -426,6 +426,20 @@ pub struct ViewArgs {
     /// warning.
     #[arg(long, value_parser = parse_msaa)]
     pub msaa: Option<u32>,
+    /// Shade draws of triangles smaller than a 4×4 pixel block deferred (a G-buffer, then each
+    /// covered pixel shaded once: the same image, less work where llvmpipe would shade whole
+    /// blocks per tiny triangle); default on for CPU devices at one sample per pixel, off on GPUs.
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub deferred: Option<bool>,
+}
+
+/// `on` or `off`.
+fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("expected on or off, got '{s}'")),
+    }
 }
 
 /// `WxH`, each side 1..=`MAX_SIDE`.
@@ -623,6 +637,7 @@ pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
         culling: !a.no_culling,
         msaa: a.msaa,
         cpu_mips: None,
+        deferred: a.deferred,
     }
 }
 

@@ -81,6 +81,19 @@ pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk:
     }
 }
 
+/// The layout covering depth and stencil for a depth-only layout (others unchanged).
+fn with_stencil(l: vk::ImageLayout) -> vk::ImageLayout {
+    match l {
+        vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL => {
+            vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL
+        }
+        vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL => {
+            vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL
+        }
+        other => other,
+    }
+}
+
 /// Records one image barrier from `from` to `to` over the given mip levels; stages, accesses and
 /// layouts all come from `access_info`.
 pub fn image_barrier(
@@ -94,6 +107,12 @@ pub fn image_barrier(
 ) {
     let (src_stage, src_access, old_layout) = access_info(from);
     let (dst_stage, dst_access, new_layout) = access_info(to);
+    // A depth-stencil image moves both aspects together, in the combined layouts.
+    let (old_layout, new_layout) = if aspect.contains(vk::ImageAspectFlags::STENCIL) {
+        (with_stencil(old_layout), with_stencil(new_layout))
+    } else {
+        (old_layout, new_layout)
+    };
     // Reads need no availability; only writes are made available.
     let src_access = src_access
         & (vk::AccessFlags2::TRANSFER_WRITE

@@ -233,6 +233,9 @@ impl Image {
             vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => {
                 vk::ImageAspectFlags::DEPTH
             }
+            vk::Format::D32_SFLOAT_S8_UINT => {
+                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+            }
             _ => vk::ImageAspectFlags::COLOR,
         };
         // Owned from here on: an error below drops `image`, which frees what exists.

@@ -1,11 +1,14 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
+use super::deferred::{self, DeferPlan, GBuffer, GBUFFER_FORMAT, GBUFFER_TARGETS};
 use super::gpu_scene::{flat_hides_nothing, vertex_layout, AlphaDraw, Draw, GpuScene, Viewpoint};
 use super::pipeline::{
-    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
+    create_layout, create_pipeline, depth_clear_attachment, has_stencil, set_viewport, ColorBlend,
+    PipelineDesc, Stencil,
 };
 use super::uniforms::FrameUniform;
+use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{
     allocate_sets, create_module, scene as sh, set_layout, ReflectedBinding,
@@ -20,6 +23,10 @@ use std::sync::Arc;
 /// Depth format of the camera pass.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
+/// Depth format of a camera pass that shades some draws deferred: the same depth, plus the
+/// stencil that marks each deferred pixel's material.
+pub const DEPTH_STENCIL_FORMAT: vk::Format = vk::Format::D32_SFLOAT_S8_UINT;
+
 struct Slot {
     buffer: Buffer,
     set: vk::DescriptorSet,
@@ -33,8 +40,17 @@ pub struct CameraPass {
     frame_layout: vk::DescriptorSetLayout,
     module: vk::ShaderModule,
     color_format: vk::Format,
+    /// Depth (and stencil) format of the pass: `DEPTH_STENCIL_FORMAT` when it may defer.
+    pub depth_format: vk::Format,
     /// Samples per pixel of the colour and depth attachments (MSAA; 1 = off).
     samples: u32,
+    /// Whether micro-triangle draws are shaded deferred (`crate::render::deferred`).
+    deferred: bool,
+    gbuffer_layout: vk::DescriptorSetLayout,
+    /// The G-buffer pipeline (`fs_gbuffer`, one for every material), once a frame defers.
+    gbuffer_pipeline: Option<vk::Pipeline>,
+    /// The G-buffer targets, at the last deferring frame's size.
+    gbuffer: Option<GBuffer>,
     /// Shader modules of the override variants created so far (by variant index).
     variant_modules: HashMap<usize, vk::ShaderModule>,
     /// Scene pipelines created so far, by (variant index, entry point).
@@ -48,18 +64,27 @@ pub struct CameraPass {
 
 impl CameraPass {
     /// Creates the pass for `color_format` at `samples` per pixel, with `slots` frame-uniform
-    /// slots (frames in flight).
+    /// slots (frames in flight); `deferred`: shade micro-triangle draws deferred (single sample
+    /// only).
     pub fn new(
         ctx: &Arc<Context>,
         scene: &GpuScene,
         color_format: vk::Format,
         samples: u32,
         slots: usize,
+        deferred: bool,
     ) -> Result<Self, GpuError> {
+        let deferred = deferred && samples == 1;
+        let depth_format = if deferred {
+            DEPTH_STENCIL_FORMAT
+        } else {
+            DEPTH_FORMAT
+        };
         let frame_layout = set_layout(ctx, sh::BINDINGS, 0, "frame set layout")?;
+        let gbuffer_layout = set_layout(ctx, sh::BINDINGS, 2, "G-buffer set layout")?;
         let layout = create_layout(
             ctx,
-            &[frame_layout, scene.material_layout],
+            &[frame_layout, scene.material_layout, gbuffer_layout],
             sh::IMMEDIATE_SIZE,
             "camera pipeline layout",
         )?;
@@ -71,8 +96,9 @@ impl CameraPass {
             fragment: Some((module, sh::ENTRY_FS_SHADOW_MAP)),
             bindings: &[],
             attributes: &[],
-            color_format: Some(color_format),
-            depth_format: DEPTH_FORMAT,
+            color_formats: &[color_format],
+            depth_format,
+            stencil: Stencil::Off,
             depth_clamp: false,
             depth_bias: false,
             depth_test: false,
@@ -120,7 +146,12 @@ impl CameraPass {
             frame_layout,
             module,
             color_format,
+            depth_format,
             samples,
+            deferred,
+            gbuffer_layout,
+            gbuffer_pipeline: None,
+            gbuffer: None,
             variant_modules: HashMap::new(),
             pipelines: HashMap::new(),
             map_pipeline,
@@ -131,21 +162,37 @@ impl CameraPass {
         })
     }
 
-    /// Creates the scene pipelines this frame needs (once each): for every (material variant,
-    /// alpha-masked) pair of the scene's draws, specialised by the frame's bits (`frame_bits`:
-    /// one light, shadows). Creation compiles the shader, so it happens here, not per draw.
+    /// Creates the scene pipelines this frame (`cull`, at `extent`) needs (once each): for every
+    /// (material variant, alpha-masked) pair of the scene's draws, specialised by the frame's
+    /// bits (`frame_bits`: one light, shadows), and when it shades draws deferred, the G-buffer
+    /// pipeline, targets and its materials' resolve pipelines. Creation compiles the shader, so
+    /// it happens here, not per draw.
     pub fn ensure_pipelines(
         &mut self,
         scene: &GpuScene,
-        frame_bits: usize,
-        debug_view: Option<Entry>,
+        cull: &CameraCull,
+        extent: vk::Extent2D,
     ) -> Result<(), GpuError> {
+        let (frame_bits, debug_view) = (cull.frame_bits, cull.debug_view);
+        let mut keys: Vec<(usize, Entry)> = scene
+            .pipeline_keys
+            .iter()
+            .map(|&(bits, alpha)| (bits | frame_bits, Entry::of(alpha, debug_view)))
+            .collect();
+        let defer = deferred::plan(draw_order(scene, cull), cull, extent, self.deferred);
+        if !defer.deferred.is_empty() {
+            keys.extend(
+                defer
+                    .resolved
+                    .iter()
+                    .map(|r| (r.material_bits | frame_bits, Entry::Resolve)),
+            );
+            self.ensure_gbuffer(extent)?;
+        }
         // Modules first (cheap), then the missing pipelines compiled in parallel: on lavapipe
         // each is an LLVM compile of its shaders, the largest part of a cold first frame.
         let mut missing: Vec<(usize, Entry, vk::ShaderModule)> = Vec::new();
-        for &(material_bits, alpha) in &scene.pipeline_keys {
-            let variant = material_bits | frame_bits;
-            let entry = Entry::of(alpha, debug_view);
+        for (variant, entry) in keys {
             if self.pipelines.contains_key(&(variant, entry))
                 || missing.iter().any(|m| (m.0, m.1) == (variant, entry))
             {
@@ -165,15 +212,17 @@ impl CameraPass {
             };
             missing.push((variant, entry, module));
         }
-        let (ctx, layout, color_format, samples) =
-            (&self.ctx, self.layout, self.color_format, self.samples);
+        let formats = Formats {
+            color: self.color_format,
+            depth: self.depth_format,
+            samples: self.samples,
+        };
+        let (ctx, layout) = (&self.ctx, self.layout);
         let built: Vec<Result<vk::Pipeline, GpuError>> = std::thread::scope(|s| {
             let threads: Vec<_> = missing
                 .iter()
                 .map(|&(variant, entry, module)| {
-                    s.spawn(move || {
-                        scene_pipeline(ctx, layout, color_format, samples, variant, entry, module)
-                    })
+                    s.spawn(move || scene_pipeline(ctx, layout, formats, variant, entry, module))
                 })
                 .collect();
             threads
@@ -196,6 +245,38 @@ impl CameraPass {
             }
         }
         first_error.map_or(Ok(()), Err)
+    }
+
+    /// The G-buffer pipeline and targets at `extent` (re-made when the size changes).
+    fn ensure_gbuffer(&mut self, extent: vk::Extent2D) -> Result<(), GpuError> {
+        if self.gbuffer_pipeline.is_none() {
+            let (bindings, attributes) = vertex_layout();
+            self.gbuffer_pipeline = Some(create_pipeline(
+                &self.ctx,
+                &PipelineDesc {
+                    name: "G-buffer pipeline",
+                    layout: self.layout,
+                    vertex: (self.module, sh::ENTRY_VS_MAIN),
+                    fragment: Some((self.module, sh::ENTRY_FS_GBUFFER)),
+                    bindings: &bindings,
+                    attributes: &attributes,
+                    color_formats: &[GBUFFER_FORMAT; GBUFFER_TARGETS],
+                    depth_format: self.depth_format,
+                    stencil: Stencil::Mark,
+                    depth_clamp: false,
+                    depth_bias: false,
+                    depth_test: true,
+                    blend: ColorBlend::Off,
+                    samples: 1,
+                },
+            )?);
+        }
+        if self.gbuffer.as_ref().is_none_or(|g| g.extent != extent) {
+            // The old targets (if any) are dropped first: a window's resize.
+            self.gbuffer = None;
+            self.gbuffer = Some(GBuffer::new(&self.ctx, extent, self.gbuffer_layout)?);
+        }
+        Ok(())
     }
 
     /// Points slot `slot`'s set at the shadow map. Every binding is written (lavapipe crashes on
@@ -247,10 +328,13 @@ impl CameraPass {
     }
 
     /// Records the pass into colour and depth attachments already in attachment layouts; with
-    /// `shadow_map_view` it draws the shadow map full-screen instead of the scene.
+    /// `shadow_map_view` it draws the shadow map full-screen instead of the scene. Draws that
+    /// `deferred::plan` picks (their pipelines made by `ensure_pipelines`) go through the
+    /// G-buffer first, and their materials are resolved before the forward draws. Returns the
+    /// draws recorded and how many of them were deferred.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
-        &self,
+        &mut self,
         cmd: vk::CommandBuffer,
         slot: usize,
         scene: &GpuScene,
@@ -261,9 +345,35 @@ impl CameraPass {
         clear: [f32; 4],
         shadow_map_view: bool,
         cull: &CameraCull,
-    ) -> usize {
-        let d = &self.ctx.device;
-        self.ctx.begin_label(cmd, "camera pass");
+    ) -> (usize, usize) {
+        let ctx = self.ctx.clone();
+        let d = &ctx.device;
+        ctx.begin_label(cmd, "camera pass");
+        let stencil = has_stencil(self.depth_format);
+        let order = if shadow_map_view {
+            Vec::new()
+        } else {
+            draw_order(scene, cull)
+        };
+        let ready = self.gbuffer.as_ref().is_some_and(|g| g.extent == extent)
+            && self.gbuffer_pipeline.is_some();
+        let mut plan = deferred::plan(order.clone(), cull, extent, self.deferred && ready);
+        if plan.resolved.iter().any(|r| {
+            !self
+                .pipelines
+                .contains_key(&(r.material_bits | cull.frame_bits, Entry::Resolve))
+        }) {
+            // Not prepared for this frame (`ensure_pipelines` saw another one): all forward.
+            plan = deferred::plan(order, cull, extent, false);
+        }
+        let deferring = !plan.deferred.is_empty();
+        let frame_set = self.slots[slot].set;
+        let mut drawn = 0;
+        let mut deferred_draws = 0;
+        if deferring {
+            deferred_draws =
+                self.record_gbuffer(cmd, scene, depth, extent, frame_set, &plan, cull.eye);
+        }
         let mut color_att = vk::RenderingAttachmentInfo::default()
             .image_view(color)
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
@@ -272,7 +382,11 @@ impl CameraPass {
             .clear_value(vk::ClearValue {
                 color: vk::ClearColorValue { float32: clear },
             });
-        let mut depth_att = depth_clear_attachment(depth);
+        let mut depth_att = depth_clear_attachment(depth, stencil);
+        if deferring {
+            // The G-buffer pass's depth and stencil marks.
+            depth_att = depth_att.load_op(vk::AttachmentLoadOp::LOAD);
+        }
         if let Some(target) = resolve.color {
             // The samples are averaged into the target; they need not be kept.
             color_att = color_att
@@ -289,7 +403,7 @@ impl CameraPass {
                 .resolve_image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
         }
         let color_att = [color_att];
-        let rendering = vk::RenderingInfo::default()
+        let mut rendering = vk::RenderingInfo::default()
             .render_area(vk::Rect2D {
                 offset: vk::Offset2D::default(),
                 extent,
@@ -297,11 +411,12 @@ impl CameraPass {
             .layer_count(1)
             .color_attachments(&color_att)
             .depth_attachment(&depth_att);
-        let frame_set = self.slots[slot].set;
-        let mut drawn = 0;
+        if stencil {
+            rendering = rendering.stencil_attachment(&depth_att);
+        }
         unsafe {
             d.cmd_begin_rendering(cmd, &rendering);
-            set_viewport(&self.ctx, cmd, extent);
+            set_viewport(&ctx, cmd, extent);
             // Both pipelines share the layout, so set 0 (frame) is bound once for either.
             d.cmd_bind_descriptor_sets(
                 cmd,
@@ -316,7 +431,11 @@ impl CameraPass {
                 d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
                 d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
                 d.cmd_draw(cmd, 3, 1, 0, 0);
-            } else if !scene.draws.is_empty() {
+            }
+            if deferring {
+                self.record_resolve(cmd, scene, &plan, cull.frame_bits, extent);
+            }
+            if !plan.forward.is_empty() {
                 d.cmd_bind_vertex_buffers(
                     cmd,
                     0,
@@ -326,7 +445,7 @@ impl CameraPass {
                 d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
                 let mut bound_material = usize::MAX;
                 let mut bound_pipeline = vk::Pipeline::null();
-                for dr in draw_order(scene, cull) {
+                for dr in plan.forward {
                     // Created by `ensure_pipelines` for this frame's bits.
                     let entry = Entry::of(dr.alpha, cull.debug_view);
                     let pipeline = self.pipelines[&(dr.material_bits | cull.frame_bits, entry)];
@@ -363,8 +482,156 @@ impl CameraPass {
             }
             d.cmd_end_rendering(cmd);
         }
-        self.ctx.end_label(cmd);
-        drawn
+        ctx.end_label(cmd);
+        (drawn + deferred_draws, deferred_draws)
+    }
+
+    /// Records the G-buffer pass of `plan`'s deferred draws (clearing depth and stencil, each
+    /// draw marking its material), then makes the targets readable and the depth and stencil
+    /// visible to the next rendering. Returns the number of draws.
+    #[allow(clippy::too_many_arguments)]
+    fn record_gbuffer(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        depth: vk::ImageView,
+        extent: vk::Extent2D,
+        frame_set: vk::DescriptorSet,
+        plan: &DeferPlan,
+        eye: (Vec3, f32),
+    ) -> usize {
+        let ctx = self.ctx.clone();
+        let d = &ctx.device;
+        let (Some(gbuffer), Some(pipeline)) = (self.gbuffer.as_mut(), self.gbuffer_pipeline) else {
+            return 0;
+        };
+        ctx.begin_label(cmd, "G-buffer");
+        gbuffer.transition(cmd, Access::ColorAttachment);
+        let targets: Vec<vk::RenderingAttachmentInfo> = gbuffer
+            .views()
+            .into_iter()
+            .map(|v| {
+                // Only marked pixels are read, and those are written: nothing to load.
+                vk::RenderingAttachmentInfo::default()
+                    .image_view(v)
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::DONT_CARE)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+            })
+            .collect();
+        let depth_att = depth_clear_attachment(depth, true);
+        let rendering = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent,
+            })
+            .layer_count(1)
+            .color_attachments(&targets)
+            .depth_attachment(&depth_att)
+            .stencil_attachment(&depth_att);
+        unsafe {
+            d.cmd_begin_rendering(cmd, &rendering);
+            set_viewport(&ctx, cmd, extent);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout,
+                0,
+                &[frame_set],
+                &[],
+            );
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+            d.cmd_bind_vertex_buffers(
+                cmd,
+                0,
+                &[scene.positions.raw, scene.attributes.raw],
+                &[0, 0],
+            );
+            d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
+        }
+        for &(dr, mark) in &plan.deferred {
+            unsafe { d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, mark) };
+            scene.record_draw(
+                d,
+                cmd,
+                self.layout,
+                dr,
+                Some(eye),
+                Viewpoint::Eye(eye.0),
+                bytemuck::bytes_of(&dr.immediates),
+            );
+        }
+        unsafe { d.cmd_end_rendering(cmd) };
+        gbuffer.transition(cmd, Access::FragmentSampled);
+        // The resolve's stencil test and the forward draws' depth test read what this pass
+        // wrote (same layout: a memory dependency only).
+        let tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+            | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
+        let mb = [vk::MemoryBarrier2::default()
+            .src_stage_mask(tests)
+            .src_access_mask(vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE)
+            .dst_stage_mask(tests)
+            .dst_access_mask(
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            )];
+        unsafe {
+            d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&mb))
+        };
+        ctx.end_label(cmd);
+        plan.deferred.len()
+    }
+
+    /// Records one full-screen triangle per resolved material of `plan`, limited to its draws'
+    /// screen rectangle and to the pixels its stencil mark holds (inside a rendering whose set 0
+    /// is bound); restores the full scissor.
+    fn record_resolve(
+        &self,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        plan: &DeferPlan,
+        frame_bits: usize,
+        extent: vk::Extent2D,
+    ) {
+        let Some(gbuffer) = self.gbuffer.as_ref() else {
+            return;
+        };
+        let d = &self.ctx.device;
+        unsafe {
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout,
+                2,
+                &[gbuffer.set],
+                &[],
+            );
+            d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
+            d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
+            for r in &plan.resolved {
+                let pipeline = self.pipelines[&(r.material_bits | frame_bits, Entry::Resolve)];
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.layout,
+                    1,
+                    &[scene.material_sets[r.material]],
+                    &[],
+                );
+                d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, r.mark);
+                d.cmd_set_scissor(cmd, 0, &[r.rect.scissor()]);
+                d.cmd_draw(cmd, 3, 1, 0, 0);
+            }
+            d.cmd_set_scissor(
+                cmd,
+                0,
+                &[vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent,
+                }],
+            );
+        }
     }
 }
 
@@ -424,24 +691,36 @@ pub struct Resolve {
     pub depth: Option<vk::ImageView>,
 }
 
+/// The attachment formats and sample count every camera pipeline is made for.
+#[derive(Clone, Copy)]
+struct Formats {
+    color: vk::Format,
+    depth: vk::Format,
+    samples: u32,
+}
+
 /// Creates the scene pipeline of shader `variant` (in `module`) with fragment entry `entry`.
 fn scene_pipeline(
     ctx: &Context,
     layout: vk::PipelineLayout,
-    color_format: vk::Format,
-    samples: u32,
+    formats: Formats,
     variant: usize,
     entry: Entry,
     module: vk::ShaderModule,
 ) -> Result<vk::Pipeline, GpuError> {
     let (bindings, attributes) = vertex_layout();
     let name = format!("camera pipeline variant {variant} {entry:?}");
+    let resolve = entry == Entry::Resolve;
     create_pipeline(
         ctx,
         &PipelineDesc {
             name: &name,
             layout,
-            vertex: (module, sh::ENTRY_VS_MAIN),
+            vertex: if resolve {
+                (module, sh::ENTRY_VS_FULLSCREEN)
+            } else {
+                (module, sh::ENTRY_VS_MAIN)
+            },
             fragment: Some((
                 module,
                 match entry {
@@ -449,21 +728,27 @@ fn scene_pipeline(
                     Entry::Masked => sh::ENTRY_FS_MASKED,
                     Entry::Blended => sh::ENTRY_FS_BLEND,
                     Entry::Debug | Entry::Overdraw => sh::ENTRY_FS_DEBUG,
+                    Entry::Resolve => sh::ENTRY_FS_RESOLVE,
                 },
             )),
-            bindings: &bindings,
-            attributes: &attributes,
-            color_format: Some(color_format),
-            depth_format: DEPTH_FORMAT,
+            bindings: if resolve { &[] } else { &bindings },
+            attributes: if resolve { &[] } else { &attributes },
+            color_formats: &[formats.color],
+            depth_format: formats.depth,
+            stencil: if resolve {
+                Stencil::Equal
+            } else {
+                Stencil::Off
+            },
             depth_clamp: false,
             depth_bias: false,
-            depth_test: entry != Entry::Overdraw,
+            depth_test: entry != Entry::Overdraw && !resolve,
             blend: match entry {
                 Entry::Overdraw => ColorBlend::Additive,
                 Entry::Blended => ColorBlend::Over,
                 _ => ColorBlend::Off,
             },
-            samples,
+            samples: formats.samples,
         },
     )
 }
@@ -481,6 +766,9 @@ pub enum Entry {
     Overdraw,
     /// `fs_blend`: blended materials, lit image, blended over (no depth write).
     Blended,
+    /// `fs_resolve` on a full-screen triangle: a deferred material's pixels (stencil equal to
+    /// its mark), shaded from the G-buffer.
+    Resolve,
 }
 
 impl Entry {
@@ -508,6 +796,11 @@ impl Drop for CameraPass {
                 d.destroy_shader_module(m, None);
             }
             d.destroy_pipeline(self.map_pipeline, None);
+            if let Some(p) = self.gbuffer_pipeline.take() {
+                d.destroy_pipeline(p, None);
+            }
+            self.gbuffer = None;
+            d.destroy_descriptor_set_layout(self.gbuffer_layout, None);
             d.destroy_shader_module(self.module, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_pool(self.pool, None);

@@ -138,7 +138,14 @@ impl FrameCore {
         let receiver_bounds = gpu.draws.iter().map(|d| d.world_bounds).collect();
         let shadow = ShadowPass::new(ctx)?;
         let samples = options.resolved_samples(ctx);
-        let camera = CameraPass::new(ctx, &gpu, color_format, samples, slots)?;
+        let camera = CameraPass::new(
+            ctx,
+            &gpu,
+            color_format,
+            samples,
+            slots,
+            options.resolved_deferred(ctx),
+        )?;
         let query_pool = unsafe {
             ctx.device.create_query_pool(
                 &vk::QueryPoolCreateInfo::default()
@@ -215,8 +222,9 @@ impl FrameCore {
             plan.uniform.views[c].rect = cp.lookup;
         }
         self.camera.write_frame(slot, &plan.uniform)?;
+        let extent = vk::Extent2D { width, height };
         self.camera
-            .ensure_pipelines(&self.gpu, plan.shader_variant, is_debug_view(view.mode))?;
+            .ensure_pipelines(&self.gpu, &camera_cull(view, &plan, extent), extent)?;
         Ok(plan)
     }
 
@@ -293,19 +301,8 @@ impl FrameCore {
                 (color.view, depth.view, Resolve::default())
             }
         };
-        let aspect = extent.width as f32 / extent.height.max(1) as f32;
-        let t = (view.camera.fov_y * 0.5).tan();
-        let cull = CameraCull {
-            clip_from_world: plan.clip_from_world,
-            eye: (
-                plan.camera_position,
-                view.camera.near * (1.0 + t * t * (1.0 + aspect * aspect)).sqrt(),
-            ),
-            frame_bits: plan.shader_variant,
-            debug_view: is_debug_view(view.mode),
-            highlight: view.highlight,
-        };
-        let camera_draws = self.camera.record(
+        let cull = camera_cull(view, plan, extent);
+        let (camera_draws, deferred_draws) = self.camera.record(
             cmd,
             slot,
             &self.gpu,
@@ -335,6 +332,7 @@ impl FrameCore {
         PassCounts {
             casters,
             camera_draws,
+            deferred_draws,
         }
     }
 
@@ -366,6 +364,22 @@ impl FrameCore {
 
 /// The debug entry `mode` draws the scene with (`None`: the lit image, or the shadow map drawn
 /// full-screen).
+/// What the camera pass culls and draws with for `view` planned as `plan` at `extent`.
+fn camera_cull(view: &View, plan: &FramePlan, extent: vk::Extent2D) -> CameraCull {
+    let aspect = extent.width as f32 / extent.height.max(1) as f32;
+    let t = (view.camera.fov_y * 0.5).tan();
+    CameraCull {
+        clip_from_world: plan.clip_from_world,
+        eye: (
+            plan.camera_position,
+            view.camera.near * (1.0 + t * t * (1.0 + aspect * aspect)).sqrt(),
+        ),
+        frame_bits: plan.shader_variant,
+        debug_view: is_debug_view(view.mode),
+        highlight: view.highlight,
+    }
+}
+
 fn is_debug_view(mode: ViewMode) -> Option<super::camera_pass::Entry> {
     use super::camera_pass::Entry;
     match mode {
@@ -382,6 +396,8 @@ pub struct PassCounts {
     pub casters: usize,
     /// Draws in the camera pass.
     pub camera_draws: usize,
+    /// Of those, draws shaded deferred (`crate::render::deferred`).
+    pub deferred_draws: usize,
 }
 
 impl Drop for FrameCore {

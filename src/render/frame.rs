@@ -486,6 +486,7 @@ pub fn plan_frame(
         * view.exposure_compensation.clamp(-64.0, 64.0).exp2();
     let mut u = FrameUniform {
         clip_from_world,
+        world_from_clip: clip_from_world.as_dmat4().inverse().as_mat4(),
         camera_position: view.camera.position().extend(1.0),
         ambient: ambient.extend(0.0),
         shadow: Vec4::new(

@@ -162,6 +162,8 @@ pub fn vertex_layout() -> (
 
 /// What the load-time analysis found about a primitive's shape.
 struct PrimitiveShape {
+    /// Total triangle area (model space).
+    area: f32,
     closed: bool,
     plane: Option<Vec4>,
     clusters: Option<(Vec<u32>, Vec<Cluster>)>,
@@ -180,6 +182,10 @@ struct PrimitiveRange {
     plane: Option<Vec4>,
     /// (first, count) in `GpuScene::clusters` (count 0: one draw).
     clusters: (u32, u32),
+    /// No vertex colour other than white (see `Draw::deferrable`).
+    white: bool,
+    /// Total triangle area (model space).
+    area: f32,
 }
 
 /// How a draw's material treats alpha.
@@ -238,6 +244,12 @@ pub struct Draw {
     /// The primitive is closed and consistently wound (`scene::topology::is_closed`): seen from
     /// outside its bounds, culling back faces changes no pixel even if it is double-sided.
     pub closed: bool,
+    /// The camera pass may shade it deferred (`CameraPass`): opaque, no vertex colour other than
+    /// white, and every texture of its material reads TEXCOORD_0 (what the G-buffer holds).
+    pub deferrable: bool,
+    /// Mean triangle area in world units (model area scaled by the transform's area scale,
+    /// |det|^⅔: exact for uniform scales).
+    pub mean_area: f32,
 }
 
 /// A model-space plane `(n, w)` carried into world space by `m` (None for a singular `m`).
@@ -273,6 +285,20 @@ impl Draw {
             vk::FrontFace::COUNTER_CLOCKWISE
         }
     }
+}
+
+/// Whether every texture of `m` reads TEXCOORD_0.
+fn reads_texcoord0_only(m: &crate::scene::Material) -> bool {
+    [
+        m.base_color_texture,
+        m.normal_texture,
+        m.metallic_roughness_texture,
+        m.emissive_texture,
+        m.occlusion_texture,
+    ]
+    .iter()
+    .flatten()
+    .all(|t| t.tex_coord == 0)
 }
 
 /// The scene shader's variant bits for a material: which texture slots it fills (the shader
@@ -453,6 +479,15 @@ impl GpuScene {
                 .get(p.material)
                 .is_some_and(|m| m.double_sided);
             PrimitiveShape {
+                area: p
+                    .indices
+                    .chunks_exact(3)
+                    .map(|t| {
+                        let v =
+                            |k: usize| p.positions.get(t[k] as usize).copied().unwrap_or_default();
+                        0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length()
+                    })
+                    .sum(),
                 // Only double-sided materials can use it; skip the check for the others.
                 closed: options.culling && double_sided && is_closed(&p.positions, &p.indices),
                 plane: options
@@ -515,6 +550,11 @@ impl GpuScene {
                     bounds: p.bounds(),
                     closed: shape.closed,
                     plane: shape.plane,
+                    white: p
+                        .colors
+                        .iter()
+                        .all(|c| c.clamp(Vec4::ZERO, Vec4::ONE) == Vec4::ONE),
+                    area: shape.area,
                 });
             }
             ranges.push(r);
@@ -554,6 +594,16 @@ impl GpuScene {
                         _ => AlphaDraw::Opaque,
                     },
                     material_bits: mat.map_or(0, material_variant_bits),
+                    mean_area: r.area
+                        * glam::Mat3::from_mat4(world_from_model)
+                            .determinant()
+                            .abs()
+                            .powf(2.0 / 3.0)
+                        / (index_count / 3).max(1) as f32,
+                    deferrable: r.white
+                        && mat.is_none_or(|m| {
+                            m.alpha_mode == AlphaMode::Opaque && reads_texcoord0_only(m)
+                        }),
                 });
             }
         }

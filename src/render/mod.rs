@@ -3,6 +3,7 @@
 
 pub(crate) mod camera_pass;
 pub(crate) mod core;
+pub(crate) mod deferred;
 pub(crate) mod frame;
 pub(crate) mod gpu_scene;
 pub(crate) mod pipeline;

@@ -18,10 +18,12 @@ pub struct PipelineDesc<'a> {
     pub bindings: &'a [vk::VertexInputBindingDescription],
     /// Vertex attributes.
     pub attributes: &'a [vk::VertexInputAttributeDescription],
-    /// Colour attachment format, if any.
-    pub color_format: Option<vk::Format>,
-    /// Depth attachment format.
+    /// Colour attachment formats (none for depth-only passes).
+    pub color_formats: &'a [vk::Format],
+    /// Depth attachment format; a format with stencil is also the stencil attachment's.
     pub depth_format: vk::Format,
+    /// Stencil test and write.
+    pub stencil: Stencil,
     /// Clamp depth instead of clipping at near/far.
     pub depth_clamp: bool,
     /// Enable (dynamic) depth bias.
@@ -32,6 +34,27 @@ pub struct PipelineDesc<'a> {
     pub blend: ColorBlend,
     /// Samples per pixel of the attachments (1, or the MSAA count).
     pub samples: u32,
+}
+
+/// What a pipeline does with the stencil aspect (reference value: dynamic state).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stencil {
+    /// No stencil test or write.
+    Off,
+    /// Writes the reference wherever the depth test passes (the deferred draws' material mark).
+    Mark,
+    /// Passes only where the stored value equals the reference; writes nothing.
+    Equal,
+}
+
+/// Whether depth format `f` has a stencil aspect.
+pub fn has_stencil(f: vk::Format) -> bool {
+    matches!(
+        f,
+        vk::Format::D32_SFLOAT_S8_UINT
+            | vk::Format::D24_UNORM_S8_UINT
+            | vk::Format::D16_UNORM_S8_UINT
+    )
 }
 
 /// How a pipeline's colour output combines with the attachment.
@@ -78,10 +101,31 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .line_width(1.0);
     let multisample = vk::PipelineMultisampleStateCreateInfo::default()
         .rasterization_samples(vk::SampleCountFlags::from_raw(d.samples.max(1)));
-    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+    let mut depth = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(d.depth_test)
         .depth_write_enable(d.depth_test && d.blend != ColorBlend::Over)
         .depth_compare_op(vk::CompareOp::GREATER);
+    let stencil_op = |compare, pass, write_mask| vk::StencilOpState {
+        fail_op: vk::StencilOp::KEEP,
+        pass_op: pass,
+        depth_fail_op: vk::StencilOp::KEEP,
+        compare_op: compare,
+        compare_mask: 0xff,
+        write_mask,
+        reference: 0,
+    };
+    let stencil = match d.stencil {
+        Stencil::Off => None,
+        Stencil::Mark => Some(stencil_op(
+            vk::CompareOp::ALWAYS,
+            vk::StencilOp::REPLACE,
+            0xff,
+        )),
+        Stencil::Equal => Some(stencil_op(vk::CompareOp::EQUAL, vk::StencilOp::KEEP, 0)),
+    };
+    if let Some(op) = stencil {
+        depth = depth.stencil_test_enable(true).front(op).back(op);
+    }
     let mut blend_attachment = vk::PipelineColorBlendAttachmentState::default()
         .color_write_mask(vk::ColorComponentFlags::RGBA);
     let factors = match d.blend {
@@ -107,13 +151,8 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
             })
             .alpha_blend_op(vk::BlendOp::ADD);
     }
-    let blend_attachments = [blend_attachment];
-    let blend =
-        vk::PipelineColorBlendStateCreateInfo::default().attachments(if d.color_format.is_some() {
-            &blend_attachments
-        } else {
-            &[]
-        });
+    let blend_attachments = vec![blend_attachment; d.color_formats.len()];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
     let mut dyn_states = vec![
         vk::DynamicState::VIEWPORT,
         vk::DynamicState::SCISSOR,
@@ -123,11 +162,16 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
     if d.depth_bias {
         dyn_states.push(vk::DynamicState::DEPTH_BIAS);
     }
+    if d.stencil != Stencil::Off {
+        dyn_states.push(vk::DynamicState::STENCIL_REFERENCE);
+    }
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dyn_states);
-    let color_formats: Vec<vk::Format> = d.color_format.into_iter().collect();
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
-        .color_attachment_formats(&color_formats)
+        .color_attachment_formats(d.color_formats)
         .depth_attachment_format(d.depth_format);
+    if has_stencil(d.depth_format) {
+        rendering = rendering.stencil_attachment_format(d.depth_format);
+    }
     let info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)
@@ -193,11 +237,19 @@ pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D)
     }
 }
 
-/// A depth attachment cleared to 0 (reversed-z: 0 is the far plane) and stored.
-pub fn depth_clear_attachment(view: vk::ImageView) -> vk::RenderingAttachmentInfo<'static> {
+/// A depth attachment cleared to 0 (reversed-z: 0 is the far plane) and stored (with a stencil
+/// aspect, `stencil` true: both aspects, cleared to 0, in the combined layout).
+pub fn depth_clear_attachment(
+    view: vk::ImageView,
+    stencil: bool,
+) -> vk::RenderingAttachmentInfo<'static> {
     vk::RenderingAttachmentInfo::default()
         .image_view(view)
-        .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+        .image_layout(if stencil {
+            vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL
+        } else {
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL
+        })
         .load_op(vk::AttachmentLoadOp::CLEAR)
         .store_op(vk::AttachmentStoreOp::STORE)
         .clear_value(vk::ClearValue {

@@ -1,6 +1,5 @@
 //! The offscreen renderer: the shared frame core into an image, read back to RGBA8.
 
-use super::camera_pass::DEPTH_FORMAT;
 use super::core::{Attachment, FrameCore, MsaaTargets};
 use super::frame::FramePlan;
 use super::settings::{SceneOptions, View};
@@ -32,6 +31,8 @@ pub struct FrameStats {
     pub casters_drawn: usize,
     /// Draws in the camera pass (after frustum culling).
     pub draws: usize,
+    /// Of those, draws shaded deferred (through the G-buffer; `SceneOptions::deferred`).
+    pub deferred_draws: usize,
     /// Draws in the scene (instances × primitives), before culling.
     pub draws_total: usize,
     /// Triangles in the scene.
@@ -208,7 +209,7 @@ impl Renderer {
         let depth = Image::new(
             ctx,
             "offscreen depth",
-            DEPTH_FORMAT,
+            self.core.camera.depth_format,
             extent,
             1,
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | usage,
@@ -357,6 +358,7 @@ impl Renderer {
             wall_ms: 0.0,
             casters_drawn: counts.casters,
             draws: counts.camera_draws,
+            deferred_draws: counts.deferred_draws,
             draws_total: self.core.gpu.draws.len(),
             triangles: self.core.gpu.triangles,
             hardware_compare: self.core.shadow.hardware_filtering(view.shadow.format),

@@ -216,6 +216,10 @@ pub struct SceneOptions {
     /// too, after compiling blitter shaders that Mesa's shader cache does not keep: ~200 ms of
     /// every start), blits on GPUs.
     pub cpu_mips: Option<bool>,
+    /// Shade draws of triangles smaller than llvmpipe's 4×4 shading block deferred
+    /// (`crate::render::deferred`: a G-buffer, then each covered pixel shaded once). `None`: on
+    /// CPU devices at one sample per pixel, off on GPUs (which shade 2×2 quads in hardware).
+    pub deferred: Option<bool>,
 }
 
 impl Default for SceneOptions {
@@ -225,6 +229,7 @@ impl Default for SceneOptions {
             culling: true,
             msaa: None,
             cpu_mips: None,
+            deferred: None,
         }
     }
 }
@@ -249,6 +254,28 @@ impl SceneOptions {
     pub fn resolved_cpu_mips(&self, ctx: &crate::gpu::Context) -> bool {
         self.cpu_mips
             .unwrap_or(ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU)
+    }
+
+    /// Whether micro-triangle draws may be shaded deferred on `ctx`'s device (`deferred`, or its
+    /// default; the camera pass also needs one sample per pixel).
+    pub fn resolved_deferred(&self, ctx: &crate::gpu::Context) -> bool {
+        use ash::vk::{Format, FormatFeatureFlags as F};
+        let wanted = self
+            .deferred
+            .unwrap_or(ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU);
+        let has = |format, features| {
+            let p = unsafe {
+                ctx.instance
+                    .get_physical_device_format_properties(ctx.physical, format)
+            };
+            p.optimal_tiling_features.contains(features)
+        };
+        wanted
+            && has(Format::D32_SFLOAT_S8_UINT, F::DEPTH_STENCIL_ATTACHMENT)
+            && has(
+                Format::R32G32B32A32_SFLOAT,
+                F::COLOR_ATTACHMENT | F::SAMPLED_IMAGE,
+            )
     }
 
     /// The anisotropy to use on `ctx`'s device (1.0 = off), clamped to what it supports.

@@ -5,6 +5,7 @@ use super::core::Attachment;
 use super::gpu_scene::{flat_hides_nothing, vertex_layout, GpuScene, Viewpoint};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
+    Stencil,
 };
 use super::settings::{ShadowFormat, ShadowSettings};
 use super::uniforms::ShadowImmediates;
@@ -204,8 +205,9 @@ fn depth_pipeline(
             fragment: masked.then_some((module, sh::ENTRY_FS_MASKED)),
             bindings: &bindings[..n_bindings],
             attributes: &attributes[..n_attributes],
-            color_format: None,
+            color_formats: &[],
             depth_format: format,
+            stencil: Stencil::Off,
             depth_clamp: true,
             depth_bias: true,
             depth_test: true,
@@ -383,7 +385,7 @@ impl ShadowPass {
                 Viewpoint::Eye(p) => Some((p, eye_near)),
                 Viewpoint::Along(_) => None,
             };
-            let depth_attachment = depth_clear_attachment(layer_view);
+            let depth_attachment = depth_clear_attachment(layer_view, false);
             // Only the casters' area is cleared and drawn: lookups elsewhere never read the map.
             let area = casters.area;
             let rendering = vk::RenderingInfo::default()

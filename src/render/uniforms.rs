@@ -60,6 +60,8 @@ impl Default for ShadowViewUniform {
 pub struct FrameUniform {
     /// World → clip (camera).
     pub clip_from_world: Mat4,
+    /// Clip → world (its inverse, computed in double precision).
+    pub world_from_clip: Mat4,
     /// Camera position.
     pub camera_position: Vec4,
     /// Ambient intensity Ia.

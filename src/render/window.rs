@@ -2,7 +2,6 @@
 //! (per frame: command buffer, fence, acquire semaphore, uniform slot; per image: render-finished
 //! semaphore).
 
-use super::camera_pass::DEPTH_FORMAT;
 use super::core::{Attachment, FrameCore, MsaaTargets};
 use super::renderer::{
     copy_to_buffer, rgba_from_readback, transfer_to_host_barrier, visible_depths,
@@ -182,7 +181,7 @@ impl WindowRenderer {
         let image = Image::new(
             &self.core.ctx,
             "window depth",
-            DEPTH_FORMAT,
+            self.core.camera.depth_format,
             e,
             1,
             // Read back for depth fitting.

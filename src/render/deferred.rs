@@ -1,0 +1,296 @@
+//! Deferred shading of draws made of triangles smaller than llvmpipe's shading block.
+//!
+//! llvmpipe rasterises in 4×4-pixel blocks and runs the fragment shader on every block a
+//! triangle touches (on 8 lanes at a time), so a mesh whose triangles cover a pixel or two on
+//! screen runs the whole material shader several times per pixel it keeps: FlightHelmet's
+//! 95 k triangles average 1.5 pixels at 1280×720. Those draws (`plan`) instead write what the
+//! shader reads from their varyings into a G-buffer (`fs_gbuffer`: no texture reads, no
+//! lighting) and mark their material in the stencil; then one full-screen triangle per such
+//! material, limited to its draws' screen rectangle, shades each marked pixel once
+//! (`fs_resolve`: the same textures, read with the G-buffer's derivatives, and the same
+//! `shade_texels`). Everything else is drawn forward, after the resolve, into the same depth.
+//!
+//! On by default on CPU devices at one sample per pixel (`SceneOptions::deferred`); GPUs shade
+//! 2×2 quads in hardware and keep the forward pass.
+
+use super::camera_pass::CameraCull;
+use super::gpu_scene::{AlphaDraw, Draw};
+use crate::gpu::barrier::{image_barrier, Access};
+use crate::gpu::context::{Context, GpuError};
+use crate::gpu::shaders::{allocate_sets, scene as sh, ReflectedBinding};
+use crate::gpu::Image;
+use ash::vk;
+use glam::{Mat4, Vec2};
+use std::sync::Arc;
+
+/// A draw is deferred when its triangles' estimated mean area on screen (`pixels_per_triangle`)
+/// is below this many pixels.
+pub const DEFER_BELOW_PIXELS: f32 = 4.0;
+
+/// Draws of fewer triangles are not worth a G-buffer write and a resolve.
+pub const DEFER_MIN_TRIANGLES: u32 = 256;
+
+/// Format of the G-buffer targets (`GBuffer` in scene.wgsl: 32-bit depth and texture
+/// coordinates, packed directions and derivatives).
+pub const GBUFFER_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
+
+/// Number of G-buffer targets.
+pub const GBUFFER_TARGETS: usize = 2;
+
+/// Stencil marks are 8 bits; mark 0 is "not deferred".
+const MAX_MARKS: usize = 255;
+
+/// A pixel rectangle `[x0, x1) × [y0, y1)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelRect {
+    /// Left, top (inclusive).
+    pub min: Vec2,
+    /// Right, bottom (exclusive).
+    pub max: Vec2,
+}
+
+impl PixelRect {
+    fn union(self, o: PixelRect) -> PixelRect {
+        PixelRect {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+
+    /// Whole pixels covering the rectangle, as a scissor.
+    pub fn scissor(&self) -> vk::Rect2D {
+        let x0 = self.min.x.floor().max(0.0) as i32;
+        let y0 = self.min.y.floor().max(0.0) as i32;
+        let x1 = self.max.x.ceil().max(0.0) as i32;
+        let y1 = self.max.y.ceil().max(0.0) as i32;
+        vk::Rect2D {
+            offset: vk::Offset2D { x: x0, y: y0 },
+            extent: vk::Extent2D {
+                width: (x1 - x0).max(0) as u32,
+                height: (y1 - y0).max(0) as u32,
+            },
+        }
+    }
+}
+
+/// The pixels of an `extent` image that `dr`'s world bounds project to (clamped to the image);
+/// `None` when a corner lies behind the eye (the rectangle would be unbounded).
+pub fn screen_rect(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> Option<PixelRect> {
+    let size = Vec2::new(extent.width as f32, extent.height as f32);
+    let mut min = Vec2::splat(f32::INFINITY);
+    let mut max = Vec2::splat(f32::NEG_INFINITY);
+    for c in dr.world_bounds.corners() {
+        let p = *clip_from_world * c.extend(1.0);
+        if p.w <= 1e-6 {
+            return None;
+        }
+        // Clip y is up, pixel rows go down.
+        let px = Vec2::new(p.x / p.w * 0.5 + 0.5, 0.5 - p.y / p.w * 0.5) * size;
+        min = min.min(px);
+        max = max.max(px);
+    }
+    Some(PixelRect {
+        min: min.clamp(Vec2::ZERO, size),
+        max: max.clamp(Vec2::ZERO, size),
+    })
+}
+
+/// The mean screen area in pixels of `dr`'s triangles that face the eye, estimated at its
+/// bounds' centre: half the mean world area (the mean projection of a facing triangle)
+/// times the pixels per world unit squared there (`extent`'s height over the view's height at
+/// that depth). Infinite where the centre is at or behind the eye.
+pub fn pixels_per_triangle(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> f32 {
+    let w = (*clip_from_world * dr.world_bounds.center().extend(1.0)).w;
+    if w <= 1e-6 {
+        return f32::INFINITY;
+    }
+    // Row 1 of projection × view is the projection's y scale times a unit row of the view.
+    let scale_y = clip_from_world.row(1).truncate().length();
+    let px_per_unit = 0.5 * extent.height as f32 * scale_y / w;
+    0.5 * dr.mean_area * px_per_unit * px_per_unit
+}
+
+/// Where `dr` is on screen if it is shaded deferred in a frame seen through `clip_from_world`
+/// at `extent`: deferrable, at least `DEFER_MIN_TRIANGLES`, triangles under
+/// `DEFER_BELOW_PIXELS` each, and wholly in front of the eye.
+pub fn is_micro(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> Option<PixelRect> {
+    let triangles = dr.index_count / 3;
+    if !dr.deferrable || dr.alpha != AlphaDraw::Opaque || triangles < DEFER_MIN_TRIANGLES {
+        return None;
+    }
+    if pixels_per_triangle(dr, clip_from_world, extent) >= DEFER_BELOW_PIXELS {
+        return None;
+    }
+    screen_rect(dr, clip_from_world, extent)
+}
+
+/// One material resolved full-screen: its index, stencil mark, shader variant bits and the
+/// screen rectangle of its deferred draws.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Resolved {
+    /// Material index (descriptor set).
+    pub material: usize,
+    /// Stencil value its deferred draws write (1–255).
+    pub mark: u32,
+    /// `Draw::material_bits`.
+    pub material_bits: usize,
+    /// Where its deferred draws can be on screen.
+    pub rect: PixelRect,
+}
+
+/// How a frame's draws split between the G-buffer and the forward pass.
+pub struct DeferPlan<'a> {
+    /// Draws into the G-buffer, each with its material's stencil mark, in the given order.
+    pub deferred: Vec<(&'a Draw, u32)>,
+    /// The materials to resolve.
+    pub resolved: Vec<Resolved>,
+    /// The rest, drawn forward after the resolve, in the given order.
+    pub forward: Vec<&'a Draw>,
+}
+
+/// Splits `order` (the camera pass's draw order) for `cull`'s frame at `extent`; with `enabled`
+/// false (or a debug view) everything is forward. The viewer's highlighted draw stays forward
+/// (its tint is a forward-shader immediate), and materials past the 255th deferred one too.
+pub fn plan<'a>(
+    order: Vec<&'a Draw>,
+    cull: &CameraCull,
+    extent: vk::Extent2D,
+    enabled: bool,
+) -> DeferPlan<'a> {
+    let mut p = DeferPlan {
+        deferred: Vec::new(),
+        resolved: Vec::new(),
+        forward: Vec::new(),
+    };
+    for dr in order {
+        let micro = (enabled && cull.debug_view.is_none() && cull.highlight != Some(dr.source))
+            .then(|| is_micro(dr, &cull.clip_from_world, extent))
+            .flatten();
+        let Some(rect) = micro else {
+            p.forward.push(dr);
+            continue;
+        };
+        let known = p.resolved.iter().position(|r| r.material == dr.material);
+        let mark = match known {
+            Some(i) => {
+                let r = &mut p.resolved[i];
+                r.rect = r.rect.union(rect);
+                r.mark
+            }
+            None if p.resolved.len() < MAX_MARKS => {
+                let mark = p.resolved.len() as u32 + 1;
+                p.resolved.push(Resolved {
+                    material: dr.material,
+                    mark,
+                    material_bits: dr.material_bits,
+                    rect,
+                });
+                mark
+            }
+            None => {
+                p.forward.push(dr);
+                continue;
+            }
+        };
+        p.deferred.push((dr, mark));
+    }
+    p
+}
+
+/// The G-buffer targets of one size, their descriptor set (set 2 of the camera layout), and the
+/// access each was last used with.
+pub struct GBuffer {
+    images: Vec<Image>,
+    states: Vec<Access>,
+    /// Their size.
+    pub extent: vk::Extent2D,
+    pool: vk::DescriptorPool,
+    /// Set 2: the four targets, read with `textureLoad` by `fs_resolve`.
+    pub set: vk::DescriptorSet,
+    ctx: Arc<Context>,
+}
+
+impl GBuffer {
+    /// The targets at `extent`, and their set (layout `set_layout`), every binding written.
+    pub fn new(
+        ctx: &Arc<Context>,
+        extent: vk::Extent2D,
+        set_layout: vk::DescriptorSetLayout,
+    ) -> Result<Self, GpuError> {
+        let mut images = Vec::new();
+        for i in 0..GBUFFER_TARGETS {
+            images.push(Image::new(
+                ctx,
+                &format!("G-buffer {i}"),
+                GBUFFER_FORMAT,
+                extent,
+                1,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            )?);
+        }
+        let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 2, set_layout, 1)?;
+        let set = sets[0];
+        let infos: Vec<[vk::DescriptorImageInfo; 1]> = images
+            .iter()
+            .map(|im| {
+                [vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: im.view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }]
+            })
+            .collect();
+        let bindings: [&ReflectedBinding; GBUFFER_TARGETS] = [&sh::GBUFFER_A, &sh::GBUFFER_B];
+        let writes: Vec<vk::WriteDescriptorSet> = bindings
+            .iter()
+            .zip(&infos)
+            .map(|(b, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(b.binding)
+                    .descriptor_type(b.descriptor_type())
+                    .image_info(info)
+            })
+            .collect();
+        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        Ok(Self {
+            states: vec![Access::Undefined; images.len()],
+            images,
+            extent,
+            pool,
+            set,
+            ctx: ctx.clone(),
+        })
+    }
+
+    /// The targets' views, in location order.
+    pub fn views(&self) -> Vec<vk::ImageView> {
+        self.images.iter().map(|i| i.view).collect()
+    }
+
+    /// Records barriers taking every target to `to` (after whatever the last frame did with it).
+    pub fn transition(&mut self, cmd: vk::CommandBuffer, to: Access) {
+        for (im, state) in self.images.iter().zip(&mut self.states) {
+            // From the last access: a later frame's writes wait for this one's reads.
+            image_barrier(
+                &self.ctx.device,
+                cmd,
+                im.raw,
+                vk::ImageAspectFlags::COLOR,
+                0..1,
+                *state,
+                to,
+            );
+            *state = to;
+        }
+    }
+}
+
+impl Drop for GBuffer {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.ctx.device.device_wait_idle();
+            self.ctx.device.destroy_descriptor_pool(self.pool, None);
+        }
+    }
+}
