@@ -47,8 +47,6 @@ pub struct CameraPass {
     /// Whether micro-triangle draws are shaded deferred (`crate::render::deferred`).
     deferred: bool,
     gbuffer_layout: vk::DescriptorSetLayout,
-    /// The G-buffer pipeline (`fs_gbuffer`, one for every material), once a frame defers.
-    gbuffer_pipeline: Option<vk::Pipeline>,
     /// The G-buffer targets, at the last deferring frame's size.
     gbuffer: Option<GBuffer>,
     /// Shader modules of the override variants created so far (by variant index).
@@ -150,7 +148,6 @@ impl CameraPass {
             samples,
             deferred,
             gbuffer_layout,
-            gbuffer_pipeline: None,
             gbuffer: None,
             variant_modules: HashMap::new(),
             pipelines: HashMap::new(),
@@ -187,6 +184,8 @@ impl CameraPass {
                     .iter()
                     .map(|r| (r.material_bits | frame_bits, Entry::Resolve)),
             );
+            // One G-buffer pipeline for every material (fs_gbuffer reads no material).
+            keys.push((0, Entry::GBuffer));
             self.ensure_gbuffer(extent)?;
         }
         // Modules first (cheap), then the missing pipelines compiled in parallel: on lavapipe
@@ -247,30 +246,8 @@ impl CameraPass {
         first_error.map_or(Ok(()), Err)
     }
 
-    /// The G-buffer pipeline and targets at `extent` (re-made when the size changes).
+    /// The G-buffer targets at `extent` (re-made when the size changes).
     fn ensure_gbuffer(&mut self, extent: vk::Extent2D) -> Result<(), GpuError> {
-        if self.gbuffer_pipeline.is_none() {
-            let (bindings, attributes) = vertex_layout();
-            self.gbuffer_pipeline = Some(create_pipeline(
-                &self.ctx,
-                &PipelineDesc {
-                    name: "G-buffer pipeline",
-                    layout: self.layout,
-                    vertex: (self.module, sh::ENTRY_VS_MAIN),
-                    fragment: Some((self.module, sh::ENTRY_FS_GBUFFER)),
-                    bindings: &bindings,
-                    attributes: &attributes,
-                    color_formats: &[GBUFFER_FORMAT; GBUFFER_TARGETS],
-                    depth_format: self.depth_format,
-                    stencil: Stencil::Mark,
-                    depth_clamp: false,
-                    depth_bias: false,
-                    depth_test: true,
-                    blend: ColorBlend::Off,
-                    samples: 1,
-                },
-            )?);
-        }
         if self.gbuffer.as_ref().is_none_or(|g| g.extent != extent) {
             // The old targets (if any) are dropped first: a window's resize.
             self.gbuffer = None;
@@ -356,7 +333,7 @@ impl CameraPass {
             draw_order(scene, cull)
         };
         let ready = self.gbuffer.as_ref().is_some_and(|g| g.extent == extent)
-            && self.gbuffer_pipeline.is_some();
+            && self.pipelines.contains_key(&(0, Entry::GBuffer));
         let mut plan = deferred::plan(order.clone(), cull, extent, self.deferred && ready);
         if plan.resolved.iter().any(|r| {
             !self
@@ -502,7 +479,8 @@ impl CameraPass {
     ) -> usize {
         let ctx = self.ctx.clone();
         let d = &ctx.device;
-        let (Some(gbuffer), Some(pipeline)) = (self.gbuffer.as_mut(), self.gbuffer_pipeline) else {
+        let pipeline = self.pipelines.get(&(0, Entry::GBuffer)).copied();
+        let (Some(gbuffer), Some(pipeline)) = (self.gbuffer.as_mut(), pipeline) else {
             return 0;
         };
         ctx.begin_label(cmd, "G-buffer");
@@ -711,6 +689,7 @@ fn scene_pipeline(
     let (bindings, attributes) = vertex_layout();
     let name = format!("camera pipeline variant {variant} {entry:?}");
     let resolve = entry == Entry::Resolve;
+    let gbuffer = entry == Entry::GBuffer;
     create_pipeline(
         ctx,
         &PipelineDesc {
@@ -729,16 +708,21 @@ fn scene_pipeline(
                     Entry::Blended => sh::ENTRY_FS_BLEND,
                     Entry::Debug | Entry::Overdraw => sh::ENTRY_FS_DEBUG,
                     Entry::Resolve => sh::ENTRY_FS_RESOLVE,
+                    Entry::GBuffer => sh::ENTRY_FS_GBUFFER,
                 },
             )),
             bindings: if resolve { &[] } else { &bindings },
             attributes: if resolve { &[] } else { &attributes },
-            color_formats: &[formats.color],
-            depth_format: formats.depth,
-            stencil: if resolve {
-                Stencil::Equal
+            color_formats: if gbuffer {
+                &[GBUFFER_FORMAT; GBUFFER_TARGETS]
             } else {
-                Stencil::Off
+                std::slice::from_ref(&formats.color)
+            },
+            depth_format: formats.depth,
+            stencil: match entry {
+                Entry::Resolve => Stencil::Equal,
+                Entry::GBuffer => Stencil::Mark,
+                _ => Stencil::Off,
             },
             depth_clamp: false,
             depth_bias: false,
@@ -769,6 +753,9 @@ pub enum Entry {
     /// `fs_resolve` on a full-screen triangle: a deferred material's pixels (stencil equal to
     /// its mark), shaded from the G-buffer.
     Resolve,
+    /// `fs_gbuffer`: a deferred draw's varyings into the G-buffer, its material's mark into the
+    /// stencil (one pipeline for every material).
+    GBuffer,
 }
 
 impl Entry {
@@ -796,9 +783,6 @@ impl Drop for CameraPass {
                 d.destroy_shader_module(m, None);
             }
             d.destroy_pipeline(self.map_pipeline, None);
-            if let Some(p) = self.gbuffer_pipeline.take() {
-                d.destroy_pipeline(p, None);
-            }
             self.gbuffer = None;
             d.destroy_descriptor_set_layout(self.gbuffer_layout, None);
             d.destroy_shader_module(self.module, None);
