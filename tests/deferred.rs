@@ -157,10 +157,10 @@ fn deferred_micro_triangles_give_the_forward_image() {
     assert_eq!(on.stats.draws, off.stats.draws);
     let (largest, changed) = difference(&on.image, &off.image);
     eprintln!("deferred vs forward: largest difference {largest} levels, {changed} pixels > 2");
-    // Measured: largest 5 levels, 7 pixels over 2, all on silhouettes: llvmpipe takes one mip
-    // level per 2×2 quad, from its first pixel, so a silhouette pixel whose quad starts on
-    // another surface reads that pixel's level (the forward pass extrapolates its own
-    // triangle). Everywhere else the resolve reads the same varyings (directions through
+    // Measured: largest 5 levels, 7 pixels over 2, all on silhouettes: llvmpipe computes one
+    // mip level per 2×2 quad, explicit derivatives included, so a silhouette pixel whose quad
+    // also holds another surface can read a level of its derivatives (the forward pass
+    // extrapolates its own triangle). Everywhere else the resolve reads the same varyings (directions through
     // 16-bit octahedral codes, derivatives through f16): at most 2 levels.
     assert!(largest <= 8, "largest difference {largest} levels");
     assert!(
