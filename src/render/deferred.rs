@@ -24,10 +24,14 @@ use glam::{Mat4, Vec2};
 use std::sync::Arc;
 
 /// A draw is deferred when its triangles' estimated mean area on screen (`pixels_per_triangle`)
-/// is below this many pixels.
+/// is below this many pixels. Chosen by a sweep (README, *Speed*): at 2, 4, 8 and 16 the camera
+/// pass of FlightHelmet + ground took 38.6, 38.7, 39.7 and 42.1 ms (45.8 deferring nothing), the
+/// double-sided scene's 23.5, 22.2, 25.2 and 26.1 ms (24.0).
 pub const DEFER_BELOW_PIXELS: f32 = 4.0;
 
-/// Draws of fewer triangles are not worth a G-buffer write and a resolve.
+/// Draws of fewer triangles stay forward: a small draw saves little shading and would still
+/// cost its material a resolve (not measured finely; every benchmark draw that defers has
+/// over 1,000 triangles).
 pub const DEFER_MIN_TRIANGLES: u32 = 256;
 
 /// Format of the G-buffer targets (`GBuffer` in scene.wgsl: 32-bit depth and texture
@@ -292,5 +296,122 @@ impl Drop for GBuffer {
             let _ = self.ctx.device.device_wait_idle();
             self.ctx.device.destroy_descriptor_pool(self.pool, None);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::projection::perspective_infinite_reversed;
+    use crate::math::Aabb;
+    use crate::render::uniforms::SceneImmediates;
+    use glam::Vec3;
+
+    /// A deferrable opaque draw of `triangles` triangles of mean world area `mean_area` in a unit
+    /// box centred at `center`.
+    fn draw(material: usize, triangles: u32, mean_area: f32, center: Vec3) -> Draw {
+        let m = Mat4::from_translation(center);
+        Draw {
+            first_index: 0,
+            index_count: 3 * triangles,
+            vertex_offset: 0,
+            material,
+            source: (material, 0),
+            world_from_model: m,
+            model_from_world: m.inverse(),
+            clusters: (0, 0),
+            immediates: SceneImmediates::new(m),
+            world_bounds: Aabb::new(center - Vec3::splat(0.5), center + Vec3::splat(0.5)),
+            world_plane: None,
+            double_sided: false,
+            mirrored: false,
+            alpha: AlphaDraw::Opaque,
+            material_bits: 0,
+            closed: true,
+            deferrable: true,
+            mean_area,
+        }
+    }
+
+    /// A 90° camera at the origin looking down −z, 100×100 pixels.
+    fn cull() -> (CameraCull, vk::Extent2D) {
+        let c = CameraCull {
+            clip_from_world: perspective_infinite_reversed(90f32.to_radians(), 1.0, 0.1),
+            eye: (Vec3::ZERO, 0.1),
+            frame_bits: 0,
+            debug_view: None,
+            highlight: None,
+        };
+        (
+            c,
+            vk::Extent2D {
+                width: 100,
+                height: 100,
+            },
+        )
+    }
+
+    #[test]
+    fn pixels_per_triangle_is_half_the_projected_mean_area() {
+        let (c, extent) = cull();
+        // At 10 units a 90° view 100 pixels tall spans 20 units: 5 pixels per unit, so a
+        // triangle of 0.1 square units covers 0.5 · 0.1 · 25 = 1.25 pixels facing the eye.
+        let d = draw(0, 1000, 0.1, Vec3::new(0.0, 0.0, -10.0));
+        let ppt = pixels_per_triangle(&d, &c.clip_from_world, extent);
+        assert!((ppt - 1.25).abs() < 1e-4, "{ppt}");
+        // Twice as far, a quarter of the pixels; behind the eye, never deferred.
+        let far = draw(0, 1000, 0.1, Vec3::new(0.0, 0.0, -20.0));
+        let ppt_far = pixels_per_triangle(&far, &c.clip_from_world, extent);
+        assert!((ppt_far - 0.3125).abs() < 1e-4, "{ppt_far}");
+        let behind = draw(0, 1000, 0.1, Vec3::new(0.0, 0.0, 10.0));
+        assert_eq!(
+            pixels_per_triangle(&behind, &c.clip_from_world, extent),
+            f32::INFINITY
+        );
+    }
+
+    #[test]
+    fn plan_marks_each_deferred_material_once_and_keeps_the_rest_forward() {
+        let (mut c, extent) = cull();
+        let draws = [
+            draw(3, 1000, 0.01, Vec3::new(-1.0, 0.0, -10.0)),
+            Draw {
+                source: (3, 1),
+                ..draw(3, 1000, 0.01, Vec3::new(1.0, 0.0, -10.0))
+            },
+            draw(5, 1000, 0.01, Vec3::new(0.0, 1.0, -10.0)),
+            // Large triangles, too few triangles, not deferrable: forward.
+            draw(6, 1000, 10.0, Vec3::new(0.0, -1.0, -10.0)),
+            draw(7, 100, 0.01, Vec3::new(0.0, -2.0, -10.0)),
+            Draw {
+                deferrable: false,
+                ..draw(8, 1000, 0.01, Vec3::new(2.0, 0.0, -10.0))
+            },
+        ];
+        let p = plan(draws.iter().collect(), &c, extent, true);
+        let marks: Vec<(usize, u32)> = p.deferred.iter().map(|(d, m)| (d.material, *m)).collect();
+        assert_eq!(marks, [(3, 1), (3, 1), (5, 2)]);
+        assert_eq!(p.resolved.len(), 2);
+        // Material 3's rectangle covers both of its draws' boxes.
+        let r = p.resolved[0].rect;
+        let a = screen_rect(&draws[0], &c.clip_from_world, extent).unwrap();
+        let b = screen_rect(&draws[1], &c.clip_from_world, extent).unwrap();
+        assert_eq!(r, a.union(b));
+        let forward: Vec<usize> = p.forward.iter().map(|d| d.material).collect();
+        assert_eq!(forward, [6, 7, 8]);
+        // Off, in a debug view, or for the highlighted draw: forward.
+        assert!(plan(draws.iter().collect(), &c, extent, false)
+            .deferred
+            .is_empty());
+        c.highlight = Some((3, 1));
+        let p = plan(draws.iter().collect(), &c, extent, true);
+        let sources: Vec<(usize, usize)> = p.deferred.iter().map(|(d, _)| d.source).collect();
+        assert_eq!(sources, [(3, 0), (5, 0)]);
+        assert_eq!(p.forward[0].source, (3, 1));
+        c.highlight = None;
+        c.debug_view = Some(crate::render::camera_pass::Entry::Debug);
+        assert!(plan(draws.iter().collect(), &c, extent, true)
+            .deferred
+            .is_empty());
     }
 }
