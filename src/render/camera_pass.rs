@@ -391,18 +391,8 @@ impl CameraPass {
         if stencil {
             rendering = rendering.stencil_attachment(&depth_att);
         }
+        self.begin_rendering(cmd, &rendering, extent, frame_set);
         unsafe {
-            d.cmd_begin_rendering(cmd, &rendering);
-            set_viewport(&ctx, cmd, extent);
-            // Both pipelines share the layout, so set 0 (frame) is bound once for either.
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout,
-                0,
-                &[frame_set],
-                &[],
-            );
             if shadow_map_view {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.map_pipeline);
                 d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
@@ -413,13 +403,7 @@ impl CameraPass {
                 self.record_resolve(cmd, scene, &plan, cull.frame_bits, extent);
             }
             if !plan.forward.is_empty() {
-                d.cmd_bind_vertex_buffers(
-                    cmd,
-                    0,
-                    &[scene.positions.raw, scene.attributes.raw],
-                    &[0, 0],
-                );
-                d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
+                bind_geometry(d, cmd, scene);
                 let mut bound_material = usize::MAX;
                 let mut bound_pipeline = vk::Pipeline::null();
                 for dr in plan.forward {
@@ -485,8 +469,8 @@ impl CameraPass {
         };
         ctx.begin_label(cmd, "G-buffer");
         gbuffer.transition(cmd, Access::ColorAttachment);
-        let targets: Vec<vk::RenderingAttachmentInfo> = gbuffer
-            .views()
+        let views = gbuffer.views();
+        let targets: Vec<vk::RenderingAttachmentInfo> = views
             .into_iter()
             .map(|v| {
                 // Only marked pixels are read, and those are written: nothing to load.
@@ -507,26 +491,9 @@ impl CameraPass {
             .color_attachments(&targets)
             .depth_attachment(&depth_att)
             .stencil_attachment(&depth_att);
-        unsafe {
-            d.cmd_begin_rendering(cmd, &rendering);
-            set_viewport(&ctx, cmd, extent);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout,
-                0,
-                &[frame_set],
-                &[],
-            );
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-            d.cmd_bind_vertex_buffers(
-                cmd,
-                0,
-                &[scene.positions.raw, scene.attributes.raw],
-                &[0, 0],
-            );
-            d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-        }
+        self.begin_rendering(cmd, &rendering, extent, frame_set);
+        unsafe { d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline) };
+        bind_geometry(d, cmd, scene);
         for &(dr, mark) in &plan.deferred {
             unsafe { d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, mark) };
             scene.record_draw(
@@ -540,7 +507,9 @@ impl CameraPass {
             );
         }
         unsafe { d.cmd_end_rendering(cmd) };
-        gbuffer.transition(cmd, Access::FragmentSampled);
+        if let Some(g) = self.gbuffer.as_mut() {
+            g.transition(cmd, Access::FragmentSampled);
+        }
         // The resolve's stencil test and the forward draws' depth test read what this pass
         // wrote (same layout: a memory dependency only).
         let tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
@@ -558,6 +527,30 @@ impl CameraPass {
         };
         ctx.end_label(cmd);
         plan.deferred.len()
+    }
+
+    /// Begins `rendering` with a full-extent viewport and the frame's set 0 bound (every camera
+    /// pipeline shares the layout).
+    fn begin_rendering(
+        &self,
+        cmd: vk::CommandBuffer,
+        rendering: &vk::RenderingInfo,
+        extent: vk::Extent2D,
+        frame_set: vk::DescriptorSet,
+    ) {
+        let d = &self.ctx.device;
+        unsafe {
+            d.cmd_begin_rendering(cmd, rendering);
+            set_viewport(&self.ctx, cmd, extent);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout,
+                0,
+                &[frame_set],
+                &[],
+            );
+        }
     }
 
     /// Records one full-screen triangle per resolved material of `plan`, limited to its draws'
@@ -610,6 +603,19 @@ impl CameraPass {
                 }],
             );
         }
+    }
+}
+
+/// Binds the scene's vertex streams (positions, attributes) and index buffer.
+fn bind_geometry(d: &ash::Device, cmd: vk::CommandBuffer, scene: &GpuScene) {
+    unsafe {
+        d.cmd_bind_vertex_buffers(
+            cmd,
+            0,
+            &[scene.positions.raw, scene.attributes.raw],
+            &[0, 0],
+        );
+        d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
     }
 }
 
