@@ -592,8 +592,8 @@ fn fs_resolve(full: FullscreenOut) -> @location(0) vec4<f32> {
     in.clip = frag;
     in.world_position = world.xyz / world.w;
     in.normal = oct_decode(unpack2x16snorm(b.x));
-    in.uv = vec4<f32>(bitcast<f32>(a.y), bitcast<f32>(a.z), 0.0, 0.0);
-    in.uv = vec4<f32>(in.uv.xy, in.uv.xy);
+    let uv = vec2<f32>(bitcast<f32>(a.y), bitcast<f32>(a.z));
+    in.uv = vec4<f32>(uv, uv);
     let tangent = select(vec3<f32>(0.0), oct_decode(unpack2x16snorm(b.y)), (flags & 4u) != 0u);
     in.tangent = vec4<f32>(tangent, select(-1.0, 1.0, (flags & 1u) != 0u));
     in.color = vec4<f32>(1.0);

@@ -143,6 +143,26 @@ impl Drop for Buffer {
     }
 }
 
+/// The aspects of an image of `format`: depth, depth and stencil, or colour.
+pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
+    match format {
+        vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => {
+            vk::ImageAspectFlags::DEPTH
+        }
+        vk::Format::D32_SFLOAT_S8_UINT
+        | vk::Format::D24_UNORM_S8_UINT
+        | vk::Format::D16_UNORM_S8_UINT => {
+            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+        }
+        _ => vk::ImageAspectFlags::COLOR,
+    }
+}
+
+/// Whether depth format `f` has a stencil aspect.
+pub fn has_stencil(f: vk::Format) -> bool {
+    aspect_of(f).contains(vk::ImageAspectFlags::STENCIL)
+}
+
 /// A 2-D image with one view over all its mip levels.
 pub struct Image {
     ctx: Arc<Context>,
@@ -229,15 +249,7 @@ impl Image {
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let raw = unsafe { ctx.device.create_image(&info, None) }.vk("vkCreateImage")?;
-        let aspect = match format {
-            vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => {
-                vk::ImageAspectFlags::DEPTH
-            }
-            vk::Format::D32_SFLOAT_S8_UINT => {
-                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
-            }
-            _ => vk::ImageAspectFlags::COLOR,
-        };
+        let aspect = aspect_of(format);
         // Owned from here on: an error below drops `image`, which frees what exists.
         let mut image = Self {
             ctx: ctx.clone(),

@@ -4,12 +4,13 @@
 use super::deferred::{self, DeferPlan, GBuffer, GBUFFER_FORMAT, GBUFFER_TARGETS};
 use super::gpu_scene::{flat_hides_nothing, vertex_layout, AlphaDraw, Draw, GpuScene, Viewpoint};
 use super::pipeline::{
-    create_layout, create_pipeline, depth_clear_attachment, has_stencil, set_viewport, ColorBlend,
-    PipelineDesc, Stencil,
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
+    Stencil,
 };
 use super::uniforms::FrameUniform;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::resources::has_stencil;
 use crate::gpu::shaders::{
     allocate_sets, create_module, scene as sh, set_layout, ReflectedBinding,
 };
@@ -332,17 +333,8 @@ impl CameraPass {
         } else {
             draw_order(scene, cull)
         };
-        let ready = self.gbuffer.as_ref().is_some_and(|g| g.extent == extent)
-            && self.pipelines.contains_key(&(0, Entry::GBuffer));
-        let mut plan = deferred::plan(order.clone(), cull, extent, self.deferred && ready);
-        if plan.resolved.iter().any(|r| {
-            !self
-                .pipelines
-                .contains_key(&(r.material_bits | cull.frame_bits, Entry::Resolve))
-        }) {
-            // Not prepared for this frame (`ensure_pipelines` saw another one): all forward.
-            plan = deferred::plan(order, cull, extent, false);
-        }
+        // The split `ensure_pipelines` made this frame's pipelines and G-buffer for.
+        let plan = deferred::plan(order, cull, extent, self.deferred);
         let deferring = !plan.deferred.is_empty();
         let frame_set = self.slots[slot].set;
         let mut drawn = 0;
@@ -463,8 +455,9 @@ impl CameraPass {
     ) -> usize {
         let ctx = self.ctx.clone();
         let d = &ctx.device;
-        let pipeline = self.pipelines.get(&(0, Entry::GBuffer)).copied();
-        let (Some(gbuffer), Some(pipeline)) = (self.gbuffer.as_mut(), pipeline) else {
+        // Both made by `ensure_pipelines` for this frame.
+        let pipeline = self.pipelines[&(0, Entry::GBuffer)];
+        let Some(gbuffer) = self.gbuffer.as_mut() else {
             return 0;
         };
         ctx.begin_label(cmd, "G-buffer");

@@ -1,6 +1,7 @@
 //! Graphics pipeline creation shared by the passes (dynamic rendering, no render pass objects).
 
 use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::resources::has_stencil;
 use ash::vk;
 use std::ffi::CStr;
 
@@ -45,16 +46,6 @@ pub enum Stencil {
     Mark,
     /// Passes only where the stored value equals the reference; writes nothing.
     Equal,
-}
-
-/// Whether depth format `f` has a stencil aspect.
-pub fn has_stencil(f: vk::Format) -> bool {
-    matches!(
-        f,
-        vk::Format::D32_SFLOAT_S8_UINT
-            | vk::Format::D24_UNORM_S8_UINT
-            | vk::Format::D16_UNORM_S8_UINT
-    )
 }
 
 /// How a pipeline's colour output combines with the attachment.
