@@ -431,6 +431,11 @@ pub struct ViewArgs {
     /// blocks per tiny triangle); default on for CPU devices at one sample per pixel, off on GPUs.
     #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
     pub deferred: Option<bool>,
+    /// Draw small receivers (a ground) without the shadow lookup beyond the casters' reach (the
+    /// same image, scissored; llvmpipe pays a lookup even where a branch skips it); default on
+    /// for CPU devices, off on GPUs.
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub receiver_split: Option<bool>,
 }
 
 /// `on` or `off`.
@@ -638,6 +643,7 @@ pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
         msaa: a.msaa,
         cpu_mips: None,
         deferred: a.deferred,
+        receiver_split: a.receiver_split,
     }
 }
 

@@ -215,6 +215,7 @@ impl App {
             instance_extensions,
             swapchain: true,
             pipeline_cache: super::pipeline_cache_path(),
+            ..Default::default()
         })?;
         let handle = window
             .window_handle()

@@ -4,6 +4,7 @@
 
 pub(crate) mod barrier;
 pub(crate) mod context;
+mod heap;
 pub mod pipeline_cache;
 pub(crate) mod resources;
 pub(crate) mod shaders;

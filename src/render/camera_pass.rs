@@ -7,6 +7,7 @@ use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
     Stencil,
 };
+use super::receivers::{self, ShadowReach, Split};
 use super::uniforms::FrameUniform;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
@@ -178,6 +179,15 @@ impl CameraPass {
             .map(|&(bits, alpha)| (bits | frame_bits, Entry::of(alpha, debug_view)))
             .collect();
         let defer = deferred::plan(draw_order(scene, cull), cull, extent, self.deferred);
+        // The unshadowed variants of receivers drawn (partly) beyond the casters' reach.
+        if let Some(reach) = &cull.shadow_reach {
+            for dr in &defer.forward {
+                if receivers::split(reach, dr, &cull.clip_from_world, extent) != Split::Shadowed {
+                    let bits = receivers::unshadowed(dr.material_bits | frame_bits);
+                    keys.push((bits, Entry::of(dr.alpha, debug_view)));
+                }
+            }
+        }
         if !defer.deferred.is_empty() {
             keys.extend(
                 defer
@@ -309,7 +319,8 @@ impl CameraPass {
     /// `shadow_map_view` it draws the shadow map full-screen instead of the scene. Draws that
     /// `deferred::plan` picks (their pipelines made by `ensure_pipelines`) go through the
     /// G-buffer first, and their materials are resolved before the forward draws. Returns the
-    /// draws recorded and how many of them were deferred.
+    /// draws recorded, how many of them were deferred, and how many were drawn (in part) without
+    /// the shadow lookup (`receivers::split`).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -323,7 +334,7 @@ impl CameraPass {
         clear: [f32; 4],
         shadow_map_view: bool,
         cull: &CameraCull,
-    ) -> (usize, usize) {
+    ) -> CameraCounts {
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         ctx.begin_label(cmd, "camera pass");
@@ -338,6 +349,7 @@ impl CameraPass {
         let deferring = !plan.deferred.is_empty();
         let frame_set = self.slots[slot].set;
         let mut drawn = 0;
+        let mut unshadowed = 0;
         let mut deferred_draws = 0;
         if deferring {
             deferred_draws =
@@ -399,14 +411,25 @@ impl CameraPass {
                 let mut bound_material = usize::MAX;
                 let mut bound_pipeline = vk::Pipeline::null();
                 for dr in plan.forward {
-                    // Created by `ensure_pipelines` for this frame's bits.
                     let entry = Entry::of(dr.alpha, cull.debug_view);
-                    let pipeline = self.pipelines[&(dr.material_bits | cull.frame_bits, entry)];
-                    if pipeline != bound_pipeline {
-                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                        bound_pipeline = pipeline;
-                    }
+                    let bits = dr.material_bits | cull.frame_bits;
+                    let split = cull.shadow_reach.as_ref().map_or(Split::Shadowed, |r| {
+                        receivers::split(r, dr, &cull.clip_from_world, extent)
+                    });
+                    // (variant, scissor) of each piece; None: the whole image.
+                    let pieces: Vec<(usize, Option<vk::Rect2D>)> = match split {
+                        Split::Shadowed => vec![(bits, None)],
+                        Split::Unshadowed => vec![(receivers::unshadowed(bits), None)],
+                        Split::Both { inside, outside } => std::iter::once((bits, Some(inside)))
+                            .chain(
+                                outside
+                                    .into_iter()
+                                    .map(|r| (receivers::unshadowed(bits), Some(r))),
+                            )
+                            .collect(),
+                    };
                     drawn += 1;
+                    unshadowed += usize::from(pieces.iter().any(|p| p.0 != bits));
                     if dr.material != bound_material {
                         d.cmd_bind_descriptor_sets(
                             cmd,
@@ -422,21 +445,39 @@ impl CameraPass {
                     if cull.highlight == Some(dr.source) {
                         imm.normal_y.w = 1.0;
                     }
-                    scene.record_draw(
-                        d,
-                        cmd,
-                        self.layout,
-                        dr,
-                        Some(cull.eye),
-                        Viewpoint::Eye(cull.eye.0),
-                        bytemuck::bytes_of(&imm),
-                    );
+                    for &(variant, scissor) in &pieces {
+                        // Created by `ensure_pipelines` for this frame's bits.
+                        let pipeline = self.pipelines[&(variant, entry)];
+                        if pipeline != bound_pipeline {
+                            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                            bound_pipeline = pipeline;
+                        }
+                        if let Some(s) = scissor {
+                            d.cmd_set_scissor(cmd, 0, &[s]);
+                        }
+                        scene.record_draw(
+                            d,
+                            cmd,
+                            self.layout,
+                            dr,
+                            Some(cull.eye),
+                            Viewpoint::Eye(cull.eye.0),
+                            bytemuck::bytes_of(&imm),
+                        );
+                    }
+                    if pieces.iter().any(|p| p.1.is_some()) {
+                        d.cmd_set_scissor(cmd, 0, &[full_rect(extent)]);
+                    }
                 }
             }
             d.cmd_end_rendering(cmd);
         }
         ctx.end_label(cmd);
-        (drawn + deferred_draws, deferred_draws)
+        CameraCounts {
+            drawn: drawn + deferred_draws,
+            deferred: deferred_draws,
+            unshadowed,
+        }
     }
 
     /// Records the G-buffer pass of `plan`'s deferred draws (clearing depth and stencil, each
@@ -587,14 +628,7 @@ impl CameraPass {
                 d.cmd_set_scissor(cmd, 0, &[r.rect.scissor()]);
                 d.cmd_draw(cmd, 3, 1, 0, 0);
             }
-            d.cmd_set_scissor(
-                cmd,
-                0,
-                &[vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent,
-                }],
-            );
+            d.cmd_set_scissor(cmd, 0, &[full_rect(extent)]);
         }
     }
 }
@@ -643,6 +677,25 @@ fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
     v.into_iter().map(|(_, _, dr)| dr).collect()
 }
 
+/// Draws one camera pass recorded.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraCounts {
+    /// Draws recorded (deferred ones included).
+    pub drawn: usize,
+    /// Of those, draws shaded deferred.
+    pub deferred: usize,
+    /// Of those, draws drawn wholly or in part without the shadow lookup.
+    pub unshadowed: usize,
+}
+
+/// The whole of an `extent` image, as a scissor.
+fn full_rect(extent: vk::Extent2D) -> vk::Rect2D {
+    vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent,
+    }
+}
+
 /// What the camera pass needs per frame to do only the work the frame needs: the camera's world →
 /// clip (draws whose bounds lie outside it are not recorded), its eye with the near plane's reach
 /// (for `Draw::cull_mode`), and which shader variant and entry point to draw with.
@@ -657,6 +710,9 @@ pub struct CameraCull {
     pub debug_view: Option<Entry>,
     /// The (instance, primitive) drawn tinted (`View::highlight`).
     pub highlight: Option<(usize, usize)>,
+    /// Where the frame's single shadow view can shadow anything, when small receivers are
+    /// drawn unshadowed beyond it (`crate::render::receivers`).
+    pub shadow_reach: Option<ShadowReach>,
 }
 
 /// Where a multisampled camera pass resolves to (both None without MSAA).

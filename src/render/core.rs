@@ -4,11 +4,13 @@
 
 use super::camera_pass::{CameraCull, CameraPass, Resolve, DEPTH_FORMAT};
 use super::frame::{plan_frame, FramePlan};
-use super::gpu_scene::GpuScene;
+use super::gpu_scene::{GpuScene, Viewpoint};
+use super::receivers::ShadowReach;
 use super::settings::{SceneOptions, View, ViewMode};
 use super::shadow_pass::{plan_casters, ShadowPass};
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::shaders::scene as sh;
 use crate::gpu::Image;
 use crate::math::shadow_fit::spot_near;
 use crate::scene::{Light, Scene};
@@ -122,6 +124,9 @@ pub struct FrameCore {
     /// What the GPU's world coordinates are relative to ([`Scene::render_origin`]): draws,
     /// lights and the planned matrices; views are rebased in [`FrameCore::prepare`].
     pub origin: glam::Vec3,
+    /// Whether small receivers are drawn unshadowed beyond the casters' reach
+    /// (`SceneOptions::receiver_split`).
+    receiver_split: bool,
 }
 
 impl FrameCore {
@@ -146,6 +151,7 @@ impl FrameCore {
             slots,
             options.resolved_deferred(ctx),
         )?;
+        let receiver_split = options.resolved_receiver_split(ctx);
         let query_pool = unsafe {
             ctx.device.create_query_pool(
                 &vk::QueryPoolCreateInfo::default()
@@ -166,6 +172,7 @@ impl FrameCore {
             query_pool,
             timestamps_written: vec![false; slots],
             receiver_bounds,
+            receiver_split,
         })
     }
 
@@ -223,8 +230,11 @@ impl FrameCore {
         }
         self.camera.write_frame(slot, &plan.uniform)?;
         let extent = vk::Extent2D { width, height };
-        self.camera
-            .ensure_pipelines(&self.gpu, &camera_cull(view, &plan, extent), extent)?;
+        self.camera.ensure_pipelines(
+            &self.gpu,
+            &camera_cull(view, &plan, extent, self.receiver_split),
+            extent,
+        )?;
         Ok(plan)
     }
 
@@ -301,8 +311,8 @@ impl FrameCore {
                 (color.view, depth.view, Resolve::default())
             }
         };
-        let cull = camera_cull(view, plan, extent);
-        let (camera_draws, deferred_draws) = self.camera.record(
+        let cull = camera_cull(view, plan, extent, self.receiver_split);
+        let counts = self.camera.record(
             cmd,
             slot,
             &self.gpu,
@@ -331,8 +341,9 @@ impl FrameCore {
         self.timestamps_written[slot] = timestamps;
         PassCounts {
             casters,
-            camera_draws,
-            deferred_draws,
+            camera_draws: counts.drawn,
+            deferred_draws: counts.deferred,
+            unshadowed_draws: counts.unshadowed,
         }
     }
 
@@ -364,11 +375,41 @@ impl FrameCore {
 
 /// The debug entry `mode` draws the scene with (`None`: the lit image, or the shadow map drawn
 /// full-screen).
-/// What the camera pass culls and draws with for `view` planned as `plan` at `extent`.
-fn camera_cull(view: &View, plan: &FramePlan, extent: vk::Extent2D) -> CameraCull {
+/// What the camera pass culls and draws with for `view` planned as `plan` at `extent`; with
+/// `receiver_split`, the reach of a single shadow view (`crate::render::receivers`).
+fn camera_cull(
+    view: &View,
+    plan: &FramePlan,
+    extent: vk::Extent2D,
+    receiver_split: bool,
+) -> CameraCull {
     let aspect = extent.width as f32 / extent.height.max(1) as f32;
     let t = (view.camera.fov_y * 0.5).tan();
+    let single_view = plan.shadow_views.len() == 1 && plan.casters.len() == 1;
+    let bits = plan.shader_variant;
+    let shadow_reach = (receiver_split
+        && view.mode == ViewMode::Lit
+        && plan.shadows_on
+        && single_view
+        && bits & sh::BIT_SHADOWS != 0
+        && bits & sh::BIT_MANY_VIEWS == 0)
+        .then(|| {
+            let sv = &plan.shadow_views[0];
+            let apex = match plan.light_source(sv.light) {
+                Viewpoint::Eye(p) => Some(p),
+                Viewpoint::Along(_) => None,
+            };
+            ShadowReach::new(
+                &sv.light_clip_from_world,
+                plan.casters[0].lookup,
+                sv.res as f32,
+                view.shadow.normal_offset.abs() + view.shadow.constant_bias.abs(),
+                sv.texel_world,
+                apex,
+            )
+        });
     CameraCull {
+        shadow_reach,
         clip_from_world: plan.clip_from_world,
         eye: (
             plan.camera_position,
@@ -398,6 +439,8 @@ pub struct PassCounts {
     pub camera_draws: usize,
     /// Of those, draws shaded deferred (`crate::render::deferred`).
     pub deferred_draws: usize,
+    /// Draws drawn, wholly or in part, without the shadow lookup (`crate::render::receivers`).
+    pub unshadowed_draws: usize,
 }
 
 impl Drop for FrameCore {

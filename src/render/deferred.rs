@@ -341,6 +341,7 @@ mod tests {
             frame_bits: 0,
             debug_view: None,
             highlight: None,
+            shadow_reach: None,
         };
         (
             c,

@@ -7,6 +7,7 @@ pub(crate) mod deferred;
 pub(crate) mod frame;
 pub(crate) mod gpu_scene;
 pub(crate) mod pipeline;
+pub(crate) mod receivers;
 pub(crate) mod renderer;
 pub mod report;
 pub(crate) mod samplers;

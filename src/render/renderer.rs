@@ -33,6 +33,9 @@ pub struct FrameStats {
     pub draws: usize,
     /// Of those, draws shaded deferred (through the G-buffer; `SceneOptions::deferred`).
     pub deferred_draws: usize,
+    /// Of those, draws drawn, wholly or in part, without the shadow lookup where no caster can
+    /// shadow them (`SceneOptions::receiver_split`).
+    pub unshadowed_draws: usize,
     /// Draws in the scene (instances × primitives), before culling.
     pub draws_total: usize,
     /// Triangles in the scene.
@@ -359,6 +362,7 @@ impl Renderer {
             casters_drawn: counts.casters,
             draws: counts.camera_draws,
             deferred_draws: counts.deferred_draws,
+            unshadowed_draws: counts.unshadowed_draws,
             draws_total: self.core.gpu.draws.len(),
             triangles: self.core.gpu.triangles,
             hardware_compare: self.core.shadow.hardware_filtering(view.shadow.format),

@@ -220,6 +220,10 @@ pub struct SceneOptions {
     /// (`crate::render::deferred`: a G-buffer, then each covered pixel shaded once). `None`: on
     /// CPU devices at one sample per pixel, off on GPUs (which shade 2×2 quads in hardware).
     pub deferred: Option<bool>,
+    /// Draw small receivers (a ground) without the shadow lookup where no caster can shadow them
+    /// (`crate::render::receivers`: the same image; llvmpipe runs the lookup even where a
+    /// branch skips it). `None`: on for CPU devices, off on GPUs (whose branches skip it).
+    pub receiver_split: Option<bool>,
 }
 
 impl Default for SceneOptions {
@@ -230,6 +234,7 @@ impl Default for SceneOptions {
             msaa: None,
             cpu_mips: None,
             deferred: None,
+            receiver_split: None,
         }
     }
 }
@@ -276,6 +281,13 @@ impl SceneOptions {
                 Format::R32G32B32A32_SFLOAT,
                 F::COLOR_ATTACHMENT | F::SAMPLED_IMAGE,
             )
+    }
+
+    /// Whether small receivers are drawn unshadowed beyond the casters' reach on `ctx`'s
+    /// device (`receiver_split`, or its default).
+    pub fn resolved_receiver_split(&self, ctx: &crate::gpu::Context) -> bool {
+        self.receiver_split
+            .unwrap_or(ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU)
     }
 
     /// The anisotropy to use on `ctx`'s device (1.0 = off), clamped to what it supports.

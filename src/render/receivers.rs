@@ -1,0 +1,395 @@
+//! Receivers beyond the casters' reach.
+//!
+//! A shadow lookup whose point projects outside the casters' rectangle in the light's view
+//! (`CasterPlan::lookup`) is lit without a read, but llvmpipe runs both sides of every branch:
+//! every fragment of a shadowed variant pays the projection and the gathered comparison, on a
+//! ground plane that mostly lies where no caster can shadow it as on the object above it. So on
+//! CPU devices a small draw (`SPLIT_MAX_TRIANGLES`, such as a ground) that lies partly inside
+//! the reach is drawn twice, scissored: with the shadowed shader over the screen rectangle of
+//! the part of its bounds a lookup can reach (`ShadowReach::clip`), and with the same material's
+//! unshadowed variant over the rest of the image (up to four bands). A draw wholly outside the
+//! reach is drawn unshadowed. The image is the same: outside the reach the shadowed shader's
+//! visibility is exactly 1.
+//!
+//! Only frames with one shadow view use it (a single map of a directional light or a spot
+//! light's; cascades and cube faces keep the shadowed shader everywhere).
+
+use super::deferred::{screen_rect, PixelRect};
+use super::gpu_scene::Draw;
+use crate::gpu::shaders::scene as sh;
+use crate::math::Aabb;
+use ash::vk;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+/// Draws of more triangles keep the shadowed shader everywhere: each split draws the geometry
+/// again for every scissor (up to five times), which costs llvmpipe's single geometry thread
+/// more than a large mesh's lookups would save.
+pub const SPLIT_MAX_TRIANGLES: u32 = 1024;
+
+/// Texels added to the normal offset and constant bias when growing the reach (rounding).
+const SLACK_TEXELS: f32 = 1.0;
+
+/// The world region where a frame's single shadow view can return less than 1: the points whose
+/// lookup point (the point moved by its normal offset and bias) projects inside the casters'
+/// rectangle, in front of a spot light.
+#[derive(Clone, Debug)]
+pub struct ShadowReach {
+    /// Half-spaces `n·p + d ≥ 0` with unit `n`, before growing by the lookup offset.
+    planes: Vec<Vec4>,
+    /// A perspective view's apex (the spot light), where its side planes meet.
+    apex: Option<Vec3>,
+    /// How far a lookup point can lie from its point, in texels of the view.
+    offset_texels: f32,
+    /// World size of a texel (directional), or per unit distance from the light (spot).
+    texel_world: f32,
+}
+
+impl ShadowReach {
+    /// The reach of a view `light_clip_from_world` whose `size`-texel square has its casters'
+    /// lookup rectangle `lookup` (texels `(x0, y0, x1, y1)`, rows down; empty when `x0 > x1`),
+    /// lookups moved up to `offset_texels` texels (normal offset + constant bias) of
+    /// `texel_world` each; `apex` is the spot light's position (None for a directional light).
+    pub fn new(
+        light_clip_from_world: &Mat4,
+        lookup: Vec4,
+        size: f32,
+        offset_texels: f32,
+        texel_world: f32,
+        apex: Option<Vec3>,
+    ) -> Self {
+        let m = light_clip_from_world;
+        let (rx, ry, rw) = (m.row(0), m.row(1), m.row(3));
+        // Texel u = (ndc.x / 2 + 1/2)·size, v = (1/2 − ndc.y / 2)·size; with w > 0:
+        // u ≥ x0 ⇔ clip.x − a·clip.w ≥ 0 (a = 2·x0/size − 1), and so on.
+        let ndc_x = |t: f32| 2.0 * t / size - 1.0;
+        let ndc_y = |t: f32| 1.0 - 2.0 * t / size;
+        let mut raw = vec![
+            rx - ndc_x(lookup.x) * rw,
+            ndc_x(lookup.z) * rw - rx,
+            ndc_y(lookup.y) * rw - ry,
+            ry - ndc_y(lookup.w) * rw,
+        ];
+        if apex.is_some() {
+            // A lookup at or behind the light's plane is lit.
+            raw.push(rw);
+        }
+        let empty = !(lookup.x <= lookup.z && lookup.y <= lookup.w);
+        let mut planes = Vec::new();
+        for p in raw {
+            let n = p.truncate().length();
+            if n > 1e-12 {
+                planes.push(p / n);
+            } else if p.w < 0.0 {
+                // Constant and negative: nothing satisfies it.
+                planes.push(Vec4::new(0.0, 0.0, 0.0, -1.0));
+            }
+        }
+        if empty {
+            planes = vec![Vec4::new(0.0, 0.0, 0.0, -1.0)];
+        }
+        Self {
+            planes,
+            apex,
+            offset_texels: offset_texels.max(0.0) + SLACK_TEXELS,
+            texel_world,
+        }
+    }
+
+    /// The corners of the part of `bounds` whose points may have a lookup that reads a caster
+    /// (a superset: the planes grown by the largest lookup offset over `bounds`); None when
+    /// no point of `bounds` can.
+    pub fn clip(&self, bounds: &Aabb) -> Option<Vec<Vec3>> {
+        let scale = match self.apex {
+            Some(a) => bounds
+                .corners()
+                .iter()
+                .map(|c| c.distance(a))
+                .fold(0.0, f32::max),
+            None => 1.0,
+        };
+        let grow = self.offset_texels * self.texel_world * scale;
+        let planes: Vec<Vec4> = self.planes.iter().map(|p| *p + Vec4::W * grow).collect();
+        let mut corners = Vec::new();
+        for face in box_faces(bounds) {
+            let mut poly = face.to_vec();
+            for p in &planes {
+                poly = clip_polygon(&poly, *p);
+                if poly.is_empty() {
+                    break;
+                }
+            }
+            corners.extend(poly);
+        }
+        // Vertices on no face of the box: only a spot light's apex, where its planes meet.
+        if let Some(a) = self.apex.filter(|a| bounds.contains(*a, 0.0)) {
+            corners.push(a);
+        }
+        (!corners.is_empty()).then_some(corners)
+    }
+}
+
+/// The six faces of `b` as quads.
+fn box_faces(b: &Aabb) -> [[Vec3; 4]; 6] {
+    let c = b.corners();
+    // corners(): bit 0 → x max, bit 1 → y max, bit 2 → z max.
+    let quad = |i: [usize; 4]| [c[i[0]], c[i[1]], c[i[2]], c[i[3]]];
+    [
+        quad([0, 2, 6, 4]),
+        quad([1, 3, 7, 5]),
+        quad([0, 1, 5, 4]),
+        quad([2, 3, 7, 6]),
+        quad([0, 1, 3, 2]),
+        quad([4, 5, 7, 6]),
+    ]
+}
+
+/// The part of convex polygon `poly` where `plane·(p, 1) ≥ 0` (Sutherland–Hodgman).
+fn clip_polygon(poly: &[Vec3], plane: Vec4) -> Vec<Vec3> {
+    let f = |p: Vec3| plane.truncate().dot(p) + plane.w;
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for (i, &a) in poly.iter().enumerate() {
+        let b = poly[(i + 1) % poly.len()];
+        let (fa, fb) = (f(a), f(b));
+        if fa >= 0.0 {
+            out.push(a);
+        }
+        if (fa >= 0.0) != (fb >= 0.0) {
+            out.push(a + (b - a) * (fa / (fa - fb)));
+        }
+    }
+    out
+}
+
+/// How one draw is shaded against the reach.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Split {
+    /// The shadowed shader everywhere.
+    Shadowed,
+    /// The unshadowed shader everywhere (no point of the draw can be shadowed).
+    Unshadowed,
+    /// The shadowed shader in `inside`, the unshadowed one in each of `outside` (the rest of
+    /// the draw's screen rectangle; together they hold every pixel once).
+    Both {
+        /// Scissor of the reach's screen rectangle.
+        inside: vk::Rect2D,
+        /// Scissors of the bands around it.
+        outside: Vec<vk::Rect2D>,
+    },
+}
+
+/// How `dr`, seen through `clip_from_world` at `extent`, is drawn against `reach`.
+pub fn split(
+    reach: &ShadowReach,
+    dr: &Draw,
+    clip_from_world: &Mat4,
+    extent: vk::Extent2D,
+) -> Split {
+    let Some(corners) = reach.clip(&dr.world_bounds) else {
+        return Split::Unshadowed;
+    };
+    if dr.index_count / 3 > SPLIT_MAX_TRIANGLES {
+        return Split::Shadowed;
+    }
+    let size = Vec2::new(extent.width as f32, extent.height as f32);
+    let mut min = Vec2::splat(f32::INFINITY);
+    let mut max = Vec2::splat(f32::NEG_INFINITY);
+    for c in corners {
+        let p = *clip_from_world * c.extend(1.0);
+        if p.w <= 1e-6 {
+            // Part of the reach is at or behind the eye: its screen rectangle is unbounded.
+            return Split::Shadowed;
+        }
+        let px = Vec2::new(p.x / p.w * 0.5 + 0.5, 0.5 - p.y / p.w * 0.5) * size;
+        min = min.min(px);
+        max = max.max(px);
+    }
+    // A pixel of slack for rasterisation rules.
+    let inside = PixelRect {
+        min: (min - Vec2::ONE).clamp(Vec2::ZERO, size),
+        max: (max + Vec2::ONE).clamp(Vec2::ZERO, size),
+    }
+    .scissor();
+    let outer = screen_rect(dr, clip_from_world, extent)
+        .map(|r| r.scissor())
+        .unwrap_or(vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent,
+        });
+    let inner = intersect(inside, outer);
+    if inner.extent.width == 0 || inner.extent.height == 0 {
+        return Split::Unshadowed;
+    }
+    if inner == outer {
+        return Split::Shadowed;
+    }
+    Split::Both {
+        inside: inner,
+        outside: bands(outer, inner),
+    }
+}
+
+/// The shader variant of `bits` without shadows: the SHADOWS override and those that mean
+/// nothing without it off (the canonical index of that SPIR-V).
+pub fn unshadowed(bits: usize) -> usize {
+    bits & !(sh::BIT_SHADOWS
+        | sh::BIT_HW_COMPARE
+        | sh::BIT_PCF_BIT0
+        | sh::BIT_PCF_BIT1
+        | sh::BIT_MANY_VIEWS
+        | sh::BIT_SOFT)
+}
+
+fn intersect(a: vk::Rect2D, b: vk::Rect2D) -> vk::Rect2D {
+    let x0 = a.offset.x.max(b.offset.x);
+    let y0 = a.offset.y.max(b.offset.y);
+    let x1 = (a.offset.x + a.extent.width as i32).min(b.offset.x + b.extent.width as i32);
+    let y1 = (a.offset.y + a.extent.height as i32).min(b.offset.y + b.extent.height as i32);
+    rect(x0, y0, x1, y1)
+}
+
+fn rect(x0: i32, y0: i32, x1: i32, y1: i32) -> vk::Rect2D {
+    vk::Rect2D {
+        offset: vk::Offset2D { x: x0, y: y0 },
+        extent: vk::Extent2D {
+            width: (x1 - x0).max(0) as u32,
+            height: (y1 - y0).max(0) as u32,
+        },
+    }
+}
+
+/// `outer` less `inner` (which lies inside it) as up to four rectangles: full-width bands above
+/// and below, and the two sides between them.
+fn bands(outer: vk::Rect2D, inner: vk::Rect2D) -> Vec<vk::Rect2D> {
+    let (ox0, oy0) = (outer.offset.x, outer.offset.y);
+    let (ox1, oy1) = (
+        ox0 + outer.extent.width as i32,
+        oy0 + outer.extent.height as i32,
+    );
+    let (ix0, iy0) = (inner.offset.x, inner.offset.y);
+    let (ix1, iy1) = (
+        ix0 + inner.extent.width as i32,
+        iy0 + inner.extent.height as i32,
+    );
+    [
+        rect(ox0, oy0, ox1, iy0),
+        rect(ox0, iy1, ox1, oy1),
+        rect(ox0, iy0, ix0, iy1),
+        rect(ix1, iy0, ox1, iy1),
+    ]
+    .into_iter()
+    .filter(|r| r.extent.width > 0 && r.extent.height > 0)
+    .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sun straight down (-y), its ortho view ±10 units: x → ndc x, z → ndc y.
+    fn sun_down() -> Mat4 {
+        let view = Mat4::look_to_rh(Vec3::new(0.0, 20.0, 0.0), Vec3::NEG_Y, Vec3::NEG_Z);
+        Mat4::orthographic_rh(-10.0, 10.0, -10.0, 10.0, 0.1, 40.0) * view
+    }
+
+    #[test]
+    fn ground_is_clipped_to_the_casters_columns() {
+        // Casters' rectangle: the middle fifth of a 100-texel map (texels 40..60), 0.2 units
+        // a texel; no offset beyond the slack (1 texel = 0.2 units).
+        let reach = ShadowReach::new(
+            &sun_down(),
+            Vec4::new(40.0, 40.0, 60.0, 60.0),
+            100.0,
+            0.0,
+            0.2,
+            None,
+        );
+        let ground = Aabb::new(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 0.0, 10.0));
+        let c = reach
+            .clip(&ground)
+            .expect("the middle of the ground is in reach");
+        let b = Aabb::from_points(c);
+        // Texels 40..60 are x in [-2, 2], grown by 0.2.
+        assert!(
+            (b.min.x + 2.2).abs() < 1e-4 && (b.max.x - 2.2).abs() < 1e-4,
+            "{b:?}"
+        );
+        assert!(
+            (b.min.z + 2.2).abs() < 1e-4 && (b.max.z - 2.2).abs() < 1e-4,
+            "{b:?}"
+        );
+        // A box off to the side: out of reach.
+        let far = Aabb::new(Vec3::new(5.0, 0.0, 5.0), Vec3::new(6.0, 3.0, 6.0));
+        assert!(reach.clip(&far).is_none());
+        // An empty casters' rectangle reaches nothing.
+        let none = ShadowReach::new(
+            &sun_down(),
+            Vec4::new(1.0, 1.0, -1.0, -1.0),
+            100.0,
+            0.0,
+            0.2,
+            None,
+        );
+        assert!(none.clip(&ground).is_none());
+    }
+
+    #[test]
+    fn spot_apex_inside_the_box_is_kept() {
+        // A spot at the origin looking down -y with a 90° cone; the box holds the light.
+        let view = Mat4::look_to_rh(Vec3::ZERO, Vec3::NEG_Y, Vec3::NEG_Z);
+        let m = Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, 0.1, 50.0) * view;
+        let reach = ShadowReach::new(
+            &m,
+            Vec4::new(0.0, 0.0, 64.0, 64.0),
+            64.0,
+            0.0,
+            0.0,
+            Some(Vec3::ZERO),
+        );
+        let room = Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0));
+        let c = reach.clip(&room).expect("below the light is in reach");
+        let b = Aabb::from_points(c.iter().copied());
+        // The cone below the light: y from the floor up to the apex, |x| up to 5 at the floor.
+        assert!(
+            (b.max.y - 0.0).abs() < 1e-4 && (b.min.y + 5.0).abs() < 1e-4,
+            "{b:?}"
+        );
+        assert!(c.contains(&Vec3::ZERO));
+        // Above the light nothing is lit by it through the map.
+        let attic = Aabb::new(Vec3::new(-5.0, 1.0, -5.0), Vec3::new(5.0, 5.0, 5.0));
+        assert!(reach.clip(&attic).is_none());
+    }
+
+    #[test]
+    fn bands_cover_the_rest_once() {
+        let outer = rect(0, 0, 100, 50);
+        let inner = rect(30, 10, 60, 40);
+        let b = bands(outer, inner);
+        assert_eq!(b.len(), 4);
+        let area = |r: &vk::Rect2D| r.extent.width * r.extent.height;
+        assert_eq!(b.iter().map(area).sum::<u32>() + area(&inner), area(&outer));
+        // Every pixel in exactly one rectangle.
+        for y in 0..50 {
+            for x in 0..100 {
+                let hits = b
+                    .iter()
+                    .chain([&inner])
+                    .filter(|r| {
+                        x >= r.offset.x
+                            && x < r.offset.x + r.extent.width as i32
+                            && y >= r.offset.y
+                            && y < r.offset.y + r.extent.height as i32
+                    })
+                    .count();
+                assert_eq!(hits, 1, "pixel {x},{y}");
+            }
+        }
+        // Touching an edge leaves fewer bands.
+        assert_eq!(bands(outer, rect(0, 0, 60, 50)).len(), 1);
+    }
+
+    #[test]
+    fn unshadowed_variant_clears_the_shadow_bits() {
+        let bits = sh::BIT_SINGLE_LIGHT | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0 | sh::BIT_SOFT;
+        assert_eq!(unshadowed(bits), sh::BIT_SINGLE_LIGHT);
+    }
+}

@@ -1,0 +1,157 @@
+//! Small receivers drawn without the shadow lookup beyond the casters' reach
+//! (`SceneOptions::receiver_split`, on by default on lavapipe) give the image drawn with the
+//! lookup everywhere, pixel for pixel: under a low sun whose shadows fall far from their casters
+//! on screen, under a spot light (a perspective reach with its apex), and in the demo scene.
+//! Validation on.
+
+mod common;
+
+use common::*;
+use glam::{Mat4, Vec3};
+use umbra::render::SceneOptions;
+use umbra::scene::demo::demo_scene;
+use umbra::scene::shapes::{add_object, colored, cuboid, uv_sphere};
+use umbra::scene::{Camera, Light, LightKind, Scene};
+use umbra::{Renderer, View};
+
+fn render(ctx: &TestContext, scene: &Scene, split: bool, view: &View) -> umbra::RenderedFrame {
+    let mut r = Renderer::with_options(
+        ctx,
+        scene,
+        &SceneOptions {
+            receiver_split: Some(split),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    r.render(view, 320, 180).unwrap()
+}
+
+/// Pixels whose colour differs at all between `a` and `b`.
+fn differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
+    a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count()
+}
+
+/// Pixels that `shadows` draws darker than `no_shadows` by over 40 levels in every channel: the
+/// shadows in the picture.
+fn shadowed(shadows: &image::RgbaImage, no_shadows: &image::RgbaImage) -> usize {
+    shadows
+        .pixels()
+        .zip(no_shadows.pixels())
+        .filter(|(p, q)| (0..3).all(|k| p[k] as i32 + 40 < q[k] as i32))
+        .count()
+}
+
+/// `view` without shadows.
+fn unshadowed(view: &View) -> View {
+    let mut v = view.clone();
+    v.shadow.enabled = false;
+    v
+}
+
+/// A 40-unit ground with two posts and a sphere, off to one side of the view.
+fn posts(light: Light) -> Scene {
+    let mut s = ground_scene(40.0, "posts");
+    for (i, x) in [-3.0f32, 2.0].into_iter().enumerate() {
+        add_object(
+            &mut s,
+            &format!("post {i}"),
+            cuboid(Vec3::new(0.25, 2.0, 0.25)),
+            colored(Vec3::new(0.7, 0.3, 0.2), 0.6),
+            Mat4::from_translation(Vec3::new(x, 2.0, -2.0)),
+        );
+    }
+    add_object(
+        &mut s,
+        "sphere",
+        uv_sphere(0.8, 32, 16),
+        colored(Vec3::new(0.2, 0.4, 0.8), 0.4),
+        Mat4::from_translation(Vec3::new(0.0, 0.8, 1.0)),
+    );
+    s.lights.push(light);
+    s
+}
+
+fn view_of_posts() -> View {
+    let mut v = View::new(Camera::look_at(
+        Vec3::new(1.0, 6.0, 12.0),
+        Vec3::new(0.0, 0.5, 0.0),
+        50f32.to_radians(),
+        0.1,
+    ));
+    // One map (the split needs a single shadow view).
+    v.shadow.cascades = 1;
+    v
+}
+
+/// A sun 20° above the horizon, from the side: the posts' shadows run ~11 units across the
+/// ground, far from the posts on screen, so the reach's screen rectangle must follow the light,
+/// not the casters.
+#[test]
+fn low_sun_shadows_unchanged_by_the_split() {
+    let ctx = context();
+    let scene = posts(Light::sun(
+        Light::sun_direction(20f32.to_radians(), std::f32::consts::FRAC_PI_2),
+        3.0,
+    ));
+    let view = view_of_posts();
+    let on = render(&ctx, &scene, true, &view);
+    let off = render(&ctx, &scene, false, &view);
+    save(&on.image, "receivers_low_sun.png");
+    let plain = render(&ctx, &scene, true, &unshadowed(&view));
+    let n = shadowed(&off.image, &plain.image);
+    eprintln!("low sun: {n} shadowed pixels");
+    // Measured: 1,010 shadowed pixels (two posts' and a sphere's shadows).
+    assert!(n > 800, "{n} shadowed pixels");
+    // Measured: 0 pixels differ (beyond the reach the shadowed shader's visibility is exactly 1).
+    let n = differing(&on.image, &off.image);
+    assert_eq!(n, 0, "{n} pixels differ");
+    assert_eq!(on.stats.unshadowed_draws, 1, "the ground is split");
+    assert_eq!(off.stats.unshadowed_draws, 0);
+    assert_validation_clean(&ctx);
+}
+
+/// A spot light above the scene: the reach is a frustum from the light; the ground beyond the
+/// casters' rectangle in its view is drawn unshadowed, the image unchanged.
+#[test]
+fn spot_light_shadows_unchanged_by_the_split() {
+    let ctx = context();
+    let spot = Light {
+        kind: LightKind::Spot {
+            inner: 35f32.to_radians(),
+            outer: 45f32.to_radians(),
+        },
+        position: Vec3::new(-2.0, 7.0, 3.0),
+        direction: Vec3::new(0.3, -1.0, -0.6).normalize(),
+        intensity: 150.0,
+        ..Light::sun(Vec3::NEG_Y, 1.0)
+    };
+    let scene = posts(spot);
+    let view = view_of_posts();
+    let on = render(&ctx, &scene, true, &view);
+    let off = render(&ctx, &scene, false, &view);
+    save(&on.image, "receivers_spot.png");
+    let plain = render(&ctx, &scene, true, &unshadowed(&view));
+    let n = shadowed(&off.image, &plain.image);
+    eprintln!("spot: {n} shadowed pixels");
+    // Measured: 621 shadowed pixels.
+    assert!(n > 500, "{n} shadowed pixels");
+    let n = differing(&on.image, &off.image);
+    assert_eq!(n, 0, "{n} pixels differ");
+    assert_eq!(on.stats.unshadowed_draws, 1, "the ground is split");
+    assert_validation_clean(&ctx);
+}
+
+/// The demo scene: its ground is split, its image unchanged.
+#[test]
+fn demo_unchanged_by_the_split() {
+    let ctx = context();
+    let scene = demo_scene();
+    let view = View::new(scene.cameras[0]);
+    let on = render(&ctx, &scene, true, &view);
+    let off = render(&ctx, &scene, false, &view);
+    let n = differing(&on.image, &off.image);
+    assert_eq!(n, 0, "{n} pixels differ");
+    assert_eq!(on.stats.unshadowed_draws, 1, "the ground is split");
+    assert_validation_clean(&ctx);
+}
