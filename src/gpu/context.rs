@@ -85,7 +85,7 @@ pub struct ContextDesc {
     /// between frames: raises glibc's `M_TRIM_THRESHOLD` to 64 MiB and fixes `M_MMAP_THRESHOLD`
     /// at 32 MiB, process-wide, once (`mallopt`). Without it llvmpipe returns its memory to the
     /// kernel at the end of every frame and faults it back in on the next (a FlightHelmet frame
-    /// at 128×72: 33 → 23 ms). The cost: up to 64 MiB of freed memory kept per malloc arena.
+    /// at 128×72: 29–36 → 21–23 ms). The cost: up to 64 MiB of freed memory kept per malloc arena.
     /// Default true; false leaves the allocator as the process set it.
     pub keep_driver_heap: bool,
 }
