@@ -385,10 +385,7 @@ impl CameraPass {
         }
         let color_att = [color_att];
         let mut rendering = vk::RenderingInfo::default()
-            .render_area(vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent,
-            })
+            .render_area(full_rect(extent))
             .layer_count(1)
             .color_attachments(&color_att)
             .depth_attachment(&depth_att);
@@ -517,10 +514,7 @@ impl CameraPass {
             .collect();
         let depth_att = depth_clear_attachment(depth, true);
         let rendering = vk::RenderingInfo::default()
-            .render_area(vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent,
-            })
+            .render_area(full_rect(extent))
             .layer_count(1)
             .color_attachments(&targets)
             .depth_attachment(&depth_att)

@@ -20,7 +20,7 @@ use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{allocate_sets, scene as sh, ReflectedBinding};
 use crate::gpu::Image;
 use ash::vk;
-use glam::{Mat4, Vec2};
+use glam::{Mat4, Vec2, Vec3};
 use std::sync::Arc;
 
 /// A draw is deferred when its triangles' estimated mean area on screen (`pixels_per_triangle`)
@@ -80,10 +80,20 @@ impl PixelRect {
 /// The pixels of an `extent` image that `dr`'s world bounds project to (clamped to the image);
 /// `None` when a corner lies behind the eye (the rectangle would be unbounded).
 pub fn screen_rect(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> Option<PixelRect> {
+    points_rect(dr.world_bounds.corners(), clip_from_world, extent)
+}
+
+/// The pixels of an `extent` image that world points `points` project to (clamped to the
+/// image); `None` when one lies at or behind the eye.
+pub fn points_rect(
+    points: impl IntoIterator<Item = Vec3>,
+    clip_from_world: &Mat4,
+    extent: vk::Extent2D,
+) -> Option<PixelRect> {
     let size = Vec2::new(extent.width as f32, extent.height as f32);
     let mut min = Vec2::splat(f32::INFINITY);
     let mut max = Vec2::splat(f32::NEG_INFINITY);
-    for c in dr.world_bounds.corners() {
+    for c in points {
         let p = *clip_from_world * c.extend(1.0);
         if p.w <= 1e-6 {
             return None;

@@ -14,7 +14,7 @@
 //! Only frames with one shadow view use it (a single map of a directional light or a spot
 //! light's; cascades and cube faces keep the shadowed shader everywhere).
 
-use super::deferred::{screen_rect, PixelRect};
+use super::deferred::{points_rect, screen_rect, PixelRect};
 use super::gpu_scene::Draw;
 use crate::gpu::shaders::scene as sh;
 use crate::math::Aabb;
@@ -190,31 +190,20 @@ pub fn split(
     if dr.index_count / 3 > SPLIT_MAX_TRIANGLES {
         return Split::Shadowed;
     }
-    let size = Vec2::new(extent.width as f32, extent.height as f32);
-    let mut min = Vec2::splat(f32::INFINITY);
-    let mut max = Vec2::splat(f32::NEG_INFINITY);
-    for c in corners {
-        let p = *clip_from_world * c.extend(1.0);
-        if p.w <= 1e-6 {
-            // Part of the reach is at or behind the eye: its screen rectangle is unbounded.
-            return Split::Shadowed;
-        }
-        let px = Vec2::new(p.x / p.w * 0.5 + 0.5, 0.5 - p.y / p.w * 0.5) * size;
-        min = min.min(px);
-        max = max.max(px);
-    }
+    // Part of the reach at or behind the eye: its screen rectangle is unbounded.
+    let Some(r) = points_rect(corners, clip_from_world, extent) else {
+        return Split::Shadowed;
+    };
     // A pixel of slack for rasterisation rules.
+    let size = Vec2::new(extent.width as f32, extent.height as f32);
     let inside = PixelRect {
-        min: (min - Vec2::ONE).clamp(Vec2::ZERO, size),
-        max: (max + Vec2::ONE).clamp(Vec2::ZERO, size),
+        min: (r.min - Vec2::ONE).max(Vec2::ZERO),
+        max: (r.max + Vec2::ONE).min(size),
     }
     .scissor();
     let outer = screen_rect(dr, clip_from_world, extent)
         .map(|r| r.scissor())
-        .unwrap_or(vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent,
-        });
+        .unwrap_or(rect(0, 0, extent.width as i32, extent.height as i32));
     let inner = intersect(inside, outer);
     if inner.extent.width == 0 || inner.extent.height == 0 {
         return Split::Unshadowed;
