@@ -14,16 +14,11 @@ use umbra::scene::{Camera, Light, LightKind, Material, Scene, Texture, TextureRe
 use umbra::{Renderer, View};
 
 fn render(ctx: &TestContext, scene: &Scene, deferred: bool, view: &View) -> umbra::RenderedFrame {
-    let mut r = Renderer::with_options(
-        ctx,
-        scene,
-        &SceneOptions {
-            deferred: Some(deferred),
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    r.render(view, 320, 180).unwrap()
+    let options = SceneOptions {
+        deferred: Some(deferred),
+        ..Default::default()
+    };
+    render_with(ctx, scene, &options, view, (320, 180))
 }
 
 /// (largest channel difference, pixels differing by more than 2 levels).

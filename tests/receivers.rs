@@ -12,19 +12,14 @@ use umbra::render::SceneOptions;
 use umbra::scene::demo::demo_scene;
 use umbra::scene::shapes::{add_object, colored, cuboid, uv_sphere};
 use umbra::scene::{Camera, Light, LightKind, Scene};
-use umbra::{Renderer, View};
+use umbra::View;
 
 fn render(ctx: &TestContext, scene: &Scene, split: bool, view: &View) -> umbra::RenderedFrame {
-    let mut r = Renderer::with_options(
-        ctx,
-        scene,
-        &SceneOptions {
-            receiver_split: Some(split),
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    r.render(view, 320, 180).unwrap()
+    let options = SceneOptions {
+        receiver_split: Some(split),
+        ..Default::default()
+    };
+    render_with(ctx, scene, &options, view, (320, 180))
 }
 
 /// Pixels whose colour differs at all between `a` and `b`.

@@ -413,6 +413,7 @@ impl CameraPass {
                     let split = cull.shadow_reach.as_ref().map_or(Split::Shadowed, |r| {
                         receivers::split(r, dr, &cull.clip_from_world, extent)
                     });
+                    unshadowed += usize::from(split != Split::Shadowed);
                     // (variant, scissor) of each piece; None: the whole image.
                     let pieces: Vec<(usize, Option<vk::Rect2D>)> = match split {
                         Split::Shadowed => vec![(bits, None)],
@@ -426,7 +427,6 @@ impl CameraPass {
                             .collect(),
                     };
                     drawn += 1;
-                    unshadowed += usize::from(pieces.iter().any(|p| p.0 != bits));
                     if dr.material != bound_material {
                         d.cmd_bind_descriptor_sets(
                             cmd,

@@ -58,6 +58,17 @@ impl ShadowReach {
         texel_world: f32,
         apex: Option<Vec3>,
     ) -> Self {
+        let never = Vec4::new(0.0, 0.0, 0.0, -1.0);
+        let with = |planes| Self {
+            planes,
+            apex,
+            offset_texels: offset_texels.max(0.0) + SLACK_TEXELS,
+            texel_world,
+        };
+        if !(lookup.x <= lookup.z && lookup.y <= lookup.w) {
+            // An empty casters' rectangle: every lookup is lit.
+            return with(vec![never]);
+        }
         let m = light_clip_from_world;
         let (rx, ry, rw) = (m.row(0), m.row(1), m.row(3));
         // Texel u = (ndc.x / 2 + 1/2)·size, v = (1/2 − ndc.y / 2)·size; with w > 0:
@@ -74,26 +85,19 @@ impl ShadowReach {
             // A lookup at or behind the light's plane is lit.
             raw.push(rw);
         }
-        let empty = !(lookup.x <= lookup.z && lookup.y <= lookup.w);
-        let mut planes = Vec::new();
-        for p in raw {
-            let n = p.truncate().length();
-            if n > 1e-12 {
-                planes.push(p / n);
-            } else if p.w < 0.0 {
-                // Constant and negative: nothing satisfies it.
-                planes.push(Vec4::new(0.0, 0.0, 0.0, -1.0));
-            }
-        }
-        if empty {
-            planes = vec![Vec4::new(0.0, 0.0, 0.0, -1.0)];
-        }
-        Self {
-            planes,
-            apex,
-            offset_texels: offset_texels.max(0.0) + SLACK_TEXELS,
-            texel_world,
-        }
+        // Unit normals; a constant row (an orthographic w) holds everywhere or nowhere.
+        let planes = raw
+            .into_iter()
+            .filter_map(|p| {
+                let n = p.truncate().length();
+                if n > 1e-12 {
+                    Some(p / n)
+                } else {
+                    (p.w < 0.0).then_some(never)
+                }
+            })
+            .collect();
+        with(planes)
     }
 
     /// The corners of the part of `bounds` whose points may have a lookup that reads a caster

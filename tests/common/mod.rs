@@ -61,6 +61,18 @@ pub fn context() -> TestContext {
     }
 }
 
+/// `view` of `scene` rendered at `w`×`h` by a fresh renderer made with `options`.
+pub fn render_with(
+    ctx: &std::sync::Arc<Context>,
+    scene: &umbra::scene::Scene,
+    options: &umbra::render::SceneOptions,
+    view: &umbra::View,
+    (w, h): (u32, u32),
+) -> umbra::RenderedFrame {
+    let mut r = umbra::Renderer::with_options(ctx, scene, options).unwrap();
+    r.render(view, w, h).unwrap()
+}
+
 /// Fails the test if the validation layer reported any warning or error.
 pub fn assert_validation_clean(ctx: &Context) {
     assert!(ctx.validation_enabled, "validation layer not enabled");
