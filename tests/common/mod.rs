@@ -50,9 +50,14 @@ impl Drop for TestContext {
 /// A context with the Khronos validation layer (synchronization validation on). Fails if the
 /// layer is missing: GPU tests never run unvalidated.
 pub fn context() -> TestContext {
+    context_with(ContextDesc::default())
+}
+
+/// `context()` from `desc` (its validation made `Required`).
+pub fn context_with(desc: ContextDesc) -> TestContext {
     let ctx = Context::new(&ContextDesc {
         validation: Validation::Required,
-        ..Default::default()
+        ..desc
     })
     .unwrap_or_else(|e| panic!("cannot create a validated Vulkan context: {e}"));
     TestContext {
