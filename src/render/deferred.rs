@@ -24,15 +24,23 @@ use glam::{Mat4, Vec2, Vec3};
 use std::sync::Arc;
 
 /// A draw is deferred when its triangles' estimated mean area on screen (`pixels_per_triangle`)
-/// is below this many pixels. Chosen by a sweep (README, *Speed*): at 2, 4, 8 and 16 the camera
-/// pass of FlightHelmet + ground took 38.6, 38.7, 39.7 and 42.1 ms (45.8 deferring nothing), the
-/// double-sided scene's 23.5, 22.2, 25.2 and 26.1 ms (24.0).
-pub const DEFER_BELOW_PIXELS: f32 = 4.0;
+/// is below this many pixels. Chosen by a sweep (README, *Speed*, session 15): at 4, 8, 12 and
+/// 16 FlightHelmet + ground took 46.9, 43.0, 39.6 and 40.0 ms a frame (its helmet draws are
+/// 1.4, 1.6, 5.2, 5.9 and 9.5 pixels a triangle: even at 9.5 a triangle touches about twice the
+/// lanes it keeps). Session 13's sweep had found 4 best (8: +1.0 ms, 16: +3.4 ms), before
+/// session 14 stopped llvmpipe's memory being paged out and in again every frame.
+pub const DEFER_BELOW_PIXELS: f32 = 16.0;
 
 /// Draws of fewer triangles stay forward: a small draw saves little shading and would still
 /// cost its material a resolve (not measured finely; every benchmark draw that defers has
 /// over 1,000 triangles).
 pub const DEFER_MIN_TRIANGLES: u32 = 256;
+
+/// A frame defers nothing unless its candidates hold at least this many triangles: the
+/// G-buffer pass and the resolves cost about a millisecond whatever they hold (the demo's one
+/// candidate, 2,208 triangles of 11 pixels, made its frame 1.0–1.8 ms slower deferred; four
+/// spheres of 1,200 triangles, 9–12 pixels each, came out even; nine, of 5–7, 0.3 ms faster).
+pub const DEFER_MIN_FRAME_TRIANGLES: u32 = 4096;
 
 /// Format of the G-buffer targets (`GBuffer` in scene.wgsl: 32-bit depth and texture
 /// coordinates, packed directions and derivatives).
@@ -163,7 +171,8 @@ pub struct DeferPlan<'a> {
 }
 
 /// Splits `order` (the camera pass's draw order) for `cull`'s frame at `extent`; with `enabled`
-/// false (or a debug view) everything is forward. The viewer's highlighted draw stays forward
+/// false (or a debug view), or candidates of fewer than `DEFER_MIN_FRAME_TRIANGLES` triangles in
+/// all, everything is forward. The viewer's highlighted draw stays forward
 /// (its tint is a forward-shader immediate), and materials past the 255th deferred one too.
 pub fn plan<'a>(
     order: Vec<&'a Draw>,
@@ -176,11 +185,23 @@ pub fn plan<'a>(
         resolved: Vec::new(),
         forward: Vec::new(),
     };
-    for dr in order {
-        let micro = (enabled && cull.debug_view.is_none() && cull.highlight != Some(dr.source))
-            .then(|| is_micro(dr, &cull.clip_from_world, extent))
-            .flatten();
-        let Some(rect) = micro else {
+    let micro: Vec<Option<PixelRect>> = order
+        .iter()
+        .map(|dr| {
+            (enabled && cull.debug_view.is_none() && cull.highlight != Some(dr.source))
+                .then(|| is_micro(dr, &cull.clip_from_world, extent))
+                .flatten()
+        })
+        .collect();
+    let candidates: u32 = order
+        .iter()
+        .zip(&micro)
+        .filter(|(_, m)| m.is_some())
+        .map(|(dr, _)| dr.index_count / 3)
+        .sum();
+    let worth_a_pass = candidates >= DEFER_MIN_FRAME_TRIANGLES;
+    for (dr, micro) in order.into_iter().zip(micro) {
+        let Some(rect) = micro.filter(|_| worth_a_pass) else {
             p.forward.push(dr);
             continue;
         };
@@ -385,12 +406,12 @@ mod tests {
     fn plan_marks_each_deferred_material_once_and_keeps_the_rest_forward() {
         let (mut c, extent) = cull();
         let draws = [
-            draw(3, 1000, 0.01, Vec3::new(-1.0, 0.0, -10.0)),
+            draw(3, 2500, 0.01, Vec3::new(-1.0, 0.0, -10.0)),
             Draw {
                 source: (3, 1),
-                ..draw(3, 1000, 0.01, Vec3::new(1.0, 0.0, -10.0))
+                ..draw(3, 2500, 0.01, Vec3::new(1.0, 0.0, -10.0))
             },
-            draw(5, 1000, 0.01, Vec3::new(0.0, 1.0, -10.0)),
+            draw(5, 2500, 0.01, Vec3::new(0.0, 1.0, -10.0)),
             // Large triangles, too few triangles, not deferrable: forward.
             draw(6, 1000, 10.0, Vec3::new(0.0, -1.0, -10.0)),
             draw(7, 100, 0.01, Vec3::new(0.0, -2.0, -10.0)),
@@ -424,5 +445,26 @@ mod tests {
         assert!(plan(draws.iter().collect(), &c, extent, true)
             .deferred
             .is_empty());
+    }
+
+    #[test]
+    fn a_frame_with_few_candidate_triangles_defers_nothing() {
+        let (c, extent) = cull();
+        // Two candidates of 2,000 triangles: under DEFER_MIN_FRAME_TRIANGLES, both forward, in
+        // order; a third makes 6,000 and all three defer.
+        let draws = [
+            draw(1, 2000, 0.01, Vec3::new(-1.0, 0.0, -10.0)),
+            draw(2, 1000, 10.0, Vec3::new(0.0, -1.0, -10.0)),
+            draw(3, 2000, 0.01, Vec3::new(1.0, 0.0, -10.0)),
+            draw(4, 2000, 0.01, Vec3::new(0.0, 1.0, -10.0)),
+        ];
+        let p = plan(draws[..3].iter().collect(), &c, extent, true);
+        assert!(p.deferred.is_empty() && p.resolved.is_empty());
+        let forward: Vec<usize> = p.forward.iter().map(|d| d.material).collect();
+        assert_eq!(forward, [1, 2, 3]);
+        let p = plan(draws.iter().collect(), &c, extent, true);
+        let deferred: Vec<usize> = p.deferred.iter().map(|(d, _)| d.material).collect();
+        assert_eq!(deferred, [1, 3, 4]);
+        assert_eq!(p.forward.len(), 1);
     }
 }
