@@ -38,8 +38,9 @@ pub const DEFER_MIN_TRIANGLES: u32 = 256;
 
 /// A frame defers nothing unless its candidates hold at least this many triangles: the
 /// G-buffer pass and the resolves cost about a millisecond whatever they hold (the demo's one
-/// candidate, 2,208 triangles of 11 pixels, made its frame 1.0–1.8 ms slower deferred; four
-/// spheres of 1,200 triangles, 9–12 pixels each, came out even; nine, of 5–7, 0.3 ms faster).
+/// candidate, 2,208 triangles of 11 pixels, made its frame 1.1–2.0 ms slower deferred, three
+/// rounds; `--synthetic spheres:2`, four spheres of 1,200 triangles of 9–12 pixels, came out
+/// even; `spheres:3`, nine of 5–7 pixels, 0.5 ms faster).
 pub const DEFER_MIN_FRAME_TRIANGLES: u32 = 4096;
 
 /// Format of the G-buffer targets (`GBuffer` in scene.wgsl: 32-bit depth and texture
@@ -132,18 +133,44 @@ pub fn pixels_per_triangle(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent
     0.5 * dr.mean_area * px_per_unit * px_per_unit
 }
 
-/// Where `dr` is on screen if it is shaded deferred in a frame seen through `clip_from_world`
-/// at `extent`: deferrable, at least `DEFER_MIN_TRIANGLES`, triangles under
-/// `DEFER_BELOW_PIXELS` each, and wholly in front of the eye.
-pub fn is_micro(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> Option<PixelRect> {
+/// Where `dr` is on screen, and its pixels per triangle, if it is shaded deferred in a frame
+/// seen through `clip_from_world` at `extent`: deferrable, at least `DEFER_MIN_TRIANGLES`,
+/// triangles under `DEFER_BELOW_PIXELS` each, and wholly in front of the eye.
+fn is_micro(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> Option<(PixelRect, f32)> {
     let triangles = dr.index_count / 3;
     if !dr.deferrable || dr.alpha != AlphaDraw::Opaque || triangles < DEFER_MIN_TRIANGLES {
         return None;
     }
-    if pixels_per_triangle(dr, clip_from_world, extent) >= DEFER_BELOW_PIXELS {
+    let ppt = pixels_per_triangle(dr, clip_from_world, extent);
+    if ppt >= DEFER_BELOW_PIXELS {
         return None;
     }
-    screen_rect(dr, clip_from_world, extent)
+    Some((screen_rect(dr, clip_from_world, extent)?, ppt))
+}
+
+/// With candidates of more materials than stencil marks, the `MAX_MARKS` materials whose
+/// smallest triangles are smallest (they waste the most of llvmpipe's shading blocks) keep
+/// theirs; the others' draws stay forward.
+fn keep_smallest_materials(order: &[&Draw], micro: &mut [Option<(PixelRect, f32)>]) {
+    let mut smallest: Vec<(usize, f32)> = Vec::new();
+    for (dr, m) in order.iter().zip(micro.iter()) {
+        let Some((_, ppt)) = m else { continue };
+        match smallest.iter_mut().find(|(mat, _)| *mat == dr.material) {
+            Some(e) => e.1 = e.1.min(*ppt),
+            None => smallest.push((dr.material, *ppt)),
+        }
+    }
+    if smallest.len() <= MAX_MARKS {
+        return;
+    }
+    smallest.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let kept: std::collections::HashSet<usize> =
+        smallest[..MAX_MARKS].iter().map(|e| e.0).collect();
+    for (dr, m) in order.iter().zip(micro.iter_mut()) {
+        if !kept.contains(&dr.material) {
+            *m = None;
+        }
+    }
 }
 
 /// One material resolved full-screen: its index, stencil mark, shader variant bits and the
@@ -173,7 +200,8 @@ pub struct DeferPlan<'a> {
 /// Splits `order` (the camera pass's draw order) for `cull`'s frame at `extent`; with `enabled`
 /// false (or a debug view), or candidates of fewer than `DEFER_MIN_FRAME_TRIANGLES` triangles in
 /// all, everything is forward. The viewer's highlighted draw stays forward
-/// (its tint is a forward-shader immediate), and materials past the 255th deferred one too.
+/// (its tint is a forward-shader immediate), and past 255 candidate materials those of larger
+/// triangles too (`keep_smallest_materials`).
 pub fn plan<'a>(
     order: Vec<&'a Draw>,
     cull: &CameraCull,
@@ -185,7 +213,7 @@ pub fn plan<'a>(
         resolved: Vec::new(),
         forward: Vec::new(),
     };
-    let micro: Vec<Option<PixelRect>> = order
+    let mut micro: Vec<Option<(PixelRect, f32)>> = order
         .iter()
         .map(|dr| {
             (enabled && cull.debug_view.is_none() && cull.highlight != Some(dr.source))
@@ -193,6 +221,7 @@ pub fn plan<'a>(
                 .flatten()
         })
         .collect();
+    keep_smallest_materials(&order, &mut micro);
     let candidates: u32 = order
         .iter()
         .zip(&micro)
@@ -201,7 +230,7 @@ pub fn plan<'a>(
         .sum();
     let worth_a_pass = candidates >= DEFER_MIN_FRAME_TRIANGLES;
     for (dr, micro) in order.into_iter().zip(micro) {
-        let Some(rect) = micro.filter(|_| worth_a_pass) else {
+        let Some((rect, _)) = micro.filter(|_| worth_a_pass) else {
             p.forward.push(dr);
             continue;
         };
@@ -212,7 +241,7 @@ pub fn plan<'a>(
                 r.rect = r.rect.union(rect);
                 r.mark
             }
-            None if p.resolved.len() < MAX_MARKS => {
+            None => {
                 let mark = p.resolved.len() as u32 + 1;
                 p.resolved.push(Resolved {
                     material: dr.material,
@@ -221,10 +250,6 @@ pub fn plan<'a>(
                     rect,
                 });
                 mark
-            }
-            None => {
-                p.forward.push(dr);
-                continue;
             }
         };
         p.deferred.push((dr, mark));
@@ -466,5 +491,30 @@ mod tests {
         let deferred: Vec<usize> = p.deferred.iter().map(|(d, _)| d.material).collect();
         assert_eq!(deferred, [1, 3, 4]);
         assert_eq!(p.forward.len(), 1);
+    }
+
+    #[test]
+    fn past_255_materials_those_of_the_smallest_triangles_defer() {
+        let (c, extent) = cull();
+        // 300 materials, one draw each, triangles growing with the index (all under
+        // DEFER_BELOW_PIXELS); the last one's are the smallest of all.
+        let draws: Vec<Draw> = (0..300)
+            .map(|i| {
+                let area = if i == 299 {
+                    0.001
+                } else {
+                    0.01 + 0.0001 * i as f32
+                };
+                draw(i, 1000, area, Vec3::new(0.0, 0.0, -10.0))
+            })
+            .collect();
+        let p = plan(draws.iter().collect(), &c, extent, true);
+        assert_eq!(p.resolved.len(), MAX_MARKS);
+        let deferred: Vec<usize> = p.deferred.iter().map(|(d, _)| d.material).collect();
+        let mut expected: Vec<usize> = (0..254).collect();
+        expected.push(299);
+        assert_eq!(deferred, expected);
+        let forward: Vec<usize> = p.forward.iter().map(|d| d.material).collect();
+        assert_eq!(forward, (254..299).collect::<Vec<_>>());
     }
 }
