@@ -148,24 +148,27 @@ fn is_micro(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> Option<(
     Some((screen_rect(dr, clip_from_world, extent)?, ppt))
 }
 
-/// With candidates of more materials than stencil marks, the `MAX_MARKS` materials whose
-/// smallest triangles are smallest (they waste the most of llvmpipe's shading blocks) keep
-/// theirs; the others' draws stay forward.
-fn keep_smallest_materials(order: &[&Draw], micro: &mut [Option<(PixelRect, f32)>]) {
-    let mut smallest: Vec<(usize, f32)> = Vec::new();
+/// With candidates of more materials than stencil marks, the `MAX_MARKS` materials whose draws
+/// cover the most pixels (triangles × pixels per triangle, summed) keep theirs; the others'
+/// draws stay forward. On the 32×32 sphere grid (1,024 materials, triangles of 0.09–0.29
+/// pixels) keeping the nearest spheres' measured 103–107 ms camera pass against 109–111 ms for
+/// the farthest (smallest triangles): a sub-pixel triangle that holds no pixel centre costs no
+/// shading at all.
+fn keep_largest_materials(order: &[&Draw], micro: &mut [Option<(PixelRect, f32)>]) {
+    let mut pixels: Vec<(usize, f32)> = Vec::new();
     for (dr, m) in order.iter().zip(micro.iter()) {
         let Some((_, ppt)) = m else { continue };
-        match smallest.iter_mut().find(|(mat, _)| *mat == dr.material) {
-            Some(e) => e.1 = e.1.min(*ppt),
-            None => smallest.push((dr.material, *ppt)),
+        let covered = (dr.index_count / 3) as f32 * ppt;
+        match pixels.iter_mut().find(|(mat, _)| *mat == dr.material) {
+            Some(e) => e.1 += covered,
+            None => pixels.push((dr.material, covered)),
         }
     }
-    if smallest.len() <= MAX_MARKS {
+    if pixels.len() <= MAX_MARKS {
         return;
     }
-    smallest.sort_by(|a, b| a.1.total_cmp(&b.1));
-    let kept: std::collections::HashSet<usize> =
-        smallest[..MAX_MARKS].iter().map(|e| e.0).collect();
+    pixels.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let kept: std::collections::HashSet<usize> = pixels[..MAX_MARKS].iter().map(|e| e.0).collect();
     for (dr, m) in order.iter().zip(micro.iter_mut()) {
         if !kept.contains(&dr.material) {
             *m = None;
@@ -200,8 +203,8 @@ pub struct DeferPlan<'a> {
 /// Splits `order` (the camera pass's draw order) for `cull`'s frame at `extent`; with `enabled`
 /// false (or a debug view), or candidates of fewer than `DEFER_MIN_FRAME_TRIANGLES` triangles in
 /// all, everything is forward. The viewer's highlighted draw stays forward
-/// (its tint is a forward-shader immediate), and past 255 candidate materials those of larger
-/// triangles too (`keep_smallest_materials`).
+/// (its tint is a forward-shader immediate), and past 255 candidate materials those covering
+/// the fewest pixels too (`keep_largest_materials`).
 pub fn plan<'a>(
     order: Vec<&'a Draw>,
     cull: &CameraCull,
@@ -221,7 +224,7 @@ pub fn plan<'a>(
                 .flatten()
         })
         .collect();
-    keep_smallest_materials(&order, &mut micro);
+    keep_largest_materials(&order, &mut micro);
     let candidates: u32 = order
         .iter()
         .zip(&micro)
@@ -494,16 +497,16 @@ mod tests {
     }
 
     #[test]
-    fn past_255_materials_those_of_the_smallest_triangles_defer() {
+    fn past_255_materials_those_covering_the_most_pixels_defer() {
         let (c, extent) = cull();
-        // 300 materials, one draw each, triangles growing with the index (all under
-        // DEFER_BELOW_PIXELS); the last one's are the smallest of all.
+        // 300 materials, one draw each, triangles shrinking with the index (all under
+        // DEFER_BELOW_PIXELS); the last one's are the largest of all.
         let draws: Vec<Draw> = (0..300)
             .map(|i| {
                 let area = if i == 299 {
-                    0.001
+                    0.1
                 } else {
-                    0.01 + 0.0001 * i as f32
+                    0.05 - 0.0001 * i as f32
                 };
                 draw(i, 1000, area, Vec3::new(0.0, 0.0, -10.0))
             })
