@@ -21,6 +21,7 @@ use crate::gpu::shaders::{allocate_sets, scene as sh, ReflectedBinding};
 use crate::gpu::Image;
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
 /// A draw is deferred when its triangles' estimated mean area on screen (`pixels_per_triangle`)
@@ -155,20 +156,19 @@ fn is_micro(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> Option<(
 /// the farthest (smallest triangles): a sub-pixel triangle that holds no pixel centre costs no
 /// shading at all.
 fn keep_largest_materials(order: &[&Draw], micro: &mut [Option<(PixelRect, f32)>]) {
-    let mut pixels: Vec<(usize, f32)> = Vec::new();
+    let mut covered: HashMap<usize, f32> = HashMap::new();
     for (dr, m) in order.iter().zip(micro.iter()) {
-        let Some((_, ppt)) = m else { continue };
-        let covered = (dr.index_count / 3) as f32 * ppt;
-        match pixels.iter_mut().find(|(mat, _)| *mat == dr.material) {
-            Some(e) => e.1 += covered,
-            None => pixels.push((dr.material, covered)),
+        if let Some((_, ppt)) = m {
+            *covered.entry(dr.material).or_default() += (dr.index_count / 3) as f32 * ppt;
         }
     }
-    if pixels.len() <= MAX_MARKS {
+    if covered.len() <= MAX_MARKS {
         return;
     }
-    pixels.sort_by(|a, b| b.1.total_cmp(&a.1));
-    let kept: std::collections::HashSet<usize> = pixels[..MAX_MARKS].iter().map(|e| e.0).collect();
+    let mut pixels: Vec<(usize, f32)> = covered.into_iter().collect();
+    // Ties (and the hash map's order) broken by material index, so the choice is deterministic.
+    pixels.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    let kept: HashSet<usize> = pixels[..MAX_MARKS].iter().map(|e| e.0).collect();
     for (dr, m) in order.iter().zip(micro.iter_mut()) {
         if !kept.contains(&dr.material) {
             *m = None;
@@ -202,9 +202,9 @@ pub struct DeferPlan<'a> {
 
 /// Splits `order` (the camera pass's draw order) for `cull`'s frame at `extent`; with `enabled`
 /// false (or a debug view), or candidates of fewer than `DEFER_MIN_FRAME_TRIANGLES` triangles in
-/// all, everything is forward. The viewer's highlighted draw stays forward
-/// (its tint is a forward-shader immediate), and past 255 candidate materials those covering
-/// the fewest pixels too (`keep_largest_materials`).
+/// all, everything is forward. The viewer's highlighted draw stays forward (its tint is a
+/// forward-shader immediate), and past 255 candidate materials those covering the fewest
+/// pixels too (`keep_largest_materials`).
 pub fn plan<'a>(
     order: Vec<&'a Draw>,
     cull: &CameraCull,
