@@ -137,19 +137,23 @@ fn micro_scene() -> Scene {
     s
 }
 
+/// The micro scene's view: the four spheres and the ground from above and in front.
+fn micro_view() -> View {
+    View::new(Camera::look_at(
+        Vec3::new(0.0, 2.0, 5.0),
+        Vec3::new(0.0, 0.4, 0.0),
+        45f32.to_radians(),
+        0.1,
+    ))
+}
+
 /// The spheres' triangles cover well under a pixel at 320×180, so they are deferred (and the
 /// vertex-coloured sphere and the ground are not); the image is the forward pass's.
 #[test]
 fn deferred_micro_triangles_give_the_forward_image() {
     let ctx = context();
     let scene = micro_scene();
-    let cam = Camera::look_at(
-        Vec3::new(0.0, 2.0, 5.0),
-        Vec3::new(0.0, 0.4, 0.0),
-        45f32.to_radians(),
-        0.1,
-    );
-    let view = View::new(cam);
+    let view = micro_view();
     let on = render(&ctx, &scene, true, &view);
     let off = render(&ctx, &scene, false, &view);
     save(&on.image, "deferred_micro.png");
@@ -182,13 +186,7 @@ fn deferred_micro_triangles_give_the_forward_image() {
 fn deferred_few_pixel_triangles_give_the_forward_image() {
     let ctx = context();
     let scene = micro_scene();
-    let cam = Camera::look_at(
-        Vec3::new(0.0, 2.0, 5.0),
-        Vec3::new(0.0, 0.4, 0.0),
-        45f32.to_radians(),
-        0.1,
-    );
-    let view = View::new(cam);
+    let view = micro_view();
     let on = render_at(&ctx, &scene, true, &view, (1280, 720));
     let off = render_at(&ctx, &scene, false, &view, (1280, 720));
     save(&on.image, "deferred_few_pixels.png");
@@ -238,12 +236,7 @@ fn deferred_double_sided_scene_matches_forward() {
 fn deferred_frames_do_not_depend_on_the_previous_frame() {
     let ctx = context();
     let scene = micro_scene();
-    let target = View::new(Camera::look_at(
-        Vec3::new(0.0, 2.0, 5.0),
-        Vec3::new(0.0, 0.4, 0.0),
-        45f32.to_radians(),
-        0.1,
-    ));
+    let target = micro_view();
     let other = View::new(Camera::look_at(
         Vec3::new(1.5, 1.0, 3.0),
         Vec3::new(0.0, 0.5, 0.0),
