@@ -147,17 +147,16 @@ fn micro_view() -> View {
     ))
 }
 
-/// The spheres' triangles cover well under a pixel at 320×180, so they are deferred (and the
-/// vertex-coloured sphere and the ground are not); the image is the forward pass's.
-#[test]
-fn deferred_micro_triangles_give_the_forward_image() {
-    let ctx = context();
+/// The micro scene's view at `size`, deferred and forward (saved as `name`.png and
+/// `name`_forward.png): exactly the three textured spheres deferred, nothing forward, the same
+/// draws; returns (largest channel difference, pixels differing by more than 2 levels).
+fn micro_deferred_against_forward(ctx: &TestContext, size: (u32, u32), name: &str) -> (u8, usize) {
     let scene = micro_scene();
     let view = micro_view();
-    let on = render(&ctx, &scene, true, &view);
-    let off = render(&ctx, &scene, false, &view);
-    save(&on.image, "deferred_micro.png");
-    save(&off.image, "deferred_micro_forward.png");
+    let on = render_at(ctx, &scene, true, &view, size);
+    let off = render_at(ctx, &scene, false, &view, size);
+    save(&on.image, &format!("{name}.png"));
+    save(&off.image, &format!("{name}_forward.png"));
     assert_eq!(
         on.stats.deferred_draws, 3,
         "the three textured spheres are deferred, nothing else"
@@ -165,7 +164,19 @@ fn deferred_micro_triangles_give_the_forward_image() {
     assert_eq!(off.stats.deferred_draws, 0);
     assert_eq!(on.stats.draws, off.stats.draws);
     let (largest, changed) = difference(&on.image, &off.image);
-    eprintln!("deferred vs forward: largest difference {largest} levels, {changed} pixels > 2");
+    eprintln!(
+        "deferred vs forward at {}x{}: largest difference {largest} levels, {changed} pixels > 2",
+        size.0, size.1
+    );
+    (largest, changed)
+}
+
+/// The spheres' triangles cover well under a pixel at 320×180, so they are deferred (and the
+/// vertex-coloured sphere and the ground are not); the image is the forward pass's.
+#[test]
+fn deferred_micro_triangles_give_the_forward_image() {
+    let ctx = context();
+    let (largest, changed) = micro_deferred_against_forward(&ctx, (320, 180), "deferred_micro");
     // Measured: largest 5 levels, 7 pixels over 2, all on silhouettes: llvmpipe computes one
     // mip level per 2×2 quad, explicit derivatives included, so a silhouette pixel whose quad
     // also holds another surface can read a level of its derivatives (the forward pass
@@ -185,18 +196,8 @@ fn deferred_micro_triangles_give_the_forward_image() {
 #[test]
 fn deferred_few_pixel_triangles_give_the_forward_image() {
     let ctx = context();
-    let scene = micro_scene();
-    let view = micro_view();
-    let on = render_at(&ctx, &scene, true, &view, (1280, 720));
-    let off = render_at(&ctx, &scene, false, &view, (1280, 720));
-    save(&on.image, "deferred_few_pixels.png");
-    save(&off.image, "deferred_few_pixels_forward.png");
-    assert_eq!(
-        on.stats.deferred_draws, 3,
-        "the three textured spheres are deferred, nothing else"
-    );
-    let (largest, changed) = difference(&on.image, &off.image);
-    eprintln!("deferred vs forward at 1280x720: largest difference {largest} levels, {changed} pixels > 2");
+    let (largest, changed) =
+        micro_deferred_against_forward(&ctx, (1280, 720), "deferred_few_pixels");
     // Measured: largest 20 levels, 14 pixels over 2 (633 of 921,600 by any), all on the spheres'
     // silhouettes against the ground (one mip level per 2×2 quad, as above).
     assert!(largest <= 24, "largest difference {largest} levels");
