@@ -68,7 +68,64 @@ fn finish_context(ctx: std::sync::Arc<Context>) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `render --frames N`: the animation from `--time` at `--fps`, one PNG per frame.
+fn render_sequence(a: &RenderArgs, frames: u32) -> anyhow::Result<()> {
+    let mut scene = load_scene(a.scene.as_ref(), &a.view)?;
+    // Without --time or --animation a sequence plays the first animation from 0.
+    let first = match scene.rig.as_deref() {
+        Some(r) if !r.animations.is_empty() => umbra::scene::anim::Playing::One(0),
+        _ => umbra::scene::anim::Playing::Rest,
+    };
+    let (playing, t0) = app::cli::playing(&scene, &a.view)?.unwrap_or((first, 0.0));
+    // Every name first, so a bad pattern fails before any rendering.
+    let paths = (0..frames)
+        .map(|i| app::cli::frame_path(&a.output, i))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let view = make_view(&scene, &a.view)?;
+    let ctx = offscreen_context(a.validation, a.device.clone())?;
+    let options = app::cli::animated_scene_options(&a.view);
+    let mut renderer = Renderer::with_options(&ctx, &scene, &options)?;
+    app::cli::warn_msaa(&a.view, renderer.samples());
+    let (w, h) = a.view.size;
+    let mut walls = Vec::with_capacity(paths.len());
+    for (i, path) in paths.iter().enumerate() {
+        let t = t0 + i as f32 / a.fps;
+        let start = std::time::Instant::now();
+        if scene.moves() {
+            scene.pose_at(&playing, t);
+            renderer.set_pose(&scene)?;
+        }
+        let frame = renderer.render(&view, w, h)?;
+        walls.push((start.elapsed().as_secs_f64() * 1e3, frame.stats));
+        frame
+            .image
+            .save(path)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    let stats: Vec<FrameStats> = walls.iter().map(|(_, s)| s.clone()).collect();
+    let mut posed: Vec<f64> = walls.iter().map(|(w, _)| *w).collect();
+    posed.sort_by(f64::total_cmp);
+    let gpu = median_of(&stats, &|s| Some(s.gpu_shadow_ms? + s.gpu_camera_ms?));
+    let shadow = median_of(&stats[1.min(stats.len() - 1)..], &|s| s.gpu_shadow_ms);
+    let casters = median_of(&stats[1.min(stats.len() - 1)..], &|s| {
+        Some(s.casters_drawn as f64)
+    });
+    let ms = |v: Option<f64>| v.map_or("n/a".into(), |g| format!("{g:.2} ms"));
+    println!(
+        "rendered {} frames of {} at {} fps from t = {t0} s ({}x{}, {} triangles, shadow cache {}) on {}: median per frame {:.1} ms with posing and upload, GPU {}; after the first frame shadow pass {}, casters drawn {} -> {}",
+        paths.len(), scene.name, a.fps, w, h, renderer.triangles(),
+        if options.shadow_cache { "on" } else { "off" }, ctx.device_name,
+        posed[posed.len() / 2], ms(gpu), ms(shadow), casters.unwrap_or(0.0),
+        a.output.display()
+    );
+    drop(renderer);
+    finish_context(ctx)
+}
+
 fn render(a: RenderArgs) -> anyhow::Result<()> {
+    if let Some(n) = a.frames {
+        return render_sequence(&a, n);
+    }
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut view = make_view(&scene, &a.view)?;
     let ctx = offscreen_context(a.validation, a.device.clone())?;
@@ -225,11 +282,12 @@ fn write_depth_profile(
 fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let view = make_view(&scene, &a.view)?;
+    let start = app::cli::playing(&scene, &a.view)?;
     app::viewer::run(app::viewer::ViewerOptions {
         scene,
         view,
         size: a.view.size,
-        scene_options: scene_options(&a.view),
+        scene_options: app::cli::animated_scene_options(&a.view),
         vsync: !a.no_vsync,
         frames: a.frames,
         screenshot: a.screenshot,
@@ -237,6 +295,7 @@ fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
         validation: a.validation,
         script: app::script::expand(&a.script).map_err(|e| anyhow::anyhow!("--script: {e}"))?,
         shadow_budget: a.view.shadow_budget,
+        start,
     })
 }
 
@@ -274,6 +333,15 @@ fn stability(a: app::cli::StabilityArgs) -> anyhow::Result<()> {
         &StabilityOptions {
             size: a.size,
             quick: a.quick,
+            animation: match a.animation.as_deref() {
+                Some(spec) => match umbra::scene::anim::Playing::parse(spec, scene.rig.as_deref())
+                    .map_err(|e| anyhow::anyhow!(e))?
+                {
+                    umbra::scene::anim::Playing::One(i) => Some(i),
+                    _ => anyhow::bail!("--animation: the motion probe plays one animation"),
+                },
+                None => None,
+            },
         },
         wall,
         &mut |phase| {

@@ -314,6 +314,11 @@ fn bad_arguments() {
         (vec!["render", "--shadow-budget", "150%"], "below 100%"),
         (vec!["render", "--shadow-budget", "abc"], "not a fraction"),
         (vec!["sweep", "no-such-scene.gltf"], "no such file"),
+        (vec!["render", "--time", "nan"], "finite"),
+        (vec!["render", "--animation", "3"], "no animations"),
+        (vec!["render", "--frames", "3", "-o", "x.png"], "pattern"),
+        (vec!["render", "--frames", "3", "-o", "x%q.png"], "%0nd"),
+        (vec!["render", "--frames", "2", "--fps", "0"], "frame rate"),
     ] {
         let (ok, stderr) = run(&args, &d);
         assert!(!ok, "{args:?} should fail");

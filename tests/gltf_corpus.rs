@@ -17,7 +17,7 @@ const H: u32 = 120;
 /// The generated corpus, written under the test output folder, plus the extra corpus if set.
 fn all_models(tag: &str) -> Vec<PathBuf> {
     let mut models = write_corpus(&out_dir().join(format!("corpus_{tag}")));
-    assert_eq!(models.len(), 6, "the generated corpus has six models");
+    assert_eq!(models.len(), 9, "the generated corpus has nine models");
     match extra_corpus() {
         Some(dir) => {
             let extra = models_under(&dir);
@@ -28,13 +28,13 @@ fn all_models(tag: &str) -> Vec<PathBuf> {
                 extra.len()
             );
             eprintln!(
-                "corpus: 6 generated models + {} from {}",
+                "corpus: 9 generated models + {} from {}",
                 extra.len(),
                 dir.display()
             );
             models.extend(extra);
         }
-        None => eprintln!("corpus: 6 generated models (UMBRA_GLTF_CORPUS not set)"),
+        None => eprintln!("corpus: 9 generated models (UMBRA_GLTF_CORPUS not set)"),
     }
     models
 }

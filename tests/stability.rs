@@ -28,6 +28,7 @@ fn builtin_scene_meets_the_thresholds_at_the_defaults() {
         &StabilityOptions {
             size: SIZE,
             quick: true,
+            animation: None,
         },
         Some(STABILITY_WALL_HALF),
         &mut |_| {},

@@ -253,7 +253,7 @@ fn viewer_soak_with_resizes_keeps_memory_flat() {
         .next()
         .and_then(|g| g.trim_end_matches(" MB)").parse().ok())
         .unwrap();
-    // Measured over frames 100–500 in one session: −0.16, 0.84, 1.89 and 2.36 MB (no trend:
+    // Measured over frames 100–500 in one run: −0.16, 0.84, 1.89 and 2.36 MB (no trend:
     // allocator and driver noise around a flat line; the 10,000-frame offscreen soak in
     // tests/soak.rs bounds steady growth at 2 MB). A leak of 10 kB a frame would add 4 MB here.
     assert!(growth < 4.0, "viewer memory grew: {line}");
@@ -422,5 +422,75 @@ fn a_click_picks_the_node_mesh_and_triangle_under_it() {
     assert!(
         left[0] as i32 > left[2] as i32 + 60 && (right[0] as i32 - right[2] as i32).abs() < 10,
         "left {left:?}, right {right:?}"
+    );
+}
+
+#[test]
+fn the_viewer_plays_and_steps_animations_like_the_offscreen_render() {
+    // The skinned bar: started paused at 0.2 s and stepped 6 frames of 1/30 s with `O` it
+    // stands at 0.4 s; the offscreen render at --time 0.4 must show the same pose. Then `R`
+    // (next: all animations, from 0 playing) and `space` (pause) on the same run leave no
+    // validation message.
+    let x = Xvfb::start();
+    let model = common::animated::skinned_bar(&out("animated"), "viewer_bar", 0.0, true);
+    let model = model.to_str().unwrap();
+    let shot = out("viewer_bar_shot.png");
+    let offscreen = out("viewer_bar_offscreen.png");
+    let size = [
+        "--size",
+        "320x240",
+        "--eye",
+        "1,4.5,2.2",
+        "--target",
+        "0,0.6,0",
+        "--ground",
+    ];
+    let mut args = vec![
+        "view",
+        model,
+        "--time",
+        "0.2",
+        "--frames",
+        "20",
+        "--validation",
+    ];
+    args.extend([
+        "--script",
+        "key:o*6",
+        "--screenshot",
+        shot.to_str().unwrap(),
+    ]);
+    args.extend(size);
+    let (ok, log) = umbra(&args, Some(&x.display));
+    assert!(ok, "viewer failed:\n{log}");
+    assert!(
+        log.contains("animation: 0 'bend' 0.40/1.00 s ×1 (paused)"),
+        "{log}"
+    );
+    let mut args = vec![
+        "render",
+        model,
+        "--time",
+        "0.4",
+        "-o",
+        offscreen.to_str().unwrap(),
+    ];
+    args.extend(size);
+    let (ok, log) = umbra(&args, None);
+    assert!(ok, "render failed:\n{log}");
+    let a = image::open(&shot).unwrap().to_rgba8();
+    let b = image::open(&offscreen).unwrap().to_rgba8();
+    let (p, f) = (psnr(&b, &a), flip(&b, &a));
+    eprintln!("animated viewer vs offscreen: PSNR {p:.1} dB, FLIP {f:.5}");
+    // Measured: identical (PSNR ∞); the pose one step (1/30 s) either side gives 36.2 dB.
+    assert!(p > 50.0 && f < 0.001, "PSNR {p:.1} dB, FLIP {f:.4}");
+    let mut args = vec!["view", model, "--frames", "12", "--validation"];
+    args.extend(["--script", "key:r,key:space,key:x,key:r"]);
+    args.extend(size);
+    let (ok, log) = umbra(&args, Some(&x.display));
+    assert!(ok, "viewer failed:\n{log}");
+    assert!(
+        log.contains("animation: all 0.00/1.00 s ×1") && log.contains("rest pose"),
+        "{log}"
     );
 }

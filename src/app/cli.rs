@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use umbra::render::{
     Exposure, Pcf, ShadowFit, ShadowFormat, ShadowSettings, Tonemap, View, ViewMode,
 };
+use umbra::scene::anim::Playing;
 use umbra::scene::{demo::demo_scene, load_gltf, Camera, Scene};
 
 /// umbra: real-time shadow-mapping renderer (Vulkan).
@@ -72,6 +73,10 @@ pub struct StabilityArgs {
     /// Image size WxH of every probe.
     #[arg(long, default_value = "640x360", value_parser = parse_size)]
     pub size: (u32, u32),
+    /// The animation the motion probe's moving caster plays (index or name; default: the
+    /// scene's first; a scene without animations gets a box that crosses it).
+    #[arg(long)]
+    pub animation: Option<String>,
     /// Add a ground plane under glTF models (as `render --ground`).
     #[arg(long)]
     pub ground: bool,
@@ -156,7 +161,7 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
     } else if let Some(s) = umbra::scene::synthetic::by_name(spec) {
         s
     } else {
-        bail!("{spec}: no such file, and not demo, town, grazing, stability, double-sided, room, sun-and-spot, two-suns, lux-yard or spheres:N");
+        bail!("{spec}: no such file, and not demo, town, town-mover, grazing, stability, double-sided, room, sun-and-spot, two-suns, lux-yard or spheres:N");
     };
     for w in &s.warnings {
         print_warning(&s.name, w);
@@ -286,6 +291,42 @@ pub struct RenderArgs {
     /// Render this many frames and report median times (the image is the last frame).
     #[arg(long, default_value_t = 1)]
     pub repeat: usize,
+    /// An image sequence: N frames of the animation from --time (default 0) at --fps, each
+    /// written to OUT with its frame number put in the `%04d` (or `%d`) the name must hold.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: Option<u32>,
+    /// Frames per second of a sequence (--frames).
+    #[arg(long, default_value_t = 30.0, value_parser = parse_fps)]
+    pub fps: f32,
+}
+
+/// A frame rate within 0.001..=10000.
+fn parse_fps(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(f) if (0.001..=10_000.0).contains(&f) => Ok(f),
+        _ => Err(format!("'{s}' is not a frame rate within 0.001..10000")),
+    }
+}
+
+/// The file name of frame `i` of a sequence: `pattern` with its `%0Nd` or `%d` replaced by `i`
+/// (zero-padded to N digits); an error names the pattern wanted when there is none.
+pub fn frame_path(pattern: &std::path::Path, i: u32) -> anyhow::Result<PathBuf> {
+    let text = pattern.to_string_lossy();
+    let Some(start) = text.find('%') else {
+        bail!("-o {text}: a sequence (--frames) needs a frame-number pattern such as out_%04d.png");
+    };
+    let rest = &text[start + 1..];
+    let digits: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
+    if !rest[digits.len()..].starts_with('d') {
+        bail!("-o {text}: expected %d or %0Nd (such as %04d) after '%'");
+    }
+    let width: usize = digits.parse().unwrap_or(0).min(12);
+    let end = start + 1 + digits.len() + 1;
+    Ok(PathBuf::from(format!(
+        "{}{i:0width$}{}",
+        &text[..start],
+        &text[end..]
+    )))
 }
 
 /// PCF kernels.
@@ -312,7 +353,8 @@ pub struct ViewArgs {
     #[arg(long)]
     pub no_culling: bool,
     /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided
-    /// primitives), `town` (2 km across, cameras at eye height and on a roof), `grazing` (a sun 6° above the
+    /// primitives), `town` (2 km across, cameras at eye height and on a roof), `town-mover` (the town
+    /// with a person-sized box walking across the street: animation \"move\"), `grazing` (a sun 6° above the
     /// horizon over posts, spheres and crates), `stability` (a thin wall, a box, spheres and a
     /// torus: the stability suite's scene), `room` (a point light in a furnished room),
     /// `sun-and-spot` and `two-suns` (a yard where two lights cast), `lux-yard` (the yard lit in
@@ -436,6 +478,45 @@ pub struct ViewArgs {
     /// for CPU devices, off on GPUs.
     #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
     pub receiver_split: Option<bool>,
+    /// Pose the scene at this time in seconds of `--animation` (each channel clamped to its
+    /// keyframes, as glTF says). Without it (and without --animation) the scene is drawn at
+    /// rest: the file's node transforms, skins and default morph weights applied.
+    #[arg(long, value_parser = parse_time, allow_hyphen_values = true)]
+    pub time: Option<f32>,
+    /// Reuse shadow-map layers whose light view and static casters did not change since the
+    /// last frame, drawing only moving casters over a cached copy (the same image). Default:
+    /// on in the viewer and for image sequences (--frames), off for one frame and `bench`.
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub shadow_cache: Option<bool>,
+    /// Which animation plays: its index, its name, or `all` (every animation at once, a later
+    /// one winning where two animate the same property). Default with --time: the first (0).
+    #[arg(long)]
+    pub animation: Option<String>,
+}
+
+/// A finite time in seconds.
+fn parse_time(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(t) if t.is_finite() => Ok(t),
+        _ => Err(format!("'{s}' is not a finite number of seconds")),
+    }
+}
+
+/// What `--animation` and `--time` ask of `scene`: the animations and the time, or None for the
+/// rest pose. A scene without animations at `--time` gets a warning and its rest pose.
+pub fn playing(scene: &Scene, a: &ViewArgs) -> anyhow::Result<Option<(Playing, f32)>> {
+    if a.time.is_none() && a.animation.is_none() {
+        return Ok(None);
+    }
+    let rig = scene.rig.as_deref();
+    let Some(spec) = a.animation.as_deref() else {
+        if rig.is_none_or(|r| r.animations.is_empty()) {
+            return Ok(None);
+        }
+        return Ok(Some((Playing::One(0), a.time.unwrap_or(0.0))));
+    };
+    let p = Playing::parse(spec, rig).map_err(|e| anyhow!(e))?;
+    Ok(Some((p, a.time.unwrap_or(0.0))))
 }
 
 /// `on` or `off`.
@@ -621,13 +702,23 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
         (None, None) => demo_scene(),
         (None, Some(name)) => umbra::scene::synthetic::by_name(name).ok_or_else(|| {
             anyhow!(
-                "--synthetic {name}: expected double-sided, town, grazing, stability, room, sun-and-spot, two-suns, lux-yard or spheres:N with N in 1..=256"
+                "--synthetic {name}: expected double-sided, town, town-mover, grazing, stability, room, sun-and-spot, two-suns, lux-yard or spheres:N with N in 1..=256"
             )
         })?,
     };
     let ground = a.ground;
     for w in &s.warnings {
         print_warning(&s.name, w);
+    }
+    match playing(&s, a)? {
+        Some((p, t)) => s.pose_at(&p, t),
+        None if a.time.is_some() => {
+            eprintln!(
+                "warning: {}: --time: the scene has no animations; drawn at rest",
+                s.name
+            );
+        }
+        None => {}
     }
     if ground {
         umbra::scene::shapes::add_ground(&mut s);
@@ -644,6 +735,16 @@ pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
         cpu_mips: None,
         deferred: a.deferred,
         receiver_split: a.receiver_split,
+        shadow_cache: a.shadow_cache.unwrap_or(false),
+    }
+}
+
+/// Upload options for runs of many frames (the viewer, image sequences): the shadow cache on
+/// unless `--shadow-cache off`.
+pub fn animated_scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
+    umbra::render::SceneOptions {
+        shadow_cache: a.shadow_cache.unwrap_or(true),
+        ..scene_options(a)
     }
 }
 

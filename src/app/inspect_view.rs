@@ -341,6 +341,8 @@ pub fn format_report(r: &Value, md: bool) -> String {
         out += &t.render(md);
     }
 
+    out += &motion(&r["motion"], md, &h);
+
     let f = arr(&r["findings"]);
     out += &h(&format!("Findings ({})", f.len()));
     if f.is_empty() {
@@ -355,6 +357,99 @@ pub fn format_report(r: &Value, md: bool) -> String {
                 cell(&x["message"]),
             ]);
         }
+        out += &t.render(md);
+    }
+    out
+}
+
+/// The motion tables: animations (one row per channel), skins and morph targets; nothing for
+/// a file that does not move.
+fn motion(m: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
+    let anims = arr(&m["animations"]);
+    if !anims.is_empty() {
+        let mut t = Table::new(&[
+            "animation",
+            "duration (s)",
+            "channels",
+            "interpolation",
+            "keys",
+            "nodes",
+        ]);
+        for a in anims {
+            let ch = arr(&a["channels"]);
+            // "20 rotation, 1 translation" and the interpolations used, in order of first use.
+            let tally = |key: &str| {
+                let mut seen: Vec<(String, usize)> = Vec::new();
+                for c in ch {
+                    let k = cell(&c[key]);
+                    match seen.iter_mut().find(|(n, _)| *n == k) {
+                        Some((_, n)) => *n += 1,
+                        None => seen.push((k, 1)),
+                    }
+                }
+                seen.iter()
+                    .map(|(k, n)| format!("{n} {k}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let keys = ch
+                .iter()
+                .filter_map(|c| c["keyframes"].as_u64())
+                .max()
+                .unwrap_or(0);
+            t.row(vec![
+                format!("{} '{}'", cell(&a["index"]), cell(&a["name"])),
+                cell(&a["duration"]),
+                tally("path"),
+                tally("interpolation"),
+                format!("up to {keys}"),
+                arr(&a["target_nodes"]).len().to_string(),
+            ]);
+        }
+        out += &h(&format!("Animations ({})", anims.len()));
+        out += &t.render(md);
+    }
+    let skins = arr(&m["skins"]);
+    if !skins.is_empty() {
+        let mut t = Table::new(&[
+            "skin",
+            "joints",
+            "inverse bind matrices",
+            "most influences",
+            "nodes",
+        ]);
+        for s in skins {
+            t.row(vec![
+                format!("{} '{}'", cell(&s["index"]), cell(&s["name"])),
+                cell(&s["joints"]),
+                cell(&s["inverse_bind_matrices"]),
+                cell(&s["max_influences"]),
+                cell(&s["nodes"]),
+            ]);
+        }
+        out += &h("Skins");
+        out += &t.render(md);
+    }
+    let morphs = arr(&m["morph_targets"]);
+    if !morphs.is_empty() {
+        let mut t = Table::new(&[
+            "mesh",
+            "primitive",
+            "targets",
+            "attributes",
+            "default weights",
+        ]);
+        for x in morphs {
+            t.row(vec![
+                cell(&x["mesh"]),
+                cell(&x["primitive"]),
+                cell(&x["targets"]),
+                cell(&x["attributes"]),
+                cell(&x["default_weights"]),
+            ]);
+        }
+        out += &h("Morph targets");
         out += &t.render(md);
     }
     out

@@ -12,6 +12,8 @@ pub mod inspect_view;
 #[cfg(all(feature = "viewer", feature = "reference"))]
 pub mod pick;
 #[cfg(feature = "viewer")]
+pub mod player;
+#[cfg(feature = "viewer")]
 pub mod script;
 #[cfg(feature = "viewer")]
 pub mod viewer;

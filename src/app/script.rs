@@ -4,14 +4,14 @@
 //!
 //! A script is a comma-separated list of steps, each optionally repeated with `*N`:
 //! `WxH` resizes the window (`0x0` simulates minimising), `key:NAME` presses and releases a key
-//! (`up down left right [ ] k + - v h f tab c p`, the viewer's own bindings), `wheel:N`
+//! (`up down left right [ ] k + - v h f tab c p space i o z x r`, the viewer's own bindings), `wheel:N`
 //! scrolls N lines (positive zooms in) and `click:X:Y` clicks (picks) at window pixel (X, Y).
 //! Example: `key:down*40,wheel:1*80,640x360*3,0x0,click:320:200`.
 
 /// Key names a script may press (each one of the viewer's bindings).
 pub const KEYS: &[&str] = &[
     "up", "down", "left", "right", "[", "]", "k", "+", "-", "v", "h", "n", "g", "j", "l", "t",
-    "comma", "period", "f", "tab", "c", "p",
+    "comma", "period", "f", "tab", "c", "p", "space", "i", "o", "z", "x", "r",
 ];
 
 /// Most steps one script may expand to (a typo such as `*1000000000` is an error, not a hang).
@@ -120,7 +120,7 @@ mod tests {
         assert_eq!(steps[5], ScriptStep::Resize(640, 360));
         assert_eq!(steps[6], ScriptStep::Resize(0, 0));
         for bad in [
-            "key:z",
+            "key:q",
             "wheel:x",
             "10x0",
             "5",

@@ -50,6 +50,18 @@ pub struct ViewerOptions {
     pub script: Vec<ScriptStep>,
     /// Re-choose the shadow settings for this misclassification budget as the camera moves.
     pub shadow_budget: Option<f64>,
+    /// Where the animation clock starts (`--animation`, `--time`: paused there); None: the
+    /// first animation plays from 0.
+    pub start: Option<(umbra::scene::anim::Playing, f32)>,
+}
+
+/// The animation keys.
+#[derive(Clone, Copy)]
+enum AnimKey {
+    Toggle,
+    Step(i32),
+    Speed(f32),
+    Next,
 }
 
 /// Frames between two script steps.
@@ -73,6 +85,7 @@ enum KeyAction {
     ToggleFly,
     NextCamera,
     Screenshot,
+    Anim(AnimKey),
     Quit,
 }
 
@@ -101,6 +114,12 @@ fn script_key(name: &str) -> Option<KeyCode> {
         "t" => KeyCode::KeyT,
         "comma" => KeyCode::Comma,
         "period" => KeyCode::Period,
+        "space" => KeyCode::Space,
+        "i" => KeyCode::KeyI,
+        "o" => KeyCode::KeyO,
+        "z" => KeyCode::KeyZ,
+        "x" => KeyCode::KeyX,
+        "r" => KeyCode::KeyR,
         _ => return None,
     })
 }
@@ -137,6 +156,12 @@ fn key_action(code: KeyCode) -> Option<KeyAction> {
         KeyCode::Tab => ToggleFly,
         KeyCode::KeyC => NextCamera,
         KeyCode::KeyP => Screenshot,
+        KeyCode::Space => Anim(AnimKey::Toggle),
+        KeyCode::KeyI => Anim(AnimKey::Step(-1)),
+        KeyCode::KeyO => Anim(AnimKey::Step(1)),
+        KeyCode::KeyZ => Anim(AnimKey::Speed(0.5)),
+        KeyCode::KeyX => Anim(AnimKey::Speed(2.0)),
+        KeyCode::KeyR => Anim(AnimKey::Next),
         KeyCode::Escape => Quit,
         _ => return None,
     })
@@ -172,6 +197,9 @@ struct State {
     screenshot_count: u32,
     script_pos: usize,
     minimized: bool,
+    /// The animation clock, and whether the scene must be posed anew before the next frame.
+    player: super::player::Player,
+    pose_dirty: bool,
     #[cfg(feature = "sweep")]
     budget: Option<super::budget_worker::BudgetWorker>,
 }
@@ -277,6 +305,11 @@ impl App {
             screenshot_count: 0,
             script_pos: 0,
             minimized: size.width == 0 || size.height == 0,
+            player: super::player::Player::new(
+                self.opts.scene.rig.as_deref(),
+                self.opts.start.clone(),
+            ),
+            pose_dirty: false,
             #[cfg(feature = "sweep")]
             budget: self.opts.shadow_budget.map(|b| {
                 super::budget_worker::BudgetWorker::start(
@@ -328,13 +361,32 @@ impl App {
                 ScriptStep::Click(x, y) => self.pick(x, y),
             }
         }
-        let opts = &self.opts;
         let Some(s) = self.state.as_mut() else {
             return Ok(());
         };
         let now = Instant::now();
         let dt = (now - s.last_frame).as_secs_f32().min(0.25);
         s.last_frame = now;
+        // The animation: wall time, or one frame step per frame in a run of --frames (so what
+        // it draws does not depend on the machine's speed). Posing counts as CPU time.
+        let clock = if self.opts.frames.is_some() {
+            super::player::FRAME_STEP
+        } else {
+            dt
+        };
+        s.pose_dirty |= s.player.advance(clock);
+        let mut pose_ms = 0.0;
+        if std::mem::take(&mut s.pose_dirty) {
+            let t0 = Instant::now();
+            self.opts.scene.pose_at(&s.player.playing, s.player.time);
+            s.renderer.set_pose(&self.opts.scene)?;
+            #[cfg(feature = "reference")]
+            if let Some(r) = s.pick_renderer.as_mut() {
+                r.set_pose(&self.opts.scene)?;
+            }
+            pose_ms = t0.elapsed().as_secs_f64() * 1e3;
+        }
+        let opts = &self.opts;
         s.controller.update(dt);
         if s.camera_index.is_none() {
             s.view.camera = s.controller.camera();
@@ -364,7 +416,7 @@ impl App {
         } else {
             s.renderer.draw(&s.view, shot)?
         };
-        let cpu = t0.elapsed().as_secs_f64() * 1e3;
+        let cpu = t0.elapsed().as_secs_f64() * 1e3 + pose_ms;
         if let DrawResult::Drawn { screenshot, .. } = result {
             s.drawn += 1;
             if s.drawn == WARM_UP_FRAMES {
@@ -401,8 +453,13 @@ impl App {
                 Some((a, b)) => format!("GPU {:.1} ms (shadow {a:.1} + camera {b:.1})", a + b),
                 None => "GPU n/a".into(),
             };
+            let anim = if s.player.has_animations() {
+                format!(" | {}", s.player.label().trim_start_matches("animation: "))
+            } else {
+                String::new()
+            };
             let title = format!(
-                "umbra — {} — {:.1} fps | {gpu} | CPU {cpu:.1} ms | {} tris | map {}²",
+                "umbra — {} — {:.1} fps | {gpu} | CPU {cpu:.1} ms | {} tris | map {}²{anim}",
                 opts.scene.name,
                 1000.0 / frame.max(1e-3),
                 s.renderer.triangles(),
@@ -519,6 +576,17 @@ impl App {
                 }
             }
             KeyAction::Screenshot => s.want_screenshot = true,
+            KeyAction::Anim(k) => {
+                let p = &mut s.player;
+                let line = match k {
+                    AnimKey::Toggle => p.toggle(),
+                    AnimKey::Step(n) => p.step(n),
+                    AnimKey::Speed(f) => p.scale_speed(f),
+                    AnimKey::Next => p.next_animation(),
+                };
+                s.pose_dirty = true;
+                println!("{line}");
+            }
             KeyAction::Quit => el.exit(),
         }
     }

@@ -141,7 +141,8 @@ impl FrameCore {
         let origin = scene.render_origin();
         let gpu = GpuScene::new(ctx, scene, options, origin)?;
         let receiver_bounds = gpu.draws.iter().map(|d| d.world_bounds).collect();
-        let shadow = ShadowPass::new(ctx)?;
+        let mut shadow = ShadowPass::new(ctx)?;
+        shadow.set_caching(options.shadow_cache);
         let samples = options.resolved_samples(ctx);
         let camera = CameraPass::new(
             ctx,
@@ -174,6 +175,19 @@ impl FrameCore {
             receiver_bounds,
             receiver_split,
         })
+    }
+
+    /// Takes a new pose of the scene it was made from ([`GpuScene::update_pose`]): vertices,
+    /// draws, bounds and the lights, which may hang on animated nodes.
+    pub fn set_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
+        self.gpu.update_pose(scene)?;
+        self.receiver_bounds = self.gpu.draws.iter().map(|d| d.world_bounds).collect();
+        self.lights = scene
+            .lights
+            .iter()
+            .map(|l| l.rebased(self.origin))
+            .collect();
+        Ok(())
     }
 
     /// Sizes the shadow map for `view`, plans the frame and writes slot `slot`'s uniforms (the

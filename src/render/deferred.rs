@@ -25,11 +25,11 @@ use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
 /// A draw is deferred when its triangles' estimated mean area on screen (`pixels_per_triangle`)
-/// is below this many pixels. Chosen by a sweep (README, *Speed*, session 15): at 4, 8, 12 and
+/// is below this many pixels. Chosen by a sweep (CHANGELOG, milestone 15): at 4, 8, 12 and
 /// 16 FlightHelmet + ground took 46.9, 43.0, 39.6 and 40.0 ms a frame (its helmet draws are
 /// 1.4, 1.6, 5.2, 5.9 and 9.5 pixels a triangle: even at 9.5 a triangle touches about twice the
-/// lanes it keeps). Session 13's sweep had found 4 best (8: +1.0 ms, 16: +3.4 ms), before
-/// session 14 stopped llvmpipe's memory being paged out and in again every frame.
+/// lanes it keeps). Milestone 13's sweep had found 4 best (8: +1.0 ms, 16: +3.4 ms), before
+/// milestone 14 stopped llvmpipe's memory being paged out and in again every frame.
 pub const DEFER_BELOW_PIXELS: f32 = 16.0;
 
 /// Draws of fewer triangles stay forward: a small draw saves little shading and would still
@@ -389,6 +389,7 @@ mod tests {
             closed: true,
             deferrable: true,
             mean_area,
+            moving: false,
         }
     }
 

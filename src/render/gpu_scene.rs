@@ -4,7 +4,7 @@
 use super::samplers::SamplerCache;
 use super::settings::SceneOptions;
 use super::uniforms::{MaterialUniform, SceneImmediates};
-use crate::gpu::context::{Context, GpuError};
+use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
 use crate::gpu::{Buffer, Image};
 use crate::math::mips::mip_chain;
@@ -250,6 +250,9 @@ pub struct Draw {
     /// Mean triangle area in world units (model area scaled by the transform's area scale,
     /// |det|^⅔: exact for uniform scales).
     pub mean_area: f32,
+    /// It can move between frames (`Scene::moving_instances`): animated, or skinned or morphed.
+    /// The shadow cache draws such casters every frame.
+    pub moving: bool,
 }
 
 /// A model-space plane `(n, w)` carried into world space by `m` (None for a singular `m`).
@@ -360,6 +363,90 @@ pub fn flat_hides_nothing(plane: Vec4, from: Viewpoint, scene: &Aabb) -> bool {
         .all(|c| s * (n.dot(*c) + plane.w) >= -tolerance)
 }
 
+/// The camera pass's per-vertex attributes of `p` (defaults where it lacks one).
+fn vertex_attributes(p: &crate::scene::Primitive) -> impl Iterator<Item = VertexAttributes> + '_ {
+    (0..p.positions.len()).map(move |i| VertexAttributes {
+        normal: p
+            .normals
+            .get(i)
+            .copied()
+            .unwrap_or(glam::Vec3::Y)
+            .to_array(),
+        uv: p.uvs.get(i).copied().unwrap_or_default().to_array(),
+        tangent: p
+            .tangents
+            .get(i)
+            .copied()
+            .unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0))
+            .to_array(),
+        color: p
+            .color(i)
+            .to_array()
+            .map(|c| (c.clamp(0.0, 1.0) * 65535.0).round() as u16),
+        uv1: p.uv1(i).to_array(),
+    })
+}
+
+/// One draw per non-empty primitive of every instance, placed relative to `origin`; the
+/// triangles drawn and the world bounds.
+fn build_draws(
+    scene: &Scene,
+    ranges: &[Vec<PrimitiveRange>],
+    origin: glam::Vec3,
+) -> (Vec<Draw>, usize, Aabb) {
+    let mut draws = Vec::new();
+    let mut triangles = 0;
+    let mut bounds = Aabb::EMPTY;
+    let moving = scene.moving_instances();
+    for (ii, inst) in scene.instances.iter().enumerate() {
+        let world_from_model = crate::scene::rebased(inst.world_from_model, origin);
+        for (pi, r) in ranges[inst.mesh].iter().enumerate() {
+            let (index_count, material) = (r.index_count, r.material);
+            let world_bounds = r.bounds.transformed(&world_from_model);
+            bounds = bounds.union(&world_bounds);
+            if index_count == 0 {
+                continue;
+            }
+            let mat = scene.materials.get(material);
+            triangles += index_count as usize / 3;
+            draws.push(Draw {
+                first_index: r.first_index,
+                index_count,
+                vertex_offset: r.vertex_offset,
+                material,
+                source: (ii, pi),
+                world_from_model,
+                model_from_world: world_from_model.inverse(),
+                clusters: r.clusters,
+                immediates: SceneImmediates::new(world_from_model),
+                world_bounds,
+                world_plane: r.plane.and_then(|pl| world_plane(pl, &world_from_model)),
+                double_sided: mat.is_some_and(|m| m.double_sided),
+                mirrored: glam::Mat3::from_mat4(world_from_model).determinant() < 0.0,
+                closed: r.closed,
+                alpha: match mat.map(|m| m.alpha_mode) {
+                    Some(AlphaMode::Mask(_)) => AlphaDraw::Masked,
+                    Some(AlphaMode::Blend) => AlphaDraw::Blended,
+                    _ => AlphaDraw::Opaque,
+                },
+                material_bits: mat.map_or(0, material_variant_bits),
+                mean_area: r.area
+                    * glam::Mat3::from_mat4(world_from_model)
+                        .determinant()
+                        .abs()
+                        .powf(2.0 / 3.0)
+                    / (index_count / 3).max(1) as f32,
+                deferrable: r.white
+                    && mat.is_none_or(|m| {
+                        m.alpha_mode == AlphaMode::Opaque && reads_texcoord0_only(m)
+                    }),
+                moving: moving[ii],
+            });
+        }
+    }
+    (draws, triangles, bounds)
+}
+
 /// The GPU copy of a scene.
 pub struct GpuScene {
     ctx: Arc<Context>,
@@ -386,6 +473,10 @@ pub struct GpuScene {
     /// The distinct (material variant bits, alpha treatment) pairs of the draws: the camera
     /// pipelines the scene needs per frame variant.
     pub pipeline_keys: Vec<(usize, AlphaDraw)>,
+    /// Per mesh, per primitive: where its vertices and indices are.
+    ranges: Vec<Vec<PrimitiveRange>>,
+    /// What the draws' world coordinates are relative to.
+    origin: glam::Vec3,
     pool: vk::DescriptorPool,
     /// Destroyed after the pool (fields drop after `Drop::drop`).
     _samplers: SamplerCache,
@@ -456,6 +547,39 @@ impl GpuScene {
         }
     }
 
+    /// Takes a new pose of the scene it was made from (the same meshes, instances and
+    /// materials; positions, normals, tangents and transforms changed by
+    /// `Scene::apply_pose`): rewrites the deformed primitives' vertices and every draw's
+    /// transform and bounds. Waits for the device first. Deformed primitives lose their cluster
+    /// and flat-caster culling, which were computed for another shape.
+    pub fn update_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
+        unsafe { self.ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
+        let attr_size = std::mem::size_of::<VertexAttributes>();
+        for (mesh, ranges) in scene.meshes.iter().zip(&mut self.ranges) {
+            for (p, r) in mesh.primitives.iter().zip(ranges.iter_mut()) {
+                if p.deform.is_none() {
+                    continue;
+                }
+                let base = r.vertex_offset as usize;
+                let pos: Vec<[f32; 3]> = p.positions.iter().map(|v| v.to_array()).collect();
+                self.positions
+                    .write(base * 12, bytemuck::cast_slice(&pos))?;
+                let attrs: Vec<VertexAttributes> = vertex_attributes(p).collect();
+                self.attributes
+                    .write(base * attr_size, bytemuck::cast_slice(&attrs))?;
+                r.bounds = p.bounds();
+                r.clusters.1 = 0;
+                r.closed = false;
+                r.plane = None;
+            }
+        }
+        let (draws, triangles, bounds) = build_draws(scene, &self.ranges, self.origin);
+        self.draws = draws;
+        self.triangles = triangles;
+        self.bounds = bounds;
+        Ok(())
+    }
+
     /// Uploads `scene`.
     pub fn new(
         ctx: &Arc<Context>,
@@ -508,28 +632,7 @@ impl GpuScene {
                 let first = indices.len() as u32;
                 let base = positions.len() as i32;
                 positions.extend(p.positions.iter().map(|v| v.to_array()));
-                for i in 0..p.positions.len() {
-                    attrs.push(VertexAttributes {
-                        normal: p
-                            .normals
-                            .get(i)
-                            .copied()
-                            .unwrap_or(glam::Vec3::Y)
-                            .to_array(),
-                        uv: p.uvs.get(i).copied().unwrap_or_default().to_array(),
-                        tangent: p
-                            .tangents
-                            .get(i)
-                            .copied()
-                            .unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0))
-                            .to_array(),
-                        color: p
-                            .color(i)
-                            .to_array()
-                            .map(|c| (c.clamp(0.0, 1.0) * 65535.0).round() as u16),
-                        uv1: p.uv1(i).to_array(),
-                    });
-                }
+                attrs.extend(vertex_attributes(p));
                 // Large primitives are split into clusters (their indices reordered cluster by
                 // cluster) so that clusters facing away can be skipped.
                 let cluster_start = all_clusters.len() as u32;
@@ -559,63 +662,25 @@ impl GpuScene {
             }
             ranges.push(r);
         }
-        let mut draws = Vec::new();
-        let mut triangles = 0;
-        let mut bounds = Aabb::EMPTY;
-        for (ii, inst) in scene.instances.iter().enumerate() {
-            let world_from_model = crate::scene::rebased(inst.world_from_model, origin);
-            for (pi, r) in ranges[inst.mesh].iter().enumerate() {
-                let (index_count, material) = (r.index_count, r.material);
-                let world_bounds = r.bounds.transformed(&world_from_model);
-                bounds = bounds.union(&world_bounds);
-                if index_count == 0 {
-                    continue;
-                }
-                let mat = scene.materials.get(material);
-                triangles += index_count as usize / 3;
-                draws.push(Draw {
-                    first_index: r.first_index,
-                    index_count,
-                    vertex_offset: r.vertex_offset,
-                    material,
-                    source: (ii, pi),
-                    world_from_model,
-                    model_from_world: world_from_model.inverse(),
-                    clusters: r.clusters,
-                    immediates: SceneImmediates::new(world_from_model),
-                    world_bounds,
-                    world_plane: r.plane.and_then(|pl| world_plane(pl, &world_from_model)),
-                    double_sided: mat.is_some_and(|m| m.double_sided),
-                    mirrored: glam::Mat3::from_mat4(world_from_model).determinant() < 0.0,
-                    closed: r.closed,
-                    alpha: match mat.map(|m| m.alpha_mode) {
-                        Some(AlphaMode::Mask(_)) => AlphaDraw::Masked,
-                        Some(AlphaMode::Blend) => AlphaDraw::Blended,
-                        _ => AlphaDraw::Opaque,
-                    },
-                    material_bits: mat.map_or(0, material_variant_bits),
-                    mean_area: r.area
-                        * glam::Mat3::from_mat4(world_from_model)
-                            .determinant()
-                            .abs()
-                            .powf(2.0 / 3.0)
-                        / (index_count / 3).max(1) as f32,
-                    deferrable: r.white
-                        && mat.is_none_or(|m| {
-                            m.alpha_mode == AlphaMode::Opaque && reads_texcoord0_only(m)
-                        }),
-                });
-            }
-        }
+        let (draws, triangles, bounds) = build_draws(scene, &ranges, origin);
         let mut pipeline_keys: Vec<(usize, AlphaDraw)> =
             draws.iter().map(|d| (d.material_bits, d.alpha)).collect();
         pipeline_keys.sort_unstable();
         pipeline_keys.dedup();
         let vb = vk::BufferUsageFlags::VERTEX_BUFFER;
-        let pos_buf =
-            Buffer::device_local_with_data(ctx, "positions", vb, bytemuck::cast_slice(&positions))?;
-        let attr_buf =
-            Buffer::device_local_with_data(ctx, "attributes", vb, bytemuck::cast_slice(&attrs))?;
+        // A scene that deforms rewrites its vertices each pose (`update_pose`): host-visible.
+        let vertex_buffer = |name: &str, data: &[u8]| {
+            if scene.deforms() {
+                let mut b =
+                    Buffer::new(ctx, name, data.len() as u64, vb, MemoryLocation::CpuToGpu)?;
+                b.write(0, data)?;
+                Ok(b)
+            } else {
+                Buffer::device_local_with_data(ctx, name, vb, data)
+            }
+        };
+        let pos_buf = vertex_buffer("positions", bytemuck::cast_slice(&positions))?;
+        let attr_buf = vertex_buffer("attributes", bytemuck::cast_slice(&attrs))?;
         let idx_buf = Buffer::device_local_with_data(
             ctx,
             "indices",
@@ -777,6 +842,8 @@ impl GpuScene {
             triangles,
             frustum_culling: options.culling,
             pipeline_keys,
+            ranges,
+            origin,
             pool,
             _samplers: samplers,
             _material_buffers: material_buffers,

@@ -12,6 +12,7 @@ pub(crate) mod renderer;
 pub mod report;
 pub(crate) mod samplers;
 pub(crate) mod settings;
+pub(crate) mod shadow_cache;
 pub(crate) mod shadow_pass;
 #[cfg(feature = "viewer")]
 pub(crate) mod swapchain;

@@ -167,6 +167,13 @@ impl Renderer {
         })
     }
 
+    /// Takes a new pose of the scene it was made from (after [`Scene::pose_at`]): the next
+    /// frame draws it, in every pass.
+    pub fn set_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
+        self.seen_depths = None;
+        self.core.set_pose(scene)
+    }
+
     /// The context.
     pub fn context(&self) -> &Arc<Context> {
         &self.core.ctx

@@ -207,7 +207,7 @@ pub struct SceneOptions {
     pub culling: bool,
     /// Multisample anti-aliasing: samples per pixel of the camera pass (1, 2, 4 or 8). `None`:
     /// 4 on GPUs, 1 on CPU devices (lavapipe, where 4 samples cost
-    /// `README.md`'s measured share of the frame). A count the device lacks falls to the
+    /// `docs/speed.md`'s measured share of the frame). A count the device lacks falls to the
     /// largest it has below it (`resolved_samples`).
     pub msaa: Option<u32>,
     /// Where textures' mip chains are made: `Some(true)` on the CPU at upload
@@ -224,6 +224,12 @@ pub struct SceneOptions {
     /// (`crate::render::receivers`: the same image; llvmpipe runs the lookup even where a
     /// branch skips it). `None`: on for CPU devices, off on GPUs (whose branches skip it).
     pub receiver_split: Option<bool>,
+    /// Reuse shadow-map layers across frames (`crate::render::shadow_cache`): a layer whose
+    /// light matrix, area and static casters are those of the last frame is not redrawn, and
+    /// only moving casters (animated or deforming) are drawn over a cached copy of the static
+    /// ones. The same image to the bit. Off by default (each `render` then measures the whole
+    /// shadow pass); the viewer and image sequences turn it on.
+    pub shadow_cache: bool,
 }
 
 impl Default for SceneOptions {
@@ -235,6 +241,7 @@ impl Default for SceneOptions {
             cpu_mips: None,
             deferred: None,
             receiver_split: None,
+            shadow_cache: false,
         }
     }
 }

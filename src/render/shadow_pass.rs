@@ -8,6 +8,7 @@ use super::pipeline::{
     Stencil,
 };
 use super::settings::{ShadowFormat, ShadowSettings};
+use super::shadow_cache::{split_moving, LayerKey, LayerWork, ShadowCache};
 use super::uniforms::ShadowImmediates;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError};
@@ -229,6 +230,23 @@ pub struct ShadowPass {
     pub map: Option<Image>,
     /// The map's attachment state (set with the map).
     map_at: Option<Attachment>,
+    /// Reuse what layers hold across frames (`SceneOptions::shadow_cache`).
+    caching: bool,
+    /// What each layer of the map and of `cache` holds.
+    layers: ShadowCache,
+    /// The static casters' depth per layer, for frames with moving casters (made on first need).
+    cache: Option<(Image, Attachment)>,
+}
+
+/// What a layer is drawn with: the map's view of the layer, the frame's light matrix and
+/// casters, and a point or spot light's near distance.
+struct LayerTarget<'a> {
+    view: vk::ImageView,
+    light_clip_from_world: &'a Mat4,
+    casters: &'a CasterPlan,
+    eye_near: f32,
+    /// The texels cleared and drawn (the casters' area, or the view's whole square).
+    area: vk::Rect2D,
 }
 
 impl ShadowPass {
@@ -245,7 +263,16 @@ impl ShadowPass {
             masked: None,
             map: None,
             map_at: None,
+            caching: false,
+            layers: ShadowCache::default(),
+            cache: None,
         })
+    }
+
+    /// Turns reuse of unchanged layers across frames on or off (`shadow_cache`).
+    pub fn set_caching(&mut self, on: bool) {
+        self.caching = on;
+        self.layers.clear();
     }
 
     /// Makes sure the map has this size and format and at least `layers` layers (one per shadow
@@ -276,6 +303,11 @@ impl ShadowPass {
                 let _ = self.ctx.device.device_wait_idle();
             }
         }
+        let copies = if self.caching {
+            vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST
+        } else {
+            vk::ImageUsageFlags::empty()
+        };
         self.map = Some(Image::new_array(
             &self.ctx,
             "shadow map",
@@ -285,9 +317,11 @@ impl ShadowPass {
                 height: size,
             },
             layers,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | copies,
         )?);
         self.map_at = self.map.as_ref().map(Attachment::of);
+        self.layers.clear();
+        self.cache = None;
         Ok(true)
     }
 
@@ -358,9 +392,13 @@ impl ShadowPass {
         views: &[(Mat4, &CasterPlan)],
         eye_near: f32,
     ) -> usize {
-        let (Some(map), Some(at)) = (&self.map, self.map_at.as_mut()) else {
+        if self.map.is_none() || self.map_at.is_none() {
             return 0;
-        };
+        }
+        if self.caching && scene.draws.iter().any(|d| d.moving) && self.ensure_cache().is_err() {
+            // No memory for the cache: draw every layer in full.
+            self.caching = false;
+        }
         // Without shadow views (shadows off) one texel of layer 0 is still cleared, so that the
         // map debug view reads defined values.
         let none = CasterPlan::default();
@@ -370,92 +408,244 @@ impl ShadowPass {
         } else {
             views
         };
-        let d = &self.ctx.device;
+        let layer_views = self
+            .map
+            .as_ref()
+            .map_or(Vec::new(), |m| m.layer_views.clone());
+        let layer_side = self.map.as_ref().map_or(1, |m| m.extent.width);
         self.ctx.begin_label(cmd, "shadow depth pass");
-        at.transition(d, cmd, Access::DepthAttachment);
+        self.transition_map(cmd, Access::DepthAttachment);
         let mut drawn = 0;
         for (layer, (light_clip_from_world, casters)) in views.iter().enumerate() {
-            let Some(&layer_view) = map.layer_views.get(layer) else {
+            let Some(&view) = layer_views.get(layer) else {
                 break;
             };
-            let from = casters.light;
-            // A point or spot light's eye and its projection's near distance (clusters wholly
-            // nearer are not drawn); none for a directional light (outside everything).
-            let eye = match from {
-                Viewpoint::Eye(p) => Some((p, eye_near)),
-                Viewpoint::Along(_) => None,
+            let t = LayerTarget {
+                view,
+                light_clip_from_world,
+                casters,
+                eye_near,
+                area: casters.area,
             };
-            let depth_attachment = depth_clear_attachment(layer_view, false);
-            // Only the casters' area is cleared and drawn: lookups elsewhere never read the map.
-            let area = casters.area;
-            let rendering = vk::RenderingInfo::default()
-                .render_area(area)
-                .layer_count(1)
-                .depth_attachment(&depth_attachment);
-            unsafe {
-                d.cmd_begin_rendering(cmd, &rendering);
-                if !casters.draws.is_empty() {
-                    let side = casters.size.min(map.extent.width);
-                    set_viewport(
-                        &self.ctx,
-                        cmd,
-                        vk::Extent2D {
-                            width: side,
-                            height: side,
-                        },
-                    );
-                    d.cmd_set_scissor(cmd, 0, &[area]);
-                    d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-                    // Opaque casters first, with the depth-only pipeline; then the alpha-masked
-                    // and blended ones, whose pipeline samples the base colour and discards.
-                    for masked in [false, true] {
-                        let (pipeline, layout) = match (&self.masked, masked) {
-                            (_, false) => (self.pipeline, self.layout),
-                            (Some(m), true) => (m.pipeline, m.layout),
-                            // No masked pipeline: no masked draws (`ensure_masked`).
-                            (None, true) => break,
-                        };
-                        let mut bound = false;
-                        for dr in casters.draws.iter().map(|&i| &scene.draws[i]) {
-                            if dr.alpha.tests_alpha_in_shadow() != masked {
-                                continue;
-                            }
-                            if !bound {
-                                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                                // Reversed-z: "away from the light" is towards smaller depth, so
-                                // the factor is negated. The constant bias is applied on the
-                                // receiver side, in texels.
-                                d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
-                                let buffers = [scene.positions.raw, scene.attributes.raw];
-                                let n = if masked { 2 } else { 1 };
-                                d.cmd_bind_vertex_buffers(cmd, 0, &buffers[..n], &[0, 0][..n]);
-                                bound = true;
-                            }
-                            if masked {
-                                d.cmd_bind_descriptor_sets(
-                                    cmd,
-                                    vk::PipelineBindPoint::GRAPHICS,
-                                    layout,
-                                    0,
-                                    &[scene.material_sets[dr.material]],
-                                    &[],
-                                );
-                            }
-                            let pc = ShadowImmediates {
-                                light_clip_from_world: *light_clip_from_world,
-                                world_from_model: dr.world_from_model,
-                            };
-                            let pc = bytemuck::bytes_of(&pc);
-                            scene.record_draw(d, cmd, layout, dr, eye, from, pc);
-                            drawn += 1;
-                        }
-                    }
+            if !self.caching {
+                drawn += self.draw_layer(cmd, scene, s, &t, &casters.draws, true);
+                continue;
+            }
+            let (statics, moving) = split_moving(scene, &casters.draws);
+            // With moving casters the static layer is cached over the whole square: the caster
+            // area follows the movers, the cache must not.
+            let side = casters.size.min(layer_side);
+            let square = vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: vk::Extent2D {
+                    width: side,
+                    height: side,
+                },
+            };
+            let cached_area = if moving.is_empty() { t.area } else { square };
+            let biases = (s.slope_bias, eye_near);
+            let key = LayerKey::new(light_clip_from_world, casters, cached_area, biases, statics);
+            match self.layers.plan(layer, key, !moving.is_empty()) {
+                LayerWork::Keep => {}
+                LayerWork::DrawStatic => {
+                    drawn += self.draw_layer(cmd, scene, s, &t, &casters.draws, true);
                 }
-                d.cmd_end_rendering(cmd);
+                LayerWork::FromCache => {
+                    self.copy_layer(cmd, layer, t.area, false);
+                    drawn += self.draw_layer(cmd, scene, s, &t, &moving, false);
+                }
+                LayerWork::FillCache => {
+                    let (statics, _) = split_moving(scene, &casters.draws);
+                    let whole = LayerTarget { area: square, ..t };
+                    drawn += self.draw_layer(cmd, scene, s, &whole, &statics, true);
+                    self.copy_layer(cmd, layer, square, true);
+                    drawn += self.draw_layer(cmd, scene, s, &t, &moving, false);
+                }
             }
         }
-        at.transition(d, cmd, Access::DepthFragmentSampled);
+        self.transition_map(cmd, Access::DepthFragmentSampled);
         self.ctx.end_label(cmd);
+        drawn
+    }
+
+    fn transition_map(&mut self, cmd: vk::CommandBuffer, to: Access) {
+        if let Some(at) = self.map_at.as_mut() {
+            at.transition(&self.ctx.device, cmd, to);
+        }
+    }
+
+    /// Makes the static-caster cache (same size, format and layers as the map).
+    fn ensure_cache(&mut self) -> Result<(), GpuError> {
+        let Some(map) = &self.map else { return Ok(()) };
+        if self.cache.is_some() {
+            return Ok(());
+        }
+        let image = Image::new_array(
+            &self.ctx,
+            "shadow cache",
+            map.format,
+            map.extent,
+            map.layer_views.len() as u32,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                | vk::ImageUsageFlags::TRANSFER_SRC
+                | vk::ImageUsageFlags::TRANSFER_DST,
+        )?;
+        let at = Attachment::of(&image);
+        self.cache = Some((image, at));
+        Ok(())
+    }
+
+    /// Copies `area` of layer `layer` from the map into the cache (`to_cache`) or back, and
+    /// leaves the map a depth attachment again.
+    fn copy_layer(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        layer: usize,
+        area: vk::Rect2D,
+        to_cache: bool,
+    ) {
+        let (Some(map), Some(map_at), Some((cache, cache_at))) =
+            (&self.map, self.map_at.as_mut(), self.cache.as_mut())
+        else {
+            return;
+        };
+        let d = &self.ctx.device;
+        let (src, dst) = if to_cache {
+            map_at.transition(d, cmd, Access::TransferSrc);
+            cache_at.transition(d, cmd, Access::TransferDst);
+            (map.raw, cache.raw)
+        } else {
+            cache_at.transition(d, cmd, Access::TransferSrc);
+            map_at.transition(d, cmd, Access::TransferDst);
+            (cache.raw, map.raw)
+        };
+        let sub = vk::ImageSubresourceLayers {
+            aspect_mask: map.aspect,
+            mip_level: 0,
+            base_array_layer: layer as u32,
+            layer_count: 1,
+        };
+        let at = vk::Offset3D {
+            x: area.offset.x,
+            y: area.offset.y,
+            z: 0,
+        };
+        let region = [vk::ImageCopy {
+            src_subresource: sub,
+            src_offset: at,
+            dst_subresource: sub,
+            dst_offset: at,
+            extent: vk::Extent3D {
+                width: area.extent.width,
+                height: area.extent.height,
+                depth: 1,
+            },
+        }];
+        unsafe {
+            d.cmd_copy_image(
+                cmd,
+                src,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+            )
+        };
+        map_at.transition(d, cmd, Access::DepthAttachment);
+    }
+
+    /// Draws `draws` of one layer into the map within the casters' area (cleared first when
+    /// `clear`, else drawn over what it holds): opaque casters first, with the depth-only
+    /// pipeline, then the alpha-masked and blended ones. Returns the draws recorded.
+    fn draw_layer(
+        &self,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        s: &ShadowSettings,
+        t: &LayerTarget,
+        draws: &[usize],
+        clear: bool,
+    ) -> usize {
+        let Some(map) = &self.map else { return 0 };
+        let d = &self.ctx.device;
+        let casters = t.casters;
+        let from = casters.light;
+        // A point or spot light's eye and its projection's near distance (clusters wholly
+        // nearer are not drawn); none for a directional light (outside everything).
+        let eye = match from {
+            Viewpoint::Eye(p) => Some((p, t.eye_near)),
+            Viewpoint::Along(_) => None,
+        };
+        let mut depth_attachment = depth_clear_attachment(t.view, false);
+        if !clear {
+            depth_attachment = depth_attachment.load_op(vk::AttachmentLoadOp::LOAD);
+        }
+        // Only the casters' area is cleared and drawn: lookups elsewhere never read the map.
+        let area = t.area;
+        let rendering = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .depth_attachment(&depth_attachment);
+        let mut drawn = 0;
+        unsafe {
+            d.cmd_begin_rendering(cmd, &rendering);
+            if !draws.is_empty() {
+                let side = casters.size.min(map.extent.width);
+                set_viewport(
+                    &self.ctx,
+                    cmd,
+                    vk::Extent2D {
+                        width: side,
+                        height: side,
+                    },
+                );
+                d.cmd_set_scissor(cmd, 0, &[area]);
+                d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
+                for masked in [false, true] {
+                    let (pipeline, layout) = match (&self.masked, masked) {
+                        (_, false) => (self.pipeline, self.layout),
+                        (Some(m), true) => (m.pipeline, m.layout),
+                        // No masked pipeline: no masked draws (`ensure_masked`).
+                        (None, true) => break,
+                    };
+                    let mut bound = false;
+                    for dr in draws.iter().map(|&i| &scene.draws[i]) {
+                        if dr.alpha.tests_alpha_in_shadow() != masked {
+                            continue;
+                        }
+                        if !bound {
+                            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                            // Reversed-z: "away from the light" is towards smaller depth, so
+                            // the factor is negated. The constant bias is applied on the
+                            // receiver side, in texels.
+                            d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
+                            let buffers = [scene.positions.raw, scene.attributes.raw];
+                            let n = if masked { 2 } else { 1 };
+                            d.cmd_bind_vertex_buffers(cmd, 0, &buffers[..n], &[0, 0][..n]);
+                            bound = true;
+                        }
+                        if masked {
+                            d.cmd_bind_descriptor_sets(
+                                cmd,
+                                vk::PipelineBindPoint::GRAPHICS,
+                                layout,
+                                0,
+                                &[scene.material_sets[dr.material]],
+                                &[],
+                            );
+                        }
+                        let pc = ShadowImmediates {
+                            light_clip_from_world: *t.light_clip_from_world,
+                            world_from_model: dr.world_from_model,
+                        };
+                        let pc = bytemuck::bytes_of(&pc);
+                        scene.record_draw(d, cmd, layout, dr, eye, from, pc);
+                        drawn += 1;
+                    }
+                }
+            }
+            d.cmd_end_rendering(cmd);
+        }
         drawn
     }
 }

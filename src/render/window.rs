@@ -142,6 +142,12 @@ impl WindowRenderer {
         Ok(r)
     }
 
+    /// Takes a new pose of the scene it was made from (`FrameCore::set_pose`); waits for the
+    /// frames in flight first.
+    pub fn set_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
+        self.core.set_pose(scene)
+    }
+
     /// The triangles drawn per frame.
     pub fn triangles(&self) -> usize {
         self.core.gpu.triangles

@@ -76,6 +76,7 @@ pub(super) fn check_references(path: &Path, json: &[u8]) -> Result<(), LoadError
     };
     check_asset_version(path, &v)?;
     check_images_and_textures(path, &v)?;
+    check_motion_references(path, &v, accessors)?;
     let meshes = v
         .get("meshes")
         .and_then(|m| m.as_array())
@@ -103,6 +104,86 @@ pub(super) fn check_references(path: &Path, json: &[u8]) -> Result<(), LoadError
             }
             if let Some(i) = prim.get("indices") {
                 check(i, &format!("{label} indices"))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Skins' joints and inverse bind matrices, nodes' skins, and animations' samplers, targets,
+/// paths and interpolations must name things that exist (the gltf crate unwraps them).
+fn check_motion_references(
+    path: &Path,
+    v: &serde_json::Value,
+    accessors: u64,
+) -> Result<(), LoadError> {
+    let list = |v: &'_ serde_json::Value, key: &str| -> Vec<serde_json::Value> {
+        v.get(key)
+            .and_then(|a| a.as_array())
+            .cloned()
+            .unwrap_or_default()
+    };
+    let nodes = count_of(v, "nodes");
+    let skins = count_of(v, "skins");
+    let index = |value: Option<&serde_json::Value>, n: u64, what: String| match value {
+        None => Ok(()),
+        Some(x) if x.as_u64().is_some_and(|i| i < n) => Ok(()),
+        Some(x) => Err(corrupt(path, format!("{what} is {x}, but there are {n}"))),
+    };
+    for (i, node) in list(v, "nodes").iter().enumerate() {
+        index(node.get("skin"), skins, format!("node {i}'s skin"))?;
+    }
+    for (i, skin) in list(v, "skins").iter().enumerate() {
+        index(
+            skin.get("inverseBindMatrices"),
+            accessors,
+            format!("skin {i}'s inverseBindMatrices"),
+        )?;
+        index(skin.get("skeleton"), nodes, format!("skin {i}'s skeleton"))?;
+        for j in list(skin, "joints") {
+            index(Some(&j), nodes, format!("a joint of skin {i}"))?;
+        }
+    }
+    for (a, anim) in list(v, "animations").iter().enumerate() {
+        let samplers = list(anim, "samplers");
+        for (k, s) in samplers.iter().enumerate() {
+            let what = format!("animation {a} sampler {k}");
+            index(s.get("input"), accessors, format!("{what}'s input"))?;
+            index(s.get("output"), accessors, format!("{what}'s output"))?;
+            if let Some(m) = s.get("interpolation") {
+                if !matches!(m.as_str(), Some("LINEAR" | "STEP" | "CUBICSPLINE")) {
+                    return Err(corrupt(
+                        path,
+                        format!("{what}: interpolation {m} is not glTF's"),
+                    ));
+                }
+            }
+        }
+        for (c, ch) in list(anim, "channels").iter().enumerate() {
+            let what = format!("animation {a} channel {c}");
+            index(
+                ch.get("sampler"),
+                samplers.len() as u64,
+                format!("{what}'s sampler"),
+            )?;
+            let target = ch.get("target");
+            index(
+                target.and_then(|t| t.get("node")),
+                nodes,
+                format!("{what}'s node"),
+            )?;
+            let p = target.and_then(|t| t.get("path"));
+            if !p
+                .and_then(|p| p.as_str())
+                .is_some_and(|p| matches!(p, "translation" | "rotation" | "scale" | "weights"))
+            {
+                return Err(corrupt(
+                    path,
+                    format!(
+                        "{what}: target path {} is not glTF's",
+                        p.unwrap_or(&serde_json::Value::Null)
+                    ),
+                ));
             }
         }
     }
@@ -283,6 +364,15 @@ pub(super) fn check_attribute_types(
     }
     if let Some(a) = prim.indices() {
         ok(&a, &[T::U8, T::U16, T::U32], &[D::Scalar], "indices")?;
+    }
+    // Morph target displacements: the readers take them as f32 vec3.
+    for t in prim.morph_targets() {
+        for a in [t.positions(), t.normals(), t.tangents()]
+            .into_iter()
+            .flatten()
+        {
+            ok(&a, &[T::F32], &[D::Vec3], "morph target")?;
+        }
     }
     Ok(())
 }

@@ -4,6 +4,7 @@
 //! is read, indices are checked against the vertex count, external files must resolve inside the
 //! model's folder, and any remaining panic inside the parser is turned into an error.
 
+use super::anim::load::{check_joint_ranges, read_rig};
 use super::gltf_input::{
     check_accessor, check_attribute_types, check_references, decode_image, json_part, read_uri,
 };
@@ -451,6 +452,10 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     let mut stack: Vec<(gltf::Node, Mat4, usize)> =
         roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     let mut visited = 0usize;
+    // What motion needs from the walk: each node's parent, and the nodes lights and cameras
+    // hang on.
+    let mut parents: Vec<Option<usize>> = vec![None; gltf.nodes().len()];
+    let (mut light_nodes, mut camera_nodes) = (Vec::new(), Vec::new());
     while let Some((node, parent, depth)) = stack.pop() {
         visited += 1;
         if depth > 256 || visited > 1_000_000 {
@@ -478,6 +483,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 gltf::camera::Projection::Perspective(p) => {
                     // Remove scale from the camera transform.
                     let (_, rot, pos) = world.to_scale_rotation_translation();
+                    camera_nodes.push(node.index());
                     scene.cameras.push(Camera {
                         world_from_view: Mat4::from_rotation_translation(rot, pos),
                         fov_y: p.yfov().clamp(0.01, 3.1),
@@ -523,6 +529,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                     );
                     0.0
                 });
+            light_nodes.push(node.index());
             scene.lights.push(Light {
                 kind,
                 position: pos,
@@ -539,13 +546,47 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             });
         }
         for c in node.children() {
+            parents[c.index()] = Some(node.index());
             stack.push((c, world, depth + 1));
         }
+    }
+    let rig = read_rig(
+        &mut scene,
+        &gltf,
+        &buffers,
+        &parents,
+        light_nodes,
+        camera_nodes,
+    );
+    if let Some(rig) = rig {
+        rest_pose(&mut scene, rig);
     }
     if scene.instances.is_empty() {
         scene.warn("SCENE_EMPTY", "", "the scene has no mesh instances");
     }
     Ok(scene)
+}
+
+/// Gives each instance of a deforming mesh past the first its own copy (each is posed on its
+/// own), checks joint ranges, and poses the scene at rest: skins applied and default morph
+/// weights, node transforms as the walk computed them.
+fn rest_pose(scene: &mut Scene, rig: crate::scene::anim::Rig) {
+    let mut used = vec![false; scene.meshes.len()];
+    for i in 0..scene.instances.len() {
+        let m = scene.instances[i].mesh;
+        let deforms = scene.meshes[m]
+            .primitives
+            .iter()
+            .any(|p| p.deform.is_some());
+        if deforms && std::mem::replace(&mut used[m], true) {
+            scene.meshes.push(scene.meshes[m].clone());
+            scene.instances[i].mesh = scene.meshes.len() - 1;
+        }
+    }
+    check_joint_ranges(scene, &rig);
+    let pose = rig.pose(&crate::scene::anim::Playing::Rest, 0.0);
+    scene.apply_pose(&rig, &pose, false);
+    scene.rig = Some(std::sync::Arc::new(rig));
 }
 
 /// The emitter size in a glTF light's `extras` (`{"light_size": S}`: degrees of angular
@@ -712,6 +753,7 @@ fn read_primitive(
             format!("{label}: {degenerate} zero-area triangles"),
         );
     }
+    let has_normals = prim.get(&gltf::Semantic::Normals).is_some();
     let normals: Vec<Vec3> = match reader.read_normals() {
         Some(it) => {
             let mut off_unit = 0usize;
@@ -807,6 +849,7 @@ fn read_primitive(
         }
         None => Vec::new(),
     };
+    let deform = super::anim::load::read_deform(scene, &reader, n, &at, &label);
     let material = prim.material().index().unwrap_or(default_material);
     let mut p = Primitive {
         positions,
@@ -818,6 +861,7 @@ fn read_primitive(
         has_uvs,
         colors,
         uvs1,
+        deform: deform.map(Box::new),
     };
     let wants_normal_map = scene.materials[material].normal_texture.is_some();
     match reader.read_tangents() {
@@ -872,6 +916,12 @@ fn read_primitive(
         m.name = format!("{} (no UVs)", m.name);
         scene.materials.push(m);
         p.material = scene.materials.len() - 1;
+    }
+    if let Some(d) = p.deform.as_deref_mut() {
+        d.positions = p.positions.clone();
+        d.normals = p.normals.clone();
+        d.tangents = p.tangents.clone();
+        d.normals_computed = !has_normals;
     }
     Ok(Some(p))
 }

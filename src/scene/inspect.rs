@@ -438,6 +438,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                    "nodes": nodes.len(), "extensions_used": used.len(),
                    "gpu_bytes": {"geometry": geometry_bytes, "textures": texture_bytes}},
         "scale": scale,
+        "motion": super::anim::report::motion_report(&doc, scene),
         "findings": findings,
     }))
 }

@@ -1,6 +1,7 @@
 //! The renderer-agnostic CPU scene: meshes, materials, textures, lights, cameras and instances,
 //! loaded from glTF 2.0 or built in code. Repairs (normals, tangents) happen here, with warnings.
 
+pub mod anim;
 pub mod clusters;
 pub mod demo;
 mod gltf_input;

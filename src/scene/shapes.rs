@@ -20,6 +20,7 @@ fn prim(
         has_uvs: true,
         colors: Vec::new(),
         uvs1: Vec::new(),
+        deform: None,
     }
 }
 

@@ -147,6 +147,29 @@ pub fn town_scene() -> Scene {
     s
 }
 
+/// The town with one moving caster: a person-sized box (0.5 × 1.8 × 0.3 m) walking across the
+/// street in front of camera 0, from (−3, 0, −4) to (3, 0, −12) in 4 s and back by 8 s
+/// (animation "move"): what shadow caching is measured on.
+pub fn town_mover_scene() -> Scene {
+    let mut s = town_scene();
+    s.name = "town-mover".into();
+    let walker = cuboid(Vec3::new(0.25, 0.9, 0.15));
+    // The box's origin is its centre: lift it so it stands on the ground.
+    let up = Vec3::Y * 0.9;
+    crate::scene::anim::add_mover(
+        &mut s,
+        "walker",
+        walker,
+        colored(Vec3::new(0.2, 0.4, 0.8), 1.0),
+        &[
+            (0.0, Vec3::new(-3.0, 0.0, -4.0) + up),
+            (4.0, Vec3::new(3.0, 0.0, -12.0) + up),
+            (8.0, Vec3::new(-3.0, 0.0, -4.0) + up),
+        ],
+    );
+    s
+}
+
 /// Long shadows under a low sun: a 60 m ground, two rows of thin posts, spheres and crates, lit
 /// by a sun 6° above the horizon (shadows 10× longer than their casters, receivers at grazing
 /// incidence: where acne, peter-panning and stretched texels show first). Camera 0 looks along
@@ -464,6 +487,7 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "lux-yard" => Some(lux_yard_scene()),
         "double-sided" => Some(double_sided_scene()),
         "town" => Some(town_scene()),
+        "town-mover" => Some(town_mover_scene()),
         "grazing" => Some(grazing_scene()),
         "stability" => Some(stability_scene()),
         _ => match name.strip_prefix("spheres:").map(str::parse::<u32>) {

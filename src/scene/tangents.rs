@@ -102,8 +102,12 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
         p.tangents = p.normals.iter().map(|n| fallback_tangent(*n)).collect();
         return false;
     }
-    // Weld identical (position, normal, uvs, tangent, colour) vertices back together.
-    let mut map: HashMap<[u32; 18], u32> = HashMap::new();
+    // Weld identical (position, normal, uvs, tangent, colour) vertices back together; a
+    // primitive that skins or morphs welds only corners of the same source vertex (two vertices
+    // alike at rest may be bound to different joints or move apart under a target).
+    let keep_sources = p.deform.is_some();
+    let mut sources: Vec<u32> = Vec::new();
+    let mut map: HashMap<[u32; 19], u32> = HashMap::new();
     let (mut pos, mut nor, mut uv, mut tan, mut idx) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut col, mut uv1) = (Vec::new(), Vec::new());
@@ -131,8 +135,10 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
             g.colors[k].w.to_bits(),
             g.uvs1[k].x.to_bits(),
             g.uvs1[k].y.to_bits(),
+            if keep_sources { p.indices[k] } else { 0 },
         ];
         let id = *map.entry(key).or_insert_with(|| {
+            sources.push(p.indices[k]);
             pos.push(g.positions[k]);
             nor.push(g.normals[k]);
             uv.push(g.uvs[k]);
@@ -150,6 +156,9 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
     p.colors = if colored { col } else { Vec::new() };
     p.uvs1 = if second_set { uv1 } else { Vec::new() };
     p.indices = idx;
+    if let Some(d) = p.deform.as_deref_mut() {
+        d.remap(&sources);
+    }
     true
 }
 
@@ -186,6 +195,7 @@ mod tests {
             has_uvs: true,
             colors: Vec::new(),
             uvs1: Vec::new(),
+            deform: None,
         }
     }
 

@@ -25,6 +25,9 @@ pub struct Primitive {
     pub colors: Vec<Vec4>,
     /// Second texture coordinates (TEXCOORD_1); empty: none (a slot reading set 1 reads set 0).
     pub uvs1: Vec<Vec2>,
+    /// For a primitive that skins or morphs: its undeformed data, influences and targets
+    /// (`positions`, `normals` and `tangents` then hold the current pose).
+    pub deform: Option<Box<super::anim::Deform>>,
 }
 
 impl Primitive {
@@ -380,6 +383,9 @@ pub struct Scene {
     pub image_textures: Vec<Option<usize>>,
     /// For a loaded glTF: every node's name (empty where it has none), by node index.
     pub node_names: Vec<String>,
+    /// For a loaded glTF with animations, skins or morph targets: what moves and how
+    /// ([`super::anim`]); the scene as loaded holds its rest pose.
+    pub rig: Option<std::sync::Arc<super::anim::Rig>>,
 }
 
 impl Scene {

@@ -116,6 +116,39 @@ pub const FINDING_CODES: &[(&str, &str, &str)] = &[
     ),
     ("UNUSED_MATERIAL", "info", "a material no primitive uses"),
     ("UNUSED_TEXTURE", "info", "a texture no material uses"),
+    (
+        "ANIMATION_CHANNEL_INVALID",
+        "warning",
+        "an animation channel with times not strictly increasing, non-finite keys, an output \
+         count that does not match its inputs or accessor types glTF forbids is ignored",
+    ),
+    (
+        "SKIN_INVALID",
+        "warning",
+        "a skin without joints, with too many, or with inverse bind matrices of the wrong count \
+         or non-finite: its meshes are drawn unskinned",
+    ),
+    (
+        "SKIN_WEIGHTS_NOT_NORMALIZED",
+        "warning",
+        "vertex weights that do not sum to 1 were normalised (a zero sum binds the vertex to the \
+         skin's first joint)",
+    ),
+    (
+        "SKIN_JOINT_OUT_OF_RANGE",
+        "warning",
+        "influences naming joints past the skin's joint count lose their weight",
+    ),
+    (
+        "SKIN_MISSING",
+        "warning",
+        "a primitive with JOINTS_0 on a node without a skin is drawn as stored",
+    ),
+    (
+        "MORPH_TARGET_INVALID",
+        "warning",
+        "a morph target with a wrong count or non-finite displacements is ignored",
+    ),
 ];
 
 /// The severity of `code` (`FINDING_CODES`; "warning" for an unknown code).

@@ -3,7 +3,8 @@
 //! absent indices, triangle strips and fans, sparse accessors, a node hierarchy with non-uniform
 //! and negative scale, normal-mapped materials with and without stored tangents, every texture
 //! slot, samplers, KHR_lights_punctual (directional, spot, point), KHR_materials_unlit, an
-//! alpha-masked and a double-sided material, and two cameras.
+//! alpha-masked and a double-sided material, two cameras, and the animated models of
+//! `animated` (a skin, every interpolation, morph targets).
 
 use super::gltf_builder::{png, Builder, Container, U16, U32, U8};
 use glam::{Quat, Vec3};
@@ -22,6 +23,7 @@ pub fn write_corpus(dir: &Path) -> Vec<PathBuf> {
         normal_mapped(dir),
         lights_cameras_materials(dir),
     ];
+    out.extend(super::animated::write_animated(dir));
     out.sort();
     out
 }

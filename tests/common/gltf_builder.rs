@@ -41,6 +41,8 @@ pub struct Builder {
     roots: Vec<usize>,
     cameras: Vec<Value>,
     lights: Vec<Value>,
+    skins: Vec<Value>,
+    animations: Vec<Value>,
     extensions_used: Vec<&'static str>,
 }
 
@@ -173,6 +175,11 @@ impl Builder {
         self.meshes.len() - 1
     }
 
+    /// The JSON of mesh `i` (to add `weights`, say).
+    pub fn mesh_mut(&mut self, i: usize) -> &mut Value {
+        &mut self.meshes[i]
+    }
+
     /// A node from its JSON object; `root` nodes are listed in the scene.
     pub fn node(&mut self, n: Value, root: bool) -> usize {
         self.nodes.push(n);
@@ -180,6 +187,42 @@ impl Builder {
             self.roots.push(self.nodes.len() - 1);
         }
         self.nodes.len() - 1
+    }
+
+    /// A skin from its JSON object (`joints`, `inverseBindMatrices`).
+    pub fn skin(&mut self, s: Value) -> usize {
+        self.skins.push(s);
+        self.skins.len() - 1
+    }
+
+    /// An animation from its JSON object (`channels`, `samplers`).
+    pub fn animation(&mut self, a: Value) -> usize {
+        self.animations.push(a);
+        self.animations.len() - 1
+    }
+
+    /// A JOINTS_0 accessor (u16 VEC4) over `joints`.
+    pub fn joints(&mut self, joints: &[[u16; 4]]) -> usize {
+        let view = self.view(bytemuck::cast_slice(joints), Some(34962));
+        self.accessors.push(
+            json!({"bufferView": view, "componentType": U16, "count": joints.len(), "type": "VEC4"}),
+        );
+        self.accessors.len() - 1
+    }
+
+    /// A float accessor without a vertex target (animation inputs and outputs, inverse bind
+    /// matrices), with min/max for scalars (glTF requires them on animation inputs).
+    pub fn data(&mut self, data: &[f32], comps: usize, ty: &str) -> usize {
+        let view = self.view(bytemuck::cast_slice(data), None);
+        let mut a = json!({"bufferView": view, "componentType": F32, "count": data.len() / comps, "type": ty});
+        if ty == "SCALAR" && !data.is_empty() {
+            let lo = data.iter().copied().fold(f32::MAX, f32::min);
+            let hi = data.iter().copied().fold(f32::MIN, f32::max);
+            a["min"] = json!([lo]);
+            a["max"] = json!([hi]);
+        }
+        self.accessors.push(a);
+        self.accessors.len() - 1
     }
 
     /// A perspective camera.
@@ -257,6 +300,8 @@ impl Builder {
             ("samplers", self.samplers),
             ("cameras", self.cameras),
             ("images", images),
+            ("skins", self.skins),
+            ("animations", self.animations),
         ] {
             if !v.is_empty() {
                 doc[key] = Value::Array(v);

@@ -2,6 +2,7 @@
 //! image statistics and artifact output.
 #![allow(dead_code)]
 
+pub mod animated;
 pub mod corpus;
 pub mod gltf_builder;
 

@@ -71,6 +71,7 @@ fn one_triangle() -> Scene {
         has_uvs: true,
         colors: Vec::new(),
         uvs1: Vec::new(),
+        deform: None,
     };
     add_object(
         &mut s,

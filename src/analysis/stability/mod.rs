@@ -7,12 +7,16 @@
 //!   trade-off; and, on the built-in scene, the contact gap at a thin wall's base in texels.
 //! - [`shimmer`]: a cubic Bézier flythrough; the fraction of fixed world points whose shadow
 //!   classification flips between consecutive frames, per shadow method.
+//! - [`motion`]: a still camera over a moving caster (the scene's animation, or an added box
+//!   crossing the cascades, rising to the light and leaving the bounds) and under a moving sun;
+//!   the fraction of still points whose classification flips while their exact visibility holds.
 //! - [`precision`]: the scene translated to 10⁰…10⁶ units and scaled 10⁻³…10⁴.
 //! - [`degenerate`]: degenerate lights, cameras and scenes: each must render with no validation
 //!   message, finite depth and its documented result.
 
 pub mod degenerate;
 pub mod light;
+pub mod motion;
 pub mod precision;
 pub mod report;
 pub mod shimmer;
@@ -326,6 +330,8 @@ pub struct StabilityOptions {
     pub size: (u32, u32),
     /// Fewer angles, frames and cases (for tests and a first look).
     pub quick: bool,
+    /// The animation the motion probe's moving caster plays (None: the scene's first).
+    pub animation: Option<usize>,
 }
 
 impl Default for StabilityOptions {
@@ -333,6 +339,7 @@ impl Default for StabilityOptions {
         Self {
             size: (640, 360),
             quick: false,
+            animation: None,
         }
     }
 }
