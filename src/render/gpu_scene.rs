@@ -551,7 +551,8 @@ impl GpuScene {
     /// materials; positions, normals, tangents and transforms changed by
     /// `Scene::apply_pose`): rewrites the deformed primitives' vertices and every draw's
     /// transform and bounds. Waits for the device first. Deformed primitives lose their cluster
-    /// and flat-caster culling, which were computed for another shape.
+    /// and flat-caster culling, which were computed for another shape; closed-mesh culling stays
+    /// (a pose keeps the topology).
     pub fn update_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
         unsafe { self.ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
         let attr_size = std::mem::size_of::<VertexAttributes>();
@@ -567,9 +568,12 @@ impl GpuScene {
                 let attrs: Vec<VertexAttributes> = vertex_attributes(p).collect();
                 self.attributes
                     .write(base * attr_size, bytemuck::cast_slice(&attrs))?;
+                // Cluster cones and a flat caster's plane belong to the shape they were
+                // computed from; closedness is topology, which a pose does not change (culling
+                // back faces of a closed mesh assumes it does not pass through itself, posed or
+                // not).
                 r.bounds = p.bounds();
                 r.clusters.1 = 0;
-                r.closed = false;
                 r.plane = None;
             }
         }

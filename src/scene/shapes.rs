@@ -218,15 +218,23 @@ pub fn colored(rgb: Vec3, roughness: f32) -> Material {
     }
 }
 
-/// Adds a grey ground plane just under the scene's bounds, wide enough to catch its shadows
-/// (5× the bounds' diagonal), for viewing models that have none.
+/// Adds a grey ground plane just under the scene's bounds (for an animated scene, under the
+/// lowest point any animation reaches), wide enough to catch its shadows (5× the bounds'
+/// diagonal), for viewing models that have none.
 pub fn add_ground(scene: &mut Scene) {
     let b = scene.bounds();
     if b.is_empty() {
         return;
     }
     let size = (b.diagonal() * 5.0).max(1e-3);
-    let y = b.min.y - b.diagonal() * 1e-3;
+    // Under the lowest point the model reaches in any of its animations, so a foot that dips
+    // below the rest pose's lowest point does not pass through the ground.
+    let low = if scene.moves() {
+        scene.motion_bounds(32).min.y
+    } else {
+        b.min.y
+    };
+    let y = low - b.diagonal() * 1e-3;
     let c = b.center();
     scene.framing.get_or_insert(b);
     add_object(

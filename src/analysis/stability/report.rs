@@ -267,6 +267,16 @@ pub fn run(
     Ok(r)
 }
 
+/// The cells of a flip series: mean and worst flipped fraction, mean points per frame.
+fn flip_cells(mean: f64, max: f64, points: &[usize]) -> [String; 3] {
+    let per_frame = points.iter().sum::<usize>() / points.len().max(1);
+    [
+        format!("{mean:.2e}"),
+        format!("{max:.2e}"),
+        per_frame.to_string(),
+    ]
+}
+
 fn pct(x: f64) -> String {
     format!("{:.4} %", 100.0 * x)
 }
@@ -841,14 +851,10 @@ pub fn markdown(r: &StabilityReport) -> String {
         "mean finest texel",
     ]);
     for s in &r.shimmer {
-        let pts = s.points.iter().sum::<usize>() / s.points.len().max(1);
-        t.row(vec![
-            s.method.clone(),
-            format!("{:.2e}", s.mean_fraction),
-            format!("{:.2e}", s.max_fraction),
-            pts.to_string(),
-            format!("{:.3e}", s.mean_texel),
-        ]);
+        let mut row = vec![s.method.clone()];
+        row.extend(flip_cells(s.mean_fraction, s.max_fraction, &s.points));
+        row.push(format!("{:.3e}", s.mean_texel));
+        t.row(row);
     }
     m += &t.render(true);
     let _ = writeln!(
@@ -865,15 +871,9 @@ pub fn markdown(r: &StabilityReport) -> String {
         "points per frame",
     ]);
     for s in &r.motion {
-        let pts = s.points.iter().sum::<usize>() / s.points.len().max(1);
-        t.row(vec![
-            s.probe.clone(),
-            s.mover.clone(),
-            s.method.clone(),
-            format!("{:.2e}", s.mean_fraction),
-            format!("{:.2e}", s.max_fraction),
-            pts.to_string(),
-        ]);
+        let mut row = vec![s.probe.clone(), s.mover.clone(), s.method.clone()];
+        row.extend(flip_cells(s.mean_fraction, s.max_fraction, &s.points));
+        t.row(row);
     }
     m += &t.render(true);
     let _ = writeln!(

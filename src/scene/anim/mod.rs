@@ -340,6 +340,57 @@ impl Scene {
             .collect()
     }
 
+    /// World bounds of the scene over its motion: its current bounds united with those of every
+    /// animation posed at `samples` evenly spaced times (the current bounds alone for a scene
+    /// that does not move). What a ground under an animated model is placed by.
+    pub fn motion_bounds(&self, samples: usize) -> crate::math::Aabb {
+        let mut b = self.bounds();
+        let Some(rig) = self.rig.as_deref() else {
+            return b;
+        };
+        for (i, a) in rig.animations.iter().enumerate() {
+            let playing = Playing::One(i);
+            let d = a.duration();
+            for k in 0..samples.max(1) {
+                let t = d * k as f32 / (samples.max(2) - 1) as f32;
+                b = b.union(&self.posed_bounds(rig, &rig.pose(&playing, t)));
+            }
+        }
+        b
+    }
+
+    /// World bounds of the instances in `pose`, without changing the scene.
+    fn posed_bounds(&self, rig: &Rig, pose: &Pose) -> crate::math::Aabb {
+        let mut b = crate::math::Aabb::EMPTY;
+        for inst in &self.instances {
+            let node = inst.node.filter(|&n| n < rig.nodes.len());
+            let skin = node
+                .and_then(|n| rig.nodes[n].skin)
+                .and_then(|s| pose.joints.get(s));
+            for p in &self.meshes[inst.mesh].primitives {
+                let Some(n) = node else {
+                    b = b.union(&p.bounds().transformed(&inst.world_from_model));
+                    continue;
+                };
+                match p.deform.as_deref() {
+                    Some(d) => {
+                        let joints = skin.map(|j| &j[..]).filter(|_| d.skinned());
+                        let posed = deform(d, &pose.weights[n], joints, &p.indices);
+                        let pb = crate::math::Aabb::from_points(posed.positions);
+                        let m = if joints.is_some() {
+                            Mat4::IDENTITY
+                        } else {
+                            pose.world[n]
+                        };
+                        b = b.union(&pb.transformed(&m));
+                    }
+                    None => b = b.union(&p.bounds().transformed(&pose.world[n])),
+                }
+            }
+        }
+        b
+    }
+
     /// Poses the scene at time `t` of `playing` (no-op for a scene without a rig).
     pub fn pose_at(&mut self, playing: &Playing, t: f32) {
         if let Some(rig) = self.rig.clone() {

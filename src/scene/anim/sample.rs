@@ -282,26 +282,20 @@ mod tests {
     #[test]
     fn linear_rotation_takes_the_shorter_arc() {
         // 0° to 270° about Y stored as q(270°) = -q(-90°): the shorter arc goes through -45°.
-        let a = Quat::IDENTITY;
-        let b = Quat::from_rotation_y(270f32.to_radians());
-        let k = keys(
-            Interpolation::Linear,
-            &[0.0, 1.0],
-            &[a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w],
-            4,
-        );
+        let turn = |b: Quat| {
+            let values: Vec<f32> = Quat::IDENTITY
+                .to_array()
+                .into_iter()
+                .chain(b.to_array())
+                .collect();
+            keys(Interpolation::Linear, &[0.0, 1.0], &values, 4)
+        };
+        let k = turn(Quat::from_rotation_y(270f32.to_radians()));
         let mid = k.sample_rotation(0.5);
         let want = Quat::from_rotation_y((-45f32).to_radians());
         assert!(mid.dot(want).abs() > 1.0 - 1e-6, "{mid:?} vs {want:?}");
         // A quarter of the way along 0° → 90°: 22.5°, not a normalised lerp.
-        let b = Quat::from_rotation_x(90f32.to_radians());
-        let k = keys(
-            Interpolation::Linear,
-            &[0.0, 1.0],
-            &[a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w],
-            4,
-        );
-        let q = k.sample_rotation(0.25);
+        let q = turn(Quat::from_rotation_x(90f32.to_radians())).sample_rotation(0.25);
         let (axis, angle) = q.to_axis_angle();
         assert!((angle - 22.5f32.to_radians()).abs() < 1e-5, "{angle}");
         assert!(axis.abs_diff_eq(glam::Vec3::X, 1e-5));
