@@ -393,11 +393,11 @@ fn build_draws(
     scene: &Scene,
     ranges: &[Vec<PrimitiveRange>],
     origin: glam::Vec3,
+    moving: &[bool],
 ) -> (Vec<Draw>, usize, Aabb) {
     let mut draws = Vec::new();
     let mut triangles = 0;
     let mut bounds = Aabb::EMPTY;
-    let moving = scene.moving_instances();
     for (ii, inst) in scene.instances.iter().enumerate() {
         let world_from_model = crate::scene::rebased(inst.world_from_model, origin);
         for (pi, r) in ranges[inst.mesh].iter().enumerate() {
@@ -440,7 +440,7 @@ fn build_draws(
                     && mat.is_none_or(|m| {
                         m.alpha_mode == AlphaMode::Opaque && reads_texcoord0_only(m)
                     }),
-                moving: moving[ii],
+                moving: moving.get(ii).copied().unwrap_or(false),
             });
         }
     }
@@ -477,6 +477,9 @@ pub struct GpuScene {
     ranges: Vec<Vec<PrimitiveRange>>,
     /// What the draws' world coordinates are relative to.
     origin: glam::Vec3,
+    /// Per instance: whether it can move between poses (`Scene::moving_instances`, fixed by
+    /// the rig).
+    moving: Vec<bool>,
     pool: vk::DescriptorPool,
     /// Destroyed after the pool (fields drop after `Drop::drop`).
     _samplers: SamplerCache,
@@ -577,7 +580,8 @@ impl GpuScene {
                 r.plane = None;
             }
         }
-        let (draws, triangles, bounds) = build_draws(scene, &self.ranges, self.origin);
+        let (draws, triangles, bounds) =
+            build_draws(scene, &self.ranges, self.origin, &self.moving);
         self.draws = draws;
         self.triangles = triangles;
         self.bounds = bounds;
@@ -666,7 +670,8 @@ impl GpuScene {
             }
             ranges.push(r);
         }
-        let (draws, triangles, bounds) = build_draws(scene, &ranges, origin);
+        let moving = scene.moving_instances();
+        let (draws, triangles, bounds) = build_draws(scene, &ranges, origin, &moving);
         let mut pipeline_keys: Vec<(usize, AlphaDraw)> =
             draws.iter().map(|d| (d.material_bits, d.alpha)).collect();
         pipeline_keys.sort_unstable();
@@ -848,6 +853,7 @@ impl GpuScene {
             pipeline_keys,
             ranges,
             origin,
+            moving,
             pool,
             _samplers: samplers,
             _material_buffers: material_buffers,

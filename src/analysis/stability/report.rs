@@ -267,6 +267,16 @@ pub fn run(
     Ok(r)
 }
 
+/// A flip series' chart points: (frame, flipped fraction of that frame's points).
+fn per_frame(points: &[usize], flipped: &[usize]) -> Vec<(f64, f64)> {
+    points
+        .iter()
+        .zip(flipped)
+        .enumerate()
+        .map(|(i, (&n, &f))| ((i + 1) as f64, super::fraction(f, n)))
+        .collect()
+}
+
 /// The cells of a flip series: mean and worst flipped fraction, mean points per frame.
 fn flip_cells(mean: f64, max: f64, points: &[usize]) -> [String; 3] {
     let per_frame = points.iter().sum::<usize>() / points.len().max(1);
@@ -612,13 +622,7 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
                 .iter()
                 .map(|s| Series {
                     label: s.method.clone(),
-                    points: s
-                        .points
-                        .iter()
-                        .zip(&s.flipped)
-                        .enumerate()
-                        .map(|(i, (&n, &f))| ((i + 1) as f64, super::fraction(f, n)))
-                        .collect(),
+                    points: per_frame(&s.points, &s.flipped),
                 })
                 .collect(),
             thresholds: vec![("bound with snapping".into(), SHIMMER_BOUND)],
@@ -641,13 +645,7 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
                 .iter()
                 .map(|s| Series {
                     label: format!("{} ({}), {}", s.probe, s.mover, s.method),
-                    points: s
-                        .points
-                        .iter()
-                        .zip(&s.flipped)
-                        .enumerate()
-                        .map(|(i, (&n, &f))| ((i + 1) as f64, super::fraction(f, n)))
-                        .collect(),
+                    points: per_frame(&s.points, &s.flipped),
                 })
                 .collect(),
             thresholds: vec![
