@@ -72,10 +72,7 @@ fn finish_context(ctx: std::sync::Arc<Context>) -> anyhow::Result<()> {
 fn render_sequence(a: &RenderArgs, frames: u32) -> anyhow::Result<()> {
     let mut scene = load_scene(a.scene.as_ref(), &a.view)?;
     // Without --time or --animation a sequence plays the first animation from 0.
-    let first = match scene.rig.as_deref() {
-        Some(r) if !r.animations.is_empty() => umbra::scene::anim::Playing::One(0),
-        _ => umbra::scene::anim::Playing::Rest,
-    };
+    let first = umbra::scene::anim::Playing::first(scene.rig.as_deref());
     let (playing, t0) = app::cli::playing(&scene, &a.view)?.unwrap_or((first, 0.0));
     // Every name first, so a bad pattern fails before any rendering.
     let paths = (0..frames)

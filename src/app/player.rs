@@ -39,11 +39,10 @@ impl Player {
                 p.playing = playing;
                 p.time = t;
             }
-            None if !anims.is_empty() => {
-                p.playing = Playing::One(0);
-                p.paused = false;
+            None => {
+                p.playing = Playing::first(rig);
+                p.paused = p.playing == Playing::Rest;
             }
-            None => {}
         }
         p
     }

@@ -408,16 +408,16 @@ impl ShadowPass {
         } else {
             views
         };
-        let layer_views = self
-            .map
-            .as_ref()
-            .map_or(Vec::new(), |m| m.layer_views.clone());
         let layer_side = self.map.as_ref().map_or(1, |m| m.extent.width);
         self.ctx.begin_label(cmd, "shadow depth pass");
         self.transition_map(cmd, Access::DepthAttachment);
         let mut drawn = 0;
         for (layer, (light_clip_from_world, casters)) in views.iter().enumerate() {
-            let Some(&view) = layer_views.get(layer) else {
+            let Some(view) = self
+                .map
+                .as_ref()
+                .and_then(|m| m.layer_views.get(layer).copied())
+            else {
                 break;
             };
             let t = LayerTarget {
@@ -444,7 +444,13 @@ impl ShadowPass {
             };
             let cached_area = if moving.is_empty() { t.area } else { square };
             let biases = (s.slope_bias, eye_near);
-            let key = LayerKey::new(light_clip_from_world, casters, cached_area, biases, statics);
+            let key = LayerKey::new(
+                light_clip_from_world,
+                casters,
+                cached_area,
+                biases,
+                statics.clone(),
+            );
             match self.layers.plan(layer, key, !moving.is_empty()) {
                 LayerWork::Keep => {}
                 LayerWork::DrawStatic => {
@@ -455,7 +461,6 @@ impl ShadowPass {
                     drawn += self.draw_layer(cmd, scene, s, &t, &moving, false);
                 }
                 LayerWork::FillCache => {
-                    let (statics, _) = split_moving(scene, &casters.draws);
                     let whole = LayerTarget { area: square, ..t };
                     drawn += self.draw_layer(cmd, scene, s, &whole, &statics, true);
                     self.copy_layer(cmd, layer, square, true);

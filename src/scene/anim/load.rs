@@ -78,6 +78,23 @@ where
 }
 
 fn normalise_weights(scene: &mut Scene, d: &mut Deform, at: &str, label: &str) {
+    let (off, zero) = renormalise(d);
+    if off > 0 || zero > 0 {
+        scene.warn(
+            "SKIN_WEIGHTS_NOT_NORMALIZED",
+            format!("{at}/attributes/WEIGHTS_0"),
+            format!(
+                "{label}: {off} vertices' weights do not sum to 1 (normalised), {zero} sum to 0 \
+                 (bound to the skin's first joint)"
+            ),
+        );
+    }
+}
+
+/// Scales each vertex's influences to sum 1; a vertex whose weights sum to 0 is bound wholly to
+/// the skin's first joint. Returns how many vertices' sums were off by more than 1 % and how
+/// many were 0.
+fn renormalise(d: &mut Deform) -> (usize, usize) {
     let s = d.sets;
     let (mut off, mut zero) = (0usize, 0usize);
     for v in 0..d.weights.len() / s {
@@ -97,16 +114,7 @@ fn normalise_weights(scene: &mut Scene, d: &mut Deform, at: &str, label: &str) {
             *w /= sum;
         }
     }
-    if off > 0 || zero > 0 {
-        scene.warn(
-            "SKIN_WEIGHTS_NOT_NORMALIZED",
-            format!("{at}/attributes/WEIGHTS_0"),
-            format!(
-                "{label}: {off} vertices' weights do not sum to 1 (normalised), {zero} sum to 0 \
-                 (bound to the skin's first joint)"
-            ),
-        );
-    }
+    (off, zero)
 }
 
 /// Checks an animation sampler's accessors before the gltf crate's readers, which assume glTF's
@@ -360,16 +368,7 @@ pub fn check_joint_ranges(scene: &mut Scene, rig: &Rig) {
                 }
             }
             if bad > 0 {
-                let s = d.sets;
-                for v in 0..d.weights.len() / s {
-                    let run = &mut d.weights[v * s..(v + 1) * s];
-                    let sum: f32 = run.iter().flatten().sum();
-                    if sum > 0.0 {
-                        run.iter_mut().flatten().for_each(|w| *w /= sum);
-                    } else {
-                        run[0] = [1.0, 0.0, 0.0, 0.0];
-                    }
-                }
+                renormalise(d);
                 findings.push((
                     "SKIN_JOINT_OUT_OF_RANGE",
                     format!("/nodes/{node}"),

@@ -121,6 +121,14 @@ pub enum Playing {
 }
 
 impl Playing {
+    /// What plays when nothing is chosen: the first animation, or the rest pose without one.
+    pub fn first(rig: Option<&Rig>) -> Self {
+        match rig {
+            Some(r) if !r.animations.is_empty() => Playing::One(0),
+            _ => Playing::Rest,
+        }
+    }
+
     /// Parses `--animation`: an index, a name, or `all`; the error names the choices.
     pub fn parse(spec: &str, rig: Option<&Rig>) -> Result<Self, String> {
         let anims = rig.map_or(&[][..], |r| &r.animations[..]);
@@ -348,44 +356,18 @@ impl Scene {
         let Some(rig) = self.rig.as_deref() else {
             return b;
         };
+        // The geometry alone is posed (no textures copied).
+        let mut posed = Scene {
+            meshes: self.meshes.clone(),
+            instances: self.instances.clone(),
+            ..Default::default()
+        };
         for (i, a) in rig.animations.iter().enumerate() {
-            let playing = Playing::One(i);
             let d = a.duration();
             for k in 0..samples.max(1) {
                 let t = d * k as f32 / (samples.max(2) - 1) as f32;
-                b = b.union(&self.posed_bounds(rig, &rig.pose(&playing, t)));
-            }
-        }
-        b
-    }
-
-    /// World bounds of the instances in `pose`, without changing the scene.
-    fn posed_bounds(&self, rig: &Rig, pose: &Pose) -> crate::math::Aabb {
-        let mut b = crate::math::Aabb::EMPTY;
-        for inst in &self.instances {
-            let node = inst.node.filter(|&n| n < rig.nodes.len());
-            let skin = node
-                .and_then(|n| rig.nodes[n].skin)
-                .and_then(|s| pose.joints.get(s));
-            for p in &self.meshes[inst.mesh].primitives {
-                let Some(n) = node else {
-                    b = b.union(&p.bounds().transformed(&inst.world_from_model));
-                    continue;
-                };
-                match p.deform.as_deref() {
-                    Some(d) => {
-                        let joints = skin.map(|j| &j[..]).filter(|_| d.skinned());
-                        let posed = deform(d, &pose.weights[n], joints, &p.indices);
-                        let pb = crate::math::Aabb::from_points(posed.positions);
-                        let m = if joints.is_some() {
-                            Mat4::IDENTITY
-                        } else {
-                            pose.world[n]
-                        };
-                        b = b.union(&pb.transformed(&m));
-                    }
-                    None => b = b.union(&p.bounds().transformed(&pose.world[n])),
-                }
+                posed.apply_pose(rig, &rig.pose(&Playing::One(i), t), true);
+                b = b.union(&posed.bounds());
             }
         }
         b
