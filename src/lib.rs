@@ -1,11 +1,11 @@
 //! umbra: a real-time shadow-mapping raster engine on Vulkan.
 //!
-//! Layers, in one direction only: [`math`] → [`scene`] → [`gpu`] → [`render`], with the CPU
-//! ray-cast [`reference`] beside them (feature `reference`).
+//! Layers, in one direction only: [`math`] → [`scene`] → [`gpu`] → [`plan`] → [`render`]. The
+//! CPU ray-cast reference, the metrics and the sweep live in the `umbra-lab` crate beside it, and
+//! the command line and viewer in `umbra-cli`; this crate depends on neither.
 //!
-//! The crate root re-exports what an offscreen image test needs. With
-//! `default-features = false` umbra builds without the command line, the viewer and the
-//! reference (no clap, winit, rayon or nv-flip).
+//! The crate root re-exports what an offscreen image test needs. Feature `viewer` (off by
+//! default) adds the window renderer.
 //!
 //! Render a frame offscreen (this example runs in the test suite, on lavapipe, with validation):
 //!
@@ -27,13 +27,10 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-#[cfg(feature = "sweep")]
-pub mod analysis;
 pub mod gpu;
 pub mod math;
 pub(crate) mod parallel;
-#[cfg(feature = "reference")]
-pub mod reference;
+pub mod plan;
 pub mod render;
 pub mod scene;
 pub mod table;

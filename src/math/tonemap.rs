@@ -6,7 +6,7 @@ use glam::{Mat3, Vec3};
 
 /// How exposed linear values become display values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Tonemap {
     /// Khronos PBR Neutral: identity (less a small black offset) up to 0.76, then a smooth
     /// compression of highlights towards white that keeps base colours' hues.

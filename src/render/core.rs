@@ -2,106 +2,22 @@
 //! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
 //! record exactly the same commands, so the window and the capture give the same pixels.
 
-use super::camera_pass::{CameraCull, CameraPass, Resolve, DEPTH_FORMAT};
-use super::frame::{plan_frame, FramePlan};
-use super::gpu_scene::{GpuScene, Viewpoint};
+use super::camera_pass::{CameraPass, Resolve};
+use super::cull::CameraCull;
+use super::gpu_scene::GpuScene;
 use super::receivers::ShadowReach;
-use super::settings::{SceneOptions, View, ViewMode};
 use super::shadow_pass::{plan_casters, ShadowPass};
-use crate::gpu::barrier::{image_barrier, Access};
+use super::targets::{Attachment, MsaaTargets};
+use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::scene as sh;
-use crate::gpu::Image;
 use crate::math::shadow_fit::spot_near;
+use crate::plan::frame::{plan_frame, FramePlan};
+use crate::plan::settings::{SceneOptions, ShadowSettings, View, ViewMode};
+use crate::plan::{Viewpoint, CLEAR_COLOR};
 use crate::scene::{Light, Scene};
 use ash::vk;
 use std::sync::Arc;
-
-/// Linear colour where nothing is drawn (the CPU reference uses it too).
-pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
-
-/// An image rendered into, with the access it was last used with; `transition` records the
-/// barrier to the next access and remembers it, so no caller tracks layouts by hand.
-pub struct Attachment {
-    /// Image.
-    pub image: vk::Image,
-    /// View.
-    pub view: vk::ImageView,
-    /// Colour or depth.
-    pub aspect: vk::ImageAspectFlags,
-    /// Last access.
-    pub state: Access,
-}
-
-impl Attachment {
-    /// An attachment for a not yet used `Image`.
-    pub fn of(image: &Image) -> Self {
-        Self {
-            image: image.raw,
-            view: image.view,
-            aspect: image.aspect,
-            state: Access::Undefined,
-        }
-    }
-
-    /// Records a barrier from the last access to `to`, and remembers `to`.
-    pub fn transition(&mut self, device: &ash::Device, cmd: vk::CommandBuffer, to: Access) {
-        image_barrier(device, cmd, self.image, self.aspect, 0..1, self.state, to);
-        self.state = to;
-    }
-}
-
-/// The multisampled colour and depth images a camera pass renders into when MSAA is on; it
-/// resolves them into the target's single-sample images.
-pub struct MsaaTargets {
-    _color: Image,
-    _depth: Image,
-    /// The multisampled colour attachment.
-    pub color: Attachment,
-    /// The multisampled depth attachment.
-    pub depth: Attachment,
-    /// Their size (the window compares it on resize).
-    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
-    pub extent: vk::Extent2D,
-    /// The colour image's format.
-    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
-    pub color_format: vk::Format,
-}
-
-impl MsaaTargets {
-    /// Colour (`format`) and depth images of `extent` at `samples` per pixel.
-    pub fn new(
-        ctx: &Arc<Context>,
-        format: vk::Format,
-        extent: vk::Extent2D,
-        samples: u32,
-    ) -> Result<Self, GpuError> {
-        let color = Image::new_multisampled(
-            ctx,
-            "multisampled colour",
-            format,
-            extent,
-            samples,
-            vk::ImageUsageFlags::COLOR_ATTACHMENT,
-        )?;
-        let depth = Image::new_multisampled(
-            ctx,
-            "multisampled depth",
-            DEPTH_FORMAT,
-            extent,
-            samples,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        )?;
-        Ok(Self {
-            color: Attachment::of(&color),
-            depth: Attachment::of(&depth),
-            _color: color,
-            _depth: depth,
-            extent,
-            color_format: format,
-        })
-    }
-}
 
 /// Scene + passes + per-slot uniforms and timestamps.
 pub struct FrameCore {
@@ -190,15 +106,16 @@ impl FrameCore {
         Ok(())
     }
 
-    /// Sizes the shadow map for `view`, plans the frame and writes slot `slot`'s uniforms (the
-    /// slot's previous frame must have completed).
+    /// Sizes the shadow map for `view`, plans the frame (with its casters and the camera pass's
+    /// draw selection) and writes slot `slot`'s uniforms (the slot's previous frame must have
+    /// completed). Recording then only does what the returned frame says.
     pub fn prepare(
         &mut self,
         slot: usize,
         view: &View,
         width: u32,
         height: u32,
-    ) -> Result<FramePlan, GpuError> {
+    ) -> Result<Prepared, GpuError> {
         let map_size = if view.shadow.enabled {
             view.shadow.map_size.clamp(16, 16384)
         } else {
@@ -233,7 +150,7 @@ impl FrameCore {
                         &sv.light_clip_from_world,
                         plan.light_source(sv.light),
                         sv.res,
-                        crate::render::frame::lookup_reach(view.shadow.pcf, plan.soft),
+                        crate::plan::frame::lookup_reach(view.shadow.pcf, plan.soft),
                         view.mode == ViewMode::ShadowMap,
                     )
                 })
@@ -244,31 +161,41 @@ impl FrameCore {
         }
         self.camera.write_frame(slot, &plan.uniform)?;
         let extent = vk::Extent2D { width, height };
-        self.camera.ensure_pipelines(
-            &self.gpu,
-            &camera_cull(view, &plan, extent, self.receiver_split),
+        let cull = camera_cull(view, &plan, extent, self.receiver_split);
+        self.camera.ensure_pipelines(&self.gpu, &cull, extent)?;
+        Ok(Prepared {
+            plan,
+            cull,
             extent,
-        )?;
-        Ok(plan)
+            slot,
+            shadow: view.shadow,
+            mode: view.mode,
+        })
     }
 
-    /// Records the shadow pass and the camera pass with timestamps; leaves `color` as a colour
-    /// attachment and `depth` as a depth attachment. With `msaa` the pass draws into its
-    /// multisampled images and resolves colour into `color` (and depth, sample 0, into `depth`
-    /// when `resolve_depth`). Returns what was drawn.
-    #[allow(clippy::too_many_arguments)]
+    /// Records the shadow pass and the camera pass of a prepared frame with timestamps; leaves
+    /// `targets.color` as a colour attachment and `targets.depth` as a depth attachment. Returns
+    /// what was drawn.
     pub fn record(
         &mut self,
         cmd: vk::CommandBuffer,
-        slot: usize,
-        view: &View,
-        plan: &FramePlan,
-        color: &mut Attachment,
-        depth: &mut Attachment,
-        msaa: Option<&mut MsaaTargets>,
-        resolve_depth: bool,
-        extent: vk::Extent2D,
+        frame: &Prepared,
+        targets: Targets<'_>,
     ) -> PassCounts {
+        let Prepared {
+            plan,
+            cull,
+            extent,
+            slot,
+            ..
+        } = frame;
+        let (slot, extent) = (*slot, *extent);
+        let Targets {
+            color,
+            depth,
+            msaa,
+            resolve_depth,
+        } = targets;
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         let q = 3 * slot as u32;
@@ -295,7 +222,7 @@ impl FrameCore {
         let near = 2.2 * spot_near(&self.gpu.bounds);
         let casters = self
             .shadow
-            .record(cmd, &self.gpu, &view.shadow, &views, near);
+            .record(cmd, &self.gpu, &frame.shadow, &views, near);
         unsafe {
             if timestamps {
                 d.cmd_write_timestamp2(
@@ -325,7 +252,6 @@ impl FrameCore {
                 (color.view, depth.view, Resolve::default())
             }
         };
-        let cull = camera_cull(view, plan, extent, self.receiver_split);
         let counts = self.camera.record(
             cmd,
             slot,
@@ -334,13 +260,13 @@ impl FrameCore {
             draw_depth,
             resolve,
             extent,
-            if view.mode == ViewMode::Overdraw {
+            if frame.mode == ViewMode::Overdraw {
                 [0.0, 0.0, 0.0, 1.0]
             } else {
                 CLEAR_COLOR
             },
-            view.mode == ViewMode::ShadowMap,
-            &cull,
+            frame.mode == ViewMode::ShadowMap,
+            cull,
         );
         unsafe {
             if timestamps {
@@ -435,13 +361,44 @@ fn camera_cull(
     }
 }
 
-fn is_debug_view(mode: ViewMode) -> Option<super::camera_pass::Entry> {
-    use super::camera_pass::Entry;
+fn is_debug_view(mode: ViewMode) -> Option<super::cull::Entry> {
+    use super::cull::Entry;
     match mode {
         ViewMode::Lit | ViewMode::ShadowMap => None,
         ViewMode::Overdraw => Some(Entry::Overdraw),
         _ => Some(Entry::Debug),
     }
+}
+
+/// A frame planned and ready to record ([`FrameCore::prepare`]): the plan, the camera pass's draw
+/// selection made from it once, and the settings recording reads.
+pub struct Prepared {
+    /// The frame's plan (returned to the caller with the image).
+    pub plan: FramePlan,
+    /// The camera pass's culling and variant inputs.
+    cull: CameraCull,
+    /// The image size.
+    extent: vk::Extent2D,
+    /// The uniform and timestamp slot the frame was prepared in.
+    slot: usize,
+    /// The view's shadow settings (the shadow pass's bias and cache switches).
+    shadow: ShadowSettings,
+    /// The view mode (clear colour, the map view).
+    mode: ViewMode,
+}
+
+/// The images one frame is recorded into. With `msaa` the camera pass draws into its
+/// multisampled images and resolves colour into `color` (and depth, sample 0, into `depth` when
+/// `resolve_depth`).
+pub struct Targets<'a> {
+    /// The single-sample colour image.
+    pub color: &'a mut Attachment,
+    /// The single-sample depth image.
+    pub depth: &'a mut Attachment,
+    /// The multisampled images, when MSAA is on.
+    pub msaa: Option<&'a mut MsaaTargets>,
+    /// Resolve depth too (for depth readback).
+    pub resolve_depth: bool,
 }
 
 /// Draws recorded in one frame, after culling.

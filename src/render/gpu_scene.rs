@@ -2,13 +2,14 @@
 //! stream, one index buffer, textures with mipmaps, and a descriptor set per material.
 
 use super::samplers::SamplerCache;
-use super::settings::SceneOptions;
-use super::uniforms::{MaterialUniform, SceneImmediates};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
 use crate::gpu::{Buffer, Image};
 use crate::math::mips::mip_chain;
 use crate::math::Aabb;
+use crate::plan::settings::SceneOptions;
+use crate::plan::uniforms::{MaterialUniform, SceneImmediates};
+use crate::plan::Viewpoint;
 use crate::scene::clusters::{self, Cluster};
 use crate::scene::topology::{is_closed, plane_of};
 use crate::scene::{AlphaMode, Scene, BLEND_SHADOW_CUTOFF};
@@ -325,42 +326,6 @@ pub fn material_variant_bits(m: &crate::scene::Material) -> usize {
         }
     }
     bits
-}
-
-/// What a draw's faces are tested against when clusters are skipped.
-#[derive(Clone, Copy, Debug)]
-pub enum Viewpoint {
-    /// A perspective eye (camera, spot light) at this world position.
-    Eye(Vec3),
-    /// An orthographic view (directional light) looking along this world direction.
-    Along(Vec3),
-}
-
-/// True when a flat primitive on `plane` (`(n, w)`, unit `n`) hides nothing from `from`: the
-/// viewpoint and the whole scene (bounds `scene`) lie on one closed side of the plane, and a
-/// segment from a point to the viewpoint never leaves that side (a half-space is convex), so it
-/// never meets the primitive except at its own end. Seen from a light, such a caster shadows
-/// nothing (the shadow pass skips a ground plane with nothing under it, the largest caster of most
-/// scenes); seen from the camera, it occludes nothing (the camera pass draws it after the rest, so
-/// the early depth test rejects its hidden fragments). Scene parts within 1e-5 of the scene's
-/// diagonal behind the plane still count as in front (a model resting on the ground), a choice
-/// that can only matter for geometry sunk that little and seen from beneath the plane.
-pub fn flat_hides_nothing(plane: Vec4, from: Viewpoint, scene: &Aabb) -> bool {
-    let n = plane.truncate();
-    let light_side = match from {
-        Viewpoint::Along(d) => -n.dot(d.normalize_or_zero()),
-        Viewpoint::Eye(p) => n.dot(p) + plane.w,
-    };
-    // Edge-on to the light, or the light on the plane: keep it (cheap, and no sign to trust).
-    if light_side.abs() <= 1e-6 || !light_side.is_finite() {
-        return false;
-    }
-    let s = light_side.signum();
-    let tolerance = 1e-5 * scene.diagonal();
-    scene
-        .corners()
-        .iter()
-        .all(|c| s * (n.dot(*c) + plane.w) >= -tolerance)
 }
 
 /// The camera pass's per-vertex attributes of `p` (defaults where it lacks one).

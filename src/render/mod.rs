@@ -1,31 +1,31 @@
-//! Rendering: one module per pass, the per-frame plan, and the offscreen renderer. Passes,
+//! Rendering: one module per pass, the targets they draw into, the scene's GPU copy, and the
+//! offscreen and window renderers; the passes record what a [`crate::plan::FramePlan`] says. Passes,
 //! pipelines and uniform layouts are internal; the public types are re-exported here.
 
 pub(crate) mod camera_pass;
 pub(crate) mod core;
+pub(crate) mod cull;
 pub(crate) mod deferred;
-pub(crate) mod frame;
 pub(crate) mod gpu_scene;
 pub(crate) mod pipeline;
 pub(crate) mod receivers;
 pub(crate) mod renderer;
 pub mod report;
 pub(crate) mod samplers;
-pub(crate) mod settings;
+pub(crate) mod screen;
 pub(crate) mod shadow_cache;
 pub(crate) mod shadow_pass;
 #[cfg(feature = "viewer")]
 pub(crate) mod swapchain;
-pub(crate) mod uniforms;
+pub(crate) mod targets;
 #[cfg(feature = "viewer")]
 pub(crate) mod window;
 
-pub use frame::{effective_lights, metered_illuminance, FramePlan, ScenePlanner, ShadowView};
-pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
-pub use settings::{
-    Exposure, HeldLight, Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings,
-    Tonemap, View, ViewMode, AUTO_AMBIENT, MAX_CASCADES, UNIT_AMBIENT,
+pub use crate::plan::{
+    effective_lights, metered_illuminance, Exposure, FramePlan, HeldLight, Pcf, SceneOptions,
+    ScenePlanner, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings, ShadowView, Tonemap, View,
+    ViewMode, AUTO_AMBIENT, MAX_CASCADES, MAX_LIGHTS, MAX_SHADOW_VIEWS, UNIT_AMBIENT,
 };
-pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
+pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 #[cfg(feature = "viewer")]
 pub use window::{surface_extensions, DrawResult, WindowRenderer};

@@ -14,8 +14,8 @@
 //! Only frames with one shadow view use it (a single map of a directional light or a spot
 //! light's; cascades and cube faces keep the shadowed shader everywhere).
 
-use super::deferred::{points_rect, screen_rect, PixelRect};
 use super::gpu_scene::Draw;
+use super::screen::{points_rect, screen_rect, PixelRect};
 use crate::gpu::shaders::scene as sh;
 use crate::math::Aabb;
 use ash::vk;

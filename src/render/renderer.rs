@@ -1,11 +1,12 @@
 //! The offscreen renderer: the shared frame core into an image, read back to RGBA8.
 
-use super::core::{Attachment, FrameCore, MsaaTargets};
-use super::frame::FramePlan;
-use super::settings::{SceneOptions, View};
+use super::core::{FrameCore, Targets};
+use super::targets::{Attachment, MsaaTargets};
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
+use crate::plan::frame::FramePlan;
+use crate::plan::settings::{SceneOptions, View};
 use crate::scene::Scene;
 use ash::vk;
 use glam::Mat4;
@@ -296,7 +297,7 @@ impl Renderer {
                 let aspect = width as f32 / height.max(1) as f32;
                 let seen = visible_depths(
                     f.depth.as_deref().unwrap_or(&[]),
-                    &crate::render::frame::camera_projection(&view.camera, aspect),
+                    &crate::plan::frame::camera_projection(&view.camera, aspect),
                 );
                 self.seen_depths = Some((key.0, key.1, key.2, seen));
                 seen
@@ -319,7 +320,7 @@ impl Renderer {
             )));
         }
         let start = Instant::now();
-        let plan = self.core.prepare(0, view, width, height)?;
+        let prepared = self.core.prepare(0, view, width, height)?;
         self.ensure_target(width, height)?;
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
@@ -329,15 +330,15 @@ impl Renderer {
         ctx.begin_one_time(cmd)?;
         let counts = self.core.record(
             cmd,
-            0,
-            view,
-            &plan,
-            &mut t.color_at,
-            &mut t.depth_at,
-            t.msaa.as_mut(),
-            self.read_depth,
-            extent,
+            &prepared,
+            Targets {
+                color: &mut t.color_at,
+                depth: &mut t.depth_at,
+                msaa: t.msaa.as_mut(),
+                resolve_depth: self.read_depth,
+            },
         );
+        let plan = prepared.plan;
         t.color_at.transition(d, cmd, Access::TransferSrc);
         copy_to_buffer(
             d,

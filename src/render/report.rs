@@ -2,8 +2,8 @@
 //! format, each shadow view (cascade) with the depth it covers and its texel's world size, how
 //! many draws fall inside it, and the memory the maps take.
 
-use super::settings::{ShadowFormat, View};
 use crate::math::Aabb;
+use crate::plan::settings::{ShadowFormat, View};
 use crate::scene::{LightKind, Scene};
 use glam::Mat4;
 use serde_json::{json, Value};
@@ -28,12 +28,12 @@ fn inside_xy(b: &Aabb, clip: &Mat4) -> bool {
 /// How `view` of `scene` is exposed: the exposure mode, what auto exposure metered (lux, as
 /// luminance), the resolved EV100 and linear scale, the ambient and the tone curve.
 pub fn exposure_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
-    let planner = super::frame::ScenePlanner::new(scene);
+    let planner = crate::plan::frame::ScenePlanner::new(scene);
     let plan = planner.plan(view, w, h);
     let mode = match view.exposure {
-        super::settings::Exposure::Auto => "auto".to_string(),
-        super::settings::Exposure::Ev100(ev) => format!("EV100 {ev}"),
-        super::settings::Exposure::Scale(k) => format!("scale {k}"),
+        crate::plan::settings::Exposure::Auto => "auto".to_string(),
+        crate::plan::settings::Exposure::Ev100(ev) => format!("EV100 {ev}"),
+        crate::plan::settings::Exposure::Scale(k) => format!("scale {k}"),
     };
     json!({
         "mode": mode,
@@ -48,7 +48,7 @@ pub fn exposure_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
 
 /// The shadow plan of `view` at `w`×`h` (the CPU side of a frame; no GPU needed).
 pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
-    let planner = super::frame::ScenePlanner::new(scene);
+    let planner = crate::plan::frame::ScenePlanner::new(scene);
     let draws = planner.receivers();
     let plan = planner.plan(view, w, h);
     let Some(li) = plan.shadow_light.filter(|_| plan.shadows_on) else {

@@ -1,20 +1,21 @@
 //! The light-space depth pass: position-only stream, depth clamp on, reversed-z (clear 0, GREATER),
 //! depth bias pushing casters away from the light (negative factors under reversed-z).
 
-use super::core::Attachment;
-use super::gpu_scene::{flat_hides_nothing, vertex_layout, GpuScene, Viewpoint};
+use super::gpu_scene::{vertex_layout, GpuScene};
 use super::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
     Stencil,
 };
-use super::settings::{ShadowFormat, ShadowSettings};
 use super::shadow_cache::{split_moving, LayerKey, LayerWork, ShadowCache};
-use super::uniforms::ShadowImmediates;
+use super::targets::Attachment;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{create_module, shadow as sh};
 use crate::gpu::Image;
 use crate::math::Aabb;
+use crate::plan::settings::{ShadowFormat, ShadowSettings};
+use crate::plan::uniforms::ShadowImmediates;
+use crate::plan::{flat_hides_nothing, CasterPlan, Viewpoint};
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use std::sync::Arc;
@@ -45,42 +46,6 @@ pub fn caster_extent(light_clip_from_world: &Mat4, b: &Aabb) -> Option<[f32; 4]>
     }
     let visible = hi.x >= -1.0 && lo.x <= 1.0 && hi.y >= -1.0 && lo.y <= 1.0 && hi.z >= 0.0;
     visible.then_some([lo.x, lo.y, hi.x, hi.y])
-}
-
-/// The casters one frame draws into the shadow map, and the texels they can touch.
-#[derive(Clone, Debug)]
-pub struct CasterPlan {
-    /// Indices into `GpuScene::draws`.
-    pub draws: Vec<usize>,
-    /// The texels the pass clears and draws (the casters' rectangle grown by twice the lookup
-    /// reach, so every texel a lookup inside `lookup` reads is written this frame).
-    pub area: vk::Rect2D,
-    /// Texel rectangle `(x0, y0, x1, y1)` outside which a lookup's footprint meets no caster
-    /// texel (the casters' rectangle grown by the reach): such lookups are lit without a read.
-    pub lookup: Vec4,
-    /// The view's light (clusters facing away from it are not drawn).
-    pub light: Viewpoint,
-    /// Side in texels of the view's square (at its layer's origin).
-    pub size: u32,
-}
-
-impl Default for CasterPlan {
-    /// No casters: one texel cleared, every lookup lit.
-    fn default() -> Self {
-        Self {
-            draws: Vec::new(),
-            area: vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent: vk::Extent2D {
-                    width: 1,
-                    height: 1,
-                },
-            },
-            lookup: Vec4::new(1.0, 1.0, -1.0, -1.0),
-            light: Viewpoint::Along(Vec3::NEG_Y),
-            size: 1,
-        }
-    }
 }
 
 /// Chooses the casters of a frame: those whose bounds reach the light's view, less flat casters

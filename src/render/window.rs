@@ -2,15 +2,16 @@
 //! (per frame: command buffer, fence, acquire semaphore, uniform slot; per image: render-finished
 //! semaphore).
 
-use super::core::{Attachment, FrameCore, MsaaTargets};
+use super::core::{FrameCore, Targets};
 use super::renderer::{
     copy_to_buffer, rgba_from_readback, transfer_to_host_barrier, visible_depths,
 };
-use super::settings::{SceneOptions, ShadowHold, View};
 use super::swapchain::Swapchain;
+use super::targets::{Attachment, MsaaTargets};
 use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
+use crate::plan::settings::{SceneOptions, ShadowHold, View};
 use crate::scene::Scene;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -253,8 +254,8 @@ impl WindowRenderer {
             return Ok(DrawResult::Skipped);
         };
         unsafe { d.reset_fences(&[sync.fence]) }.vk("vkResetFences")?;
-        let plan = self.core.prepare(f, view, extent.width, extent.height)?;
-        self.held = Some(ShadowHold::from_plan(&plan));
+        let prepared = self.core.prepare(f, view, extent.width, extent.height)?;
+        self.held = Some(ShadowHold::from_plan(&prepared.plan));
         let pixels = extent.width as usize * extent.height as usize;
         if fit
             && self.depth_reads[f]
@@ -296,14 +297,13 @@ impl WindowRenderer {
             .core
             .record(
                 cmd,
-                f,
-                view,
-                &plan,
-                &mut color,
-                depth,
-                self.msaa.as_mut(),
-                fit,
-                extent,
+                &prepared,
+                Targets {
+                    color: &mut color,
+                    depth,
+                    msaa: self.msaa.as_mut(),
+                    resolve_depth: fit,
+                },
             )
             .casters;
         if fit {
@@ -318,7 +318,7 @@ impl WindowRenderer {
             );
             let aspect = extent.width as f32 / extent.height.max(1) as f32;
             self.depth_reads[f].1 = Some((
-                super::frame::camera_projection(&view.camera, aspect),
+                crate::plan::frame::camera_projection(&view.camera, aspect),
                 pixels,
             ));
         }

@@ -3,7 +3,7 @@
 //! model's folder) and image decoding limits. Several of these guard panics in gltf 1.4.1 that
 //! mutation fuzzing found (see `tests/loader_fuzz.rs`).
 
-use super::gltf_load::{corrupt, invalid, LoadError, MAX_TEXTURE_SIDE};
+use super::load_error::{corrupt, invalid, LoadError, MAX_TEXTURE_SIDE};
 use base64::Engine as _;
 use std::path::{Component, Path};
 

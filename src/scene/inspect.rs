@@ -11,7 +11,7 @@
 //! the render layer (`render::frame::plan_report`).
 
 use super::gltf_input::json_part;
-use super::gltf_load::LoadError;
+use super::load_error::LoadError;
 use super::warning::severity_of;
 use super::{blinn_phong_params, Scene};
 use crate::math::precision::{relative_gap, DepthMapping};
@@ -105,7 +105,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
     };
     let bytes = std::fs::read(path).map_err(io)?;
     let doc: Value = serde_json::from_slice(json_part(path, &bytes)?)
-        .map_err(|e| super::gltf_load::invalid(path, e))?;
+        .map_err(|e| super::load_error::invalid(path, e))?;
     let mut findings: Vec<Value> = Vec::new();
     for w in &scene.warnings {
         findings.push(finding(w.code, w.pointer.clone(), w.message.clone()));

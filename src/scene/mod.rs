@@ -7,6 +7,7 @@ pub mod demo;
 mod gltf_input;
 pub mod gltf_load;
 pub mod inspect;
+pub mod load_error;
 pub mod material;
 pub mod sampler;
 pub mod shapes;
@@ -16,7 +17,8 @@ pub mod topology;
 mod types;
 pub mod warning;
 
-pub use gltf_load::{load_gltf, LoadError};
+pub use gltf_load::load_gltf;
+pub use load_error::LoadError;
 pub use material::{blinn_phong_params, shade_blinn_phong, BlinnPhong};
 pub use sampler::{Filter, Sampler, UvTransform, Wrap};
 pub use types::*;

@@ -1,0 +1,1085 @@
+//! Shadow settings chosen for an error budget.
+//!
+//! No sweep at render time. The chooser works in three cheap steps:
+//!
+//! 1. **Probe**: the exact visibility is ray-cast at every pixel (`PROBE_STRIDE`; 0.92 M rays at
+//!    1280×720, a primary and a shadow ray each, a few hundred ms on two cores), which finds the
+//!    view's shadow boundaries and how long they are on screen.
+//! 2. **Predict**: misclassified pixels sit in a band along those boundaries whose width grows
+//!    with the shadow texel's size in pixels there (ρ = texel world size / pixel footprint, at the
+//!    cascade covering that depth). For each candidate configuration
+//!    `e = a_f · Σ ℓ·ρ / N + b_f · Σ ℓ / N + c_f`, summed over boundary crossings between
+//!    neighbouring probes (ℓ = π·s/4 pixels of boundary per crossing at spacing s, by
+//!    Cauchy–Crofton), N the pixels that see a surface, (a_f, b_f, c_f) fitted per filter to
+//!    sweeps of training scenes (`model::MODEL`, by `umbra sweep --fit-budget`). Each candidate's
+//!    cost is its GPU time relative to the default configuration on those sweeps
+//!    (`model::COSTS`).
+//! 3. **Verify**: the cheapest candidate predicted within the budget is rendered once (shadow
+//!    view and depth) and its misclassification measured at the probes (with a probe at every
+//!    pixel this is exactly `reference::compare`'s measure). The measurements so far correct
+//!    every prediction for this view (`Calibration`: a scale, then a line through them), and the
+//!    search moves to a cheaper or a more accurate candidate accordingly; at most
+//!    `MAX_VERIFIED` renders. The choice is the cheapest verified candidate measured within the
+//!    budget, so the budget holds by measurement, not only by the model.
+
+pub use super::coeffs::Coeffs;
+use crate::reference::{Probe, ReferenceScene};
+use glam::Vec3;
+use umbra::render::{FramePlan, ScenePlanner, ShadowSettings, View};
+use umbra::scene::{LightKind, Scene};
+
+/// Probes every this many pixels in x and y. 1: every pixel, so a verified candidate's
+/// measurement is exactly what `reference::compare` measures. (Measured on the town from eye
+/// height: every 2nd pixel, a quarter of the rays, put 512² with 4 cascades at 0.093 % where the
+/// whole image has 0.114 %: thin error lines alias with a regular grid.)
+pub const PROBE_STRIDE: u32 = 1;
+
+/// The exact-visibility probe of one view.
+#[derive(Clone, Debug)]
+pub struct ViewProbe {
+    /// Probes per row.
+    pub cols: u32,
+    /// Rows of probes.
+    pub rows: u32,
+    /// Spacing in pixels.
+    pub stride: u32,
+    /// Row-major probes (`None` where the ray hits nothing), at pixel centres
+    /// (i·stride + stride/2, j·stride + stride/2).
+    pub probes: Vec<Option<Probe>>,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+}
+
+impl ViewProbe {
+    /// The pixel of probe (i, j).
+    pub fn pixel(&self, i: u32, j: u32) -> (u32, u32) {
+        (
+            (i * self.stride + self.stride / 2).min(self.width - 1),
+            (j * self.stride + self.stride / 2).min(self.height - 1),
+        )
+    }
+}
+
+/// Boundary terms of one candidate's prediction (see the module documentation).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Features {
+    /// Σ ℓ·ρ / N.
+    pub texel_term: f64,
+    /// Σ ℓ / N: boundary pixels per visible pixel.
+    pub edge_term: f64,
+}
+
+/// The plan the renderer would make for `view` with `shadow` instead of its own settings.
+fn plan_with(
+    planner: &ScenePlanner,
+    view: &View,
+    shadow: ShadowSettings,
+    w: u32,
+    h: u32,
+) -> FramePlan {
+    let mut v = view.clone();
+    v.shadow = shadow;
+    planner.plan(&v, w, h)
+}
+
+/// Ray-casts the exact visibility at every `stride`-th pixel centre of `view`.
+pub fn probe_view(
+    reference: &ReferenceScene,
+    planner: &ScenePlanner,
+    view: &View,
+    w: u32,
+    h: u32,
+    stride: u32,
+) -> ViewProbe {
+    let plan = planner.plan(view, w, h);
+    let stride = stride.max(1);
+    let mut probe = ViewProbe {
+        cols: w.div_ceil(stride),
+        rows: h.div_ceil(stride),
+        stride,
+        probes: Vec::new(),
+        width: w,
+        height: h,
+    };
+    let pixels: Vec<(f32, f32)> = (0..probe.rows)
+        .flat_map(|j| (0..probe.cols).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let (x, y) = probe.pixel(i, j);
+            (x as f32 + 0.5, y as f32 + 0.5)
+        })
+        .collect();
+    probe.probes = reference.probe(&plan, &pixels, w, h);
+    probe
+}
+
+/// Misclassified fraction of a GPU frame at the probes: its shadow view (`gpu_shadow`, lit at
+/// ≥ 128) against the exact visibility, judged where the GPU depth (`depth`, of `plan`) and the
+/// probe see the same surface (distances within 1 %, as `reference::compare`). Also returns the
+/// probes judged.
+pub fn misclassified_at_probes(
+    probe: &ViewProbe,
+    gpu_shadow: &image::RgbaImage,
+    depth: &[f32],
+    plan: &FramePlan,
+) -> (f64, usize) {
+    let inv = plan.clip_from_world.inverse();
+    let (w, h) = (probe.width, probe.height);
+    let (mut judged, mut wrong) = (0usize, 0usize);
+    for j in 0..probe.rows {
+        for i in 0..probe.cols {
+            let Some(p) = probe.probes[(j * probe.cols + i) as usize] else {
+                continue;
+            };
+            let (x, y) = probe.pixel(i, j);
+            let d = depth.get((y * w + x) as usize).copied().unwrap_or(0.0);
+            if d <= 0.0 {
+                continue;
+            }
+            let n = umbra::math::projection::pixel_to_ndc(x as f32 + 0.5, y as f32 + 0.5, w, h);
+            let q = inv * glam::Vec4::new(n.x, n.y, d, 1.0);
+            let dist = (q.truncate() / q.w).distance(plan.camera_position);
+            if (dist - p.distance).abs() > 0.01 * p.distance + 1e-4 {
+                continue;
+            }
+            judged += 1;
+            let lit = gpu_shadow.get_pixel(x, y)[0] >= 128;
+            wrong += (lit != p.visible) as usize;
+        }
+    }
+    (
+        if judged == 0 {
+            0.0
+        } else {
+            wrong as f64 / judged as f64
+        },
+        judged,
+    )
+}
+
+/// The boundary terms for a candidate's `plan` of the probed view.
+pub fn features(probe: &ViewProbe, plan: &FramePlan, view: &View) -> Features {
+    let Some(light) = plan.shadow_light.map(|i| plan.lights[i]) else {
+        return Features::default();
+    };
+    let views = plan.primary_views();
+    if views.is_empty() {
+        return Features::default();
+    }
+    let eye = view.camera.position();
+    let forward = -view
+        .camera
+        .world_from_view
+        .z_axis
+        .truncate()
+        .normalize_or(Vec3::NEG_Z);
+    let pixel_angle = 2.0 * (view.camera.fov_y * 0.5).tan() / probe.height.max(1) as f32;
+    let rho = |p: &Probe| -> f64 {
+        let depth = (p.position - eye).dot(forward);
+        let k = views
+            .iter()
+            .position(|v| depth <= v.far)
+            .unwrap_or(views.len() - 1);
+        let tw = views[k].texel_world;
+        let texel = match light.kind {
+            LightKind::Directional => tw,
+            _ => tw * (p.position - light.position).length(),
+        };
+        (texel / (p.distance * pixel_angle).max(f32::MIN_POSITIVE)) as f64
+    };
+    let at = |i: u32, j: u32| probe.probes[(j * probe.cols + i) as usize];
+    let ell = std::f64::consts::FRAC_PI_4 * probe.stride as f64;
+    let (mut texel_sum, mut edge_sum, mut seen) = (0.0f64, 0.0f64, 0usize);
+    for j in 0..probe.rows {
+        for i in 0..probe.cols {
+            let Some(a) = at(i, j) else { continue };
+            seen += 1;
+            for (ni, nj) in [(i + 1, j), (i, j + 1)] {
+                if ni >= probe.cols || nj >= probe.rows {
+                    continue;
+                }
+                if let Some(b) = at(ni, nj) {
+                    if a.visible != b.visible {
+                        texel_sum += ell * 0.5 * (rho(&a) + rho(&b));
+                        edge_sum += ell;
+                    }
+                }
+            }
+        }
+    }
+    let n = seen as f64 * (probe.stride as f64).powi(2);
+    if n == 0.0 {
+        return Features::default();
+    }
+    Features {
+        texel_term: texel_sum / n,
+        edge_term: edge_sum / n,
+    }
+}
+
+/// A sweep row joined with its prediction terms (the budget model's training data).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct FeatureRow {
+    /// Scene.
+    pub scene: String,
+    /// View.
+    pub view: String,
+    /// Configuration name.
+    pub config: String,
+    /// Filter name.
+    pub filter: String,
+    /// Fitting method.
+    pub method: String,
+    /// Map side.
+    pub map_texels: u32,
+    /// Σ ℓ·ρ / N.
+    pub texel_term: f64,
+    /// Σ ℓ / N.
+    pub edge_term: f64,
+    /// Measured misclassified fraction.
+    pub misclassified: f64,
+    /// Measured GPU ms.
+    pub gpu_ms: f64,
+}
+
+/// The prediction terms of every row of `rows` that belongs to `scene` (views by name from
+/// `views`, configurations by name from `configs`).
+pub fn feature_rows(
+    reference: &ReferenceScene,
+    scene: &Scene,
+    views: &[(String, umbra::scene::Camera)],
+    configs: &[super::grid::Config],
+    rows: &[super::sweep::Row],
+) -> Vec<FeatureRow> {
+    let planner = ScenePlanner::new(scene);
+    let mut out = Vec::new();
+    for (name, camera) in views {
+        let of: Vec<&super::sweep::Row> = rows
+            .iter()
+            .filter(|r| r.scene == scene.name && &r.view == name)
+            .collect();
+        let Some(first) = of.first() else { continue };
+        let (w, h) = (first.width_px, first.height_px);
+        let view = View::new(*camera);
+        let probe = probe_view(reference, &planner, &view, w, h, PROBE_STRIDE);
+        for r in of {
+            let Some(c) = configs.iter().find(|c| c.name() == r.config) else {
+                continue;
+            };
+            let plan = plan_with(&planner, &view, c.shadow, w, h);
+            let f = features(&probe, &plan, &view);
+            out.push(FeatureRow {
+                scene: r.scene.clone(),
+                view: r.view.clone(),
+                config: r.config.clone(),
+                filter: r.filter.clone(),
+                method: r.method.clone(),
+                map_texels: r.map_texels,
+                texel_term: f.texel_term,
+                edge_term: f.edge_term,
+                misclassified: r.misclassified,
+                gpu_ms: r.gpu_ms,
+            });
+        }
+    }
+    out
+}
+
+/// A candidate's prediction for one view.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    /// The configuration.
+    pub config: super::grid::Config,
+    /// Predicted misclassified fraction.
+    pub predicted: f64,
+    /// GPU time relative to the default configuration (`COSTS`).
+    pub relative_cost: f64,
+}
+
+/// The prediction of `f` under `coeffs`.
+pub fn predict(coeffs: &Coeffs, f: &Features) -> f64 {
+    coeffs.a * f.texel_term + coeffs.b * f.edge_term + coeffs.c
+}
+
+/// Predicts every candidate (`COSTS`, whose filters have `MODEL` coefficients) for the probed
+/// view. `base_ms` = (camera pass, shadow pass) of `COST_BASE` measured in this view weighs the
+/// stored per-pass cost ratios into one relative cost (a scene heavy in casters pays more for
+/// larger maps); without it the passes weigh 4:1.
+pub fn predict_all(
+    probe: &ViewProbe,
+    planner: &ScenePlanner,
+    view: &View,
+    base_ms: Option<(f64, f64)>,
+) -> Vec<Prediction> {
+    let (w, h) = (probe.width, probe.height);
+    let configs: std::collections::HashMap<String, super::grid::Config> = super::grid::Grid::full()
+        .configs()
+        .into_iter()
+        .map(|c| (c.name(), c))
+        .collect();
+    let (bc, bs) = base_ms.unwrap_or((4.0, 1.0));
+    let mut out = Vec::new();
+    for (name, cam, shadow) in super::model::COSTS {
+        let cost = (bc * cam + bs * shadow) / (bc + bs);
+        let Some(c) = configs.get(name) else {
+            continue;
+        };
+        let Some(k) = super::model::MODEL
+            .iter()
+            .find(|k| k.filter == super::grid::filter_name(c.shadow.pcf))
+        else {
+            continue;
+        };
+        let plan = plan_with(planner, view, c.shadow, w, h);
+        let f = features(probe, &plan, view);
+        out.push(Prediction {
+            config: c.clone(),
+            predicted: predict(k, &f),
+            relative_cost: cost,
+        });
+    }
+    out
+}
+
+/// The cheapest prediction within `budget` (a fraction), else the most accurate one.
+pub fn cheapest_within(predictions: &[Prediction], budget: f64) -> Option<&Prediction> {
+    predictions
+        .iter()
+        .filter(|p| p.predicted <= budget)
+        .min_by(|a, b| a.relative_cost.total_cmp(&b.relative_cost))
+        .or_else(|| {
+            predictions
+                .iter()
+                .min_by(|a, b| a.predicted.total_cmp(&b.predicted))
+        })
+}
+
+/// A running choice (the viewer's) moves only to a candidate at most this fraction of its cost;
+/// otherwise it stays while it measures within the budget (no flicker between two candidates
+/// near the budget).
+pub const SWITCH_COST_RATIO: f64 = 0.8;
+
+/// Whether a running choice should stay after `new` was chosen for the current view: when the
+/// running one measures within the budget here and `new` is not clearly cheaper.
+pub fn keep_current(new: &BudgetChoice, current_cost: f64, current_measured: f64) -> bool {
+    current_measured <= new.budget && new.chosen.relative_cost > SWITCH_COST_RATIO * current_cost
+}
+
+/// Floor of the relative-error weights in the fit (misclassification this small counts as this).
+pub const FIT_FLOOR: f64 = 1e-4;
+
+/// Least squares of `m ≈ a·t + b·e + c` with a, b, c ≥ 0, each residual relative to
+/// max(m, `FIT_FLOOR`): every subset of the three terms is solved and the best feasible kept,
+/// then scaled so that half the rows are over and half under their prediction.
+pub fn fit_coeffs(filter: &'static str, rows: &[&FeatureRow]) -> Coeffs {
+    let cols = |r: &FeatureRow| [r.texel_term, r.edge_term, 1.0];
+    let mut best = (f64::INFINITY, [0.0; 3]);
+    for mask in 1u32..8 {
+        let idx: Vec<usize> = (0..3).filter(|i| mask & (1 << i) != 0).collect();
+        let n = idx.len();
+        let mut ata = vec![vec![0.0f64; n]; n];
+        let mut atb = vec![0.0f64; n];
+        for r in rows {
+            let w = 1.0 / r.misclassified.max(FIT_FLOOR);
+            let x = cols(r);
+            for (p, &i) in idx.iter().enumerate() {
+                atb[p] += w * w * x[i] * r.misclassified;
+                for (q, &j) in idx.iter().enumerate() {
+                    ata[p][q] += w * w * x[i] * x[j];
+                }
+            }
+        }
+        let Some(sol) = solve(ata, atb) else { continue };
+        if sol.iter().any(|v| *v < 0.0 || !v.is_finite()) {
+            continue;
+        }
+        let mut k = [0.0; 3];
+        for (p, &i) in idx.iter().enumerate() {
+            k[i] = sol[p];
+        }
+        let loss: f64 = rows
+            .iter()
+            .map(|r| {
+                let x = cols(r);
+                let pred = k[0] * x[0] + k[1] * x[1] + k[2] * x[2];
+                ((pred - r.misclassified) / r.misclassified.max(FIT_FLOOR)).powi(2)
+            })
+            .sum();
+        if loss < best.0 {
+            best = (loss, k);
+        }
+    }
+    // Relative least squares is biased low (over-predictions cost more than under-predictions
+    // can): rescale so the median of measured / predicted is 1.
+    let k = best.1;
+    let mut ratios: Vec<f64> = rows
+        .iter()
+        .map(|r| {
+            let x = cols(r);
+            r.misclassified / (k[0] * x[0] + k[1] * x[1] + k[2] * x[2])
+        })
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    let s = ratios.get(ratios.len() / 2).copied().unwrap_or(1.0);
+    Coeffs {
+        filter,
+        a: k[0] * s,
+        b: k[1] * s,
+        c: k[2] * s,
+    }
+}
+
+/// Gaussian elimination with partial pivoting; None when singular.
+fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+    let n = b.len();
+    for col in 0..n {
+        let piv = (col..n).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[piv][col].abs() < 1e-300 {
+            return None;
+        }
+        a.swap(col, piv);
+        b.swap(col, piv);
+        let (top, rest) = a.split_at_mut(col + 1);
+        let pivot_row = &top[col];
+        for (k, row) in rest.iter_mut().enumerate() {
+            let f = row[col] / pivot_row[col];
+            for (x, p) in row[col..].iter_mut().zip(&pivot_row[col..]) {
+                *x -= f * p;
+            }
+            b[col + 1 + k] -= f * b[col];
+        }
+    }
+    let mut x = vec![0.0; n];
+    for r in (0..n).rev() {
+        let s: f64 = (r + 1..n).map(|c| a[r][c] * x[c]).sum();
+        x[r] = (b[r] - s) / a[r][r];
+    }
+    Some(x)
+}
+
+/// The default configuration costs are relative to.
+pub const COST_BASE: &str = "2048-d32-pcf2x2-camera-default";
+
+/// Per-pass timings of one view's sweep with the noise of a shared machine averaged out: each
+/// configuration's GPU time is estimated as the median camera-pass time of the configurations
+/// sharing its filter and fitting method (the camera pass does not depend on the map size) plus
+/// the median shadow-pass time of those sharing its map size and fitting method (the shadow pass
+/// does not depend on the filter). Measured on lavapipe, single configurations' camera-pass
+/// times scatter by 15–25 % between configurations that do the same camera work; these
+/// estimates use 3–12 timings each.
+pub fn denoised_ms(rows: &[&super::sweep::Row]) -> Vec<(String, f64, f64)> {
+    let med = super::sweep::median;
+    rows.iter()
+        .map(|r| {
+            let cam = med(rows
+                .iter()
+                .filter(|o| o.filter == r.filter && o.method == r.method)
+                .map(|o| o.gpu_camera_ms)
+                .collect());
+            let sh = med(rows
+                .iter()
+                .filter(|o| {
+                    o.map_texels == r.map_texels && o.method == r.method && o.format == r.format
+                })
+                .map(|o| o.gpu_shadow_ms)
+                .collect());
+            (r.config.clone(), cam, sh)
+        })
+        .collect()
+}
+
+/// Camera-pass and shadow-pass time of each configuration relative to `COST_BASE`'s, per
+/// (scene, view) from `denoised_ms`, then the geometric mean over the views that have both.
+pub fn relative_costs(rows: &[super::sweep::Row]) -> Vec<(String, f64, f64)> {
+    let mut views: Vec<(String, String)> = Vec::new();
+    for r in rows {
+        let k = (r.scene.clone(), r.view.clone());
+        if !views.contains(&k) {
+            views.push(k);
+        }
+    }
+    type Logs = (String, Vec<f64>, Vec<f64>);
+    let mut logs: Vec<Logs> = Vec::new();
+    for (scene, view) in &views {
+        let of: Vec<&super::sweep::Row> = rows
+            .iter()
+            .filter(|r| &r.scene == scene && &r.view == view)
+            .collect();
+        let est = denoised_ms(&of);
+        let Some(&(_, bc, bs)) = est.iter().find(|e| e.0 == COST_BASE) else {
+            continue;
+        };
+        for (name, c, sh) in est {
+            let (lc, ls) = ((c / bc).ln(), (sh / bs).ln());
+            if !(lc.is_finite() && ls.is_finite()) {
+                continue;
+            }
+            match logs.iter_mut().find(|e| e.0 == name) {
+                Some(e) => {
+                    e.1.push(lc);
+                    e.2.push(ls);
+                }
+                None => logs.push((name, vec![lc], vec![ls])),
+            }
+        }
+    }
+    let gm = |l: &[f64]| (l.iter().sum::<f64>() / l.len() as f64).exp();
+    logs.into_iter()
+        .map(|(n, c, sh)| {
+            let (c, sh) = (gm(&c), gm(&sh));
+            (n, c, sh)
+        })
+        .collect()
+}
+
+/// Fits the model to a sweep: coefficients per filter from its rows' prediction terms `feats`
+/// (`feature_rows`), costs from its `rows` (`relative_costs`); returns the Rust source of
+/// `analysis::model` with `provenance` in its header.
+pub fn fit_model(feats: &[FeatureRow], rows: &[super::sweep::Row], provenance: &str) -> String {
+    let model: Vec<Coeffs> = ["nearest", "pcf2x2", "pcf3x3", "pcf5x5"]
+        .into_iter()
+        .filter_map(|f| {
+            let of: Vec<&FeatureRow> = feats.iter().filter(|r| r.filter == f).collect();
+            (!of.is_empty()).then(|| fit_coeffs(f, &of))
+        })
+        .collect();
+    model_source(&model, &relative_costs(rows), provenance)
+}
+
+/// Rust source of `analysis::model` for fitted coefficients and costs.
+pub fn model_source(model: &[Coeffs], costs: &[(String, f64, f64)], provenance: &str) -> String {
+    let mut s = String::new();
+    s.push_str(
+        "//! The error-budget model's fitted numbers, generated by `umbra sweep --fit-budget`.\n",
+    );
+    for line in provenance.lines() {
+        s.push_str(&format!("//! {line}\n"));
+    }
+    s.push_str("\nuse super::coeffs::Coeffs;\n\n/// Coefficients per filter.\n");
+    s.push_str(&format!("pub const MODEL: [Coeffs; {}] = [\n", model.len()));
+    for k in model {
+        s.push_str(&format!(
+            "    Coeffs {{\n        filter: {:?},\n        a: {:e},\n        b: {:e},\n        c: {:e},\n    }},\n",
+            k.filter, k.a, k.b, k.c
+        ));
+    }
+    s.push_str(
+        "];\n\n/// Candidates: (configuration, camera-pass time, shadow-pass time), each relative to the\n/// default configuration's (`budget::COST_BASE`).\n",
+    );
+    s.push_str(&format!(
+        "pub const COSTS: [(&str, f64, f64); {}] = [\n",
+        costs.len()
+    ));
+    for (n, c, sh) in costs {
+        s.push_str(&format!("    ({n:?}, {c:.3}, {sh:.3}),\n"));
+    }
+    s.push_str("];\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::grid::Grid;
+
+    fn feature_row(t: f64, e: f64, m: f64) -> FeatureRow {
+        FeatureRow {
+            scene: "s".into(),
+            view: "v".into(),
+            config: "c".into(),
+            filter: "pcf2x2".into(),
+            method: "camera".into(),
+            map_texels: 2048,
+            texel_term: t,
+            edge_term: e,
+            misclassified: m,
+            gpu_ms: 10.0,
+        }
+    }
+
+    #[test]
+    fn fit_recovers_known_coefficients_and_stays_non_negative() {
+        let rows: Vec<FeatureRow> = (0..40)
+            .map(|i| {
+                let t = 1e-4 * (1.0 + i as f64);
+                let e = 2e-3 * (1.0 + (i % 7) as f64);
+                feature_row(t, e, 0.8 * t + 0.05 * e + 2e-5)
+            })
+            .collect();
+        let refs: Vec<&FeatureRow> = rows.iter().collect();
+        let k = fit_coeffs("pcf2x2", &refs);
+        assert!(
+            (k.a - 0.8).abs() < 1e-6 && (k.b - 0.05).abs() < 1e-6 && (k.c - 2e-5).abs() < 1e-9,
+            "{k:?}"
+        );
+        // Data that would want a negative slope gets a non-negative fit.
+        let neg: Vec<FeatureRow> = (0..10)
+            .map(|i| feature_row(i as f64, 1.0, 1.0 - 0.05 * i as f64))
+            .collect();
+        let k = fit_coeffs("nearest", &neg.iter().collect::<Vec<_>>());
+        assert!(k.a >= 0.0 && k.b >= 0.0 && k.c >= 0.0, "{k:?}");
+    }
+
+    #[test]
+    fn calibration_scales_then_fits_a_line() {
+        let v = |i: usize, p: f64, m: f64| Verified {
+            prediction: pred(i, p, 1.0),
+            measured: m,
+        };
+        assert_eq!(Calibration::fit(&[]), Calibration::IDENTITY);
+        let one = Calibration::fit(&[v(0, 2e-3, 1e-3)]);
+        assert!((one.apply(4e-3) - 2e-3).abs() < 1e-12, "{one:?}");
+        // Two points on m = 5e-4 + 0.25 p: the line through them.
+        let two = Calibration::fit(&[v(0, 2e-3, 1e-3), v(1, 6e-3, 2e-3)]);
+        assert!(
+            (two.slope - 0.25).abs() < 1e-9 && (two.offset - 5e-4).abs() < 1e-12,
+            "{two:?}"
+        );
+        // Ranked wrongly (higher prediction, lower measurement): flat at the worst measured.
+        let flat = Calibration::fit(&[v(0, 2e-3, 3e-3), v(1, 6e-3, 1e-3)]);
+        assert_eq!(flat.slope, 0.0);
+        assert_eq!(flat.apply(1.0), 3e-3);
+        // next_candidate: with everything calibrated under the budget, the cheapest.
+        let p = vec![
+            pred(0, 0.004, 0.8),
+            pred(1, 0.0012, 1.0),
+            pred(2, 0.0006, 1.3),
+        ];
+        let c = Calibration {
+            offset: 0.0,
+            slope: 0.1,
+        };
+        assert_eq!(next_candidate(&p, &[], &c, 0.001), Some(0));
+        // Uncalibrated: only #2 is predicted within 80 % of the budget.
+        assert_eq!(
+            next_candidate(&p, &[], &Calibration::IDENTITY, 0.001),
+            Some(2)
+        );
+        // Nothing predicted within: the most accurate.
+        assert_eq!(
+            next_candidate(&p, &[], &Calibration::IDENTITY, 1e-4),
+            Some(2)
+        );
+    }
+
+    fn pred(name_idx: usize, predicted: f64, cost: f64) -> Prediction {
+        Prediction {
+            config: Grid::quick().configs()[name_idx].clone(),
+            predicted,
+            relative_cost: cost,
+        }
+    }
+
+    #[test]
+    fn chooser_takes_the_cheapest_within_budget_with_hysteresis() {
+        let p = vec![
+            pred(0, 0.004, 0.8),
+            pred(1, 0.0012, 1.0),
+            pred(2, 0.0006, 1.3),
+            pred(3, 0.0002, 2.0),
+        ];
+        assert_eq!(cheapest_within(&p, 0.001).unwrap().relative_cost, 1.3);
+        assert_eq!(cheapest_within(&p, 0.01).unwrap().relative_cost, 0.8);
+        // Unreachable: the most accurate.
+        assert_eq!(cheapest_within(&p, 1e-5).unwrap().relative_cost, 2.0);
+        // Hysteresis (`keep_current`).
+        let choice = |cost: f64| BudgetChoice {
+            budget: 0.001,
+            chosen: Prediction {
+                relative_cost: cost,
+                ..p[1].clone()
+            },
+            measured: Some(0.0005),
+            met: true,
+            verified: Vec::new(),
+            current_measured: None,
+            probes: 0,
+            ms: 0.0,
+        };
+        assert!(
+            keep_current(&choice(1.0), 1.2, 0.0008),
+            "new one only 17 % cheaper: stay"
+        );
+        assert!(
+            !keep_current(&choice(0.9), 1.2, 0.0008),
+            "25 % cheaper: switch"
+        );
+        assert!(
+            !keep_current(&choice(1.5), 1.2, 0.0012),
+            "current over budget: switch"
+        );
+    }
+}
+
+/// Most candidates rendered to verify a choice.
+pub const MAX_VERIFIED: usize = 5;
+/// How far over the budget a cheaper candidate's rescaled prediction may be and still be tried.
+pub const EXPLORE_FACTOR: f64 = 2.0;
+/// The search aims a candidate's rescaled prediction at this fraction of the budget.
+pub const SEARCH_MARGIN: f64 = 0.8;
+
+/// A candidate rendered and measured at the probes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Verified {
+    /// The candidate and its (unscaled) prediction.
+    pub prediction: Prediction,
+    /// Misclassified fraction measured at the probes.
+    pub measured: f64,
+}
+
+/// What `choose` decided.
+#[derive(Clone, Debug)]
+pub struct BudgetChoice {
+    /// The budget (fraction).
+    pub budget: f64,
+    /// The chosen candidate.
+    pub chosen: Prediction,
+    /// Its misclassification measured at the probes, when it was rendered.
+    pub measured: Option<f64>,
+    /// Whether the chosen candidate's measurement (or, unverified, its prediction) is within
+    /// the budget.
+    pub met: bool,
+    /// Every candidate rendered, in order.
+    pub verified: Vec<Verified>,
+    /// The misclassification of the running configuration passed to `choose`, if any.
+    pub current_measured: Option<f64>,
+    /// Probe rays cast.
+    pub probes: usize,
+    /// Time the choice took (ms), probe and renders included.
+    pub ms: f64,
+}
+
+/// Measures `c`'s misclassification at the probes with one render (shadow view and depth).
+pub fn measure(
+    renderer: &mut umbra::render::Renderer,
+    probe: &ViewProbe,
+    view: &View,
+    c: &super::grid::Config,
+) -> Result<f64, umbra::gpu::GpuError> {
+    let mut v = view.clone();
+    v.shadow = c.shadow;
+    v.mode = umbra::render::ViewMode::Shadow;
+    renderer.set_read_depth(true);
+    let f = renderer.render(&v, probe.width, probe.height);
+    renderer.set_read_depth(false);
+    let f = f?;
+    let depth = f.depth.as_deref().unwrap_or(&[]);
+    Ok(misclassified_at_probes(probe, &f.image, depth, &f.plan).0)
+}
+
+/// This view's correction of the model, from the candidates measured so far: measured ≈
+/// `offset + slope · predicted`. One measurement: a pure scale. Two or more with predictions
+/// apart: least squares; a negative slope (the model ranks them wrongly here) becomes a flat
+/// line at the largest measurement.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Calibration {
+    /// Added.
+    pub offset: f64,
+    /// Multiplies the prediction.
+    pub slope: f64,
+}
+
+impl Calibration {
+    /// No correction.
+    pub const IDENTITY: Calibration = Calibration {
+        offset: 0.0,
+        slope: 1.0,
+    };
+
+    /// Fitted to `verified`.
+    pub fn fit(verified: &[Verified]) -> Self {
+        let pts: Vec<(f64, f64)> = verified
+            .iter()
+            .map(|v| (v.prediction.predicted, v.measured))
+            .collect();
+        let Some(&(p0, m0)) = pts.last() else {
+            return Self::IDENTITY;
+        };
+        let n = pts.len() as f64;
+        let (mp, mm) = (
+            pts.iter().map(|p| p.0).sum::<f64>() / n,
+            pts.iter().map(|p| p.1).sum::<f64>() / n,
+        );
+        let var = pts.iter().map(|p| (p.0 - mp).powi(2)).sum::<f64>();
+        if pts.len() < 2 || var <= (0.05 * mp).powi(2) {
+            return Self {
+                offset: 0.0,
+                slope: if p0 > 0.0 {
+                    (m0 / p0).clamp(0.02, 50.0)
+                } else {
+                    1.0
+                },
+            };
+        }
+        let slope = pts.iter().map(|p| (p.0 - mp) * (p.1 - mm)).sum::<f64>() / var;
+        if slope <= 0.0 {
+            let top = pts.iter().map(|p| p.1).fold(0.0, f64::max);
+            return Self {
+                offset: top,
+                slope: 0.0,
+            };
+        }
+        Self {
+            offset: mm - slope * mp,
+            slope,
+        }
+    }
+
+    /// The corrected prediction.
+    pub fn apply(&self, predicted: f64) -> f64 {
+        (self.offset + self.slope * predicted).max(0.0)
+    }
+}
+
+/// The next candidate to render, or None to stop. With `q` the calibrated prediction and only
+/// candidates cheaper than the best one measured within budget: the cheapest with `q` within
+/// `SEARCH_MARGIN` of the budget; else the cheapest with `q` within the budget; else, once one
+/// is within budget, the most accurate with `q` within `EXPLORE_FACTOR` × the budget (the model
+/// ranks configurations of one view imperfectly); before any is within budget and none is
+/// predicted to be, the most accurate unverified candidate.
+pub fn next_candidate(
+    predictions: &[Prediction],
+    verified: &[Verified],
+    cal: &Calibration,
+    budget: f64,
+) -> Option<usize> {
+    let is_verified = |p: &Prediction| verified.iter().any(|v| v.prediction.config == p.config);
+    let best_ok = verified
+        .iter()
+        .filter(|v| v.measured <= budget)
+        .map(|v| v.prediction.relative_cost)
+        .fold(f64::INFINITY, f64::min);
+    let open = || {
+        predictions
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| !is_verified(p) && p.relative_cost < best_ok)
+    };
+    let cheapest_under = |limit: f64| {
+        open()
+            .filter(|(_, p)| cal.apply(p.predicted) <= limit)
+            .min_by(|a, b| a.1.relative_cost.total_cmp(&b.1.relative_cost))
+            .map(|(i, _)| i)
+    };
+    let most_accurate = |limit: f64| {
+        open()
+            .filter(|(_, p)| cal.apply(p.predicted) <= limit)
+            .min_by(|a, b| {
+                a.1.predicted
+                    .total_cmp(&b.1.predicted)
+                    .then(a.1.relative_cost.total_cmp(&b.1.relative_cost))
+            })
+            .map(|(i, _)| i)
+    };
+    cheapest_under(budget * SEARCH_MARGIN)
+        .or_else(|| cheapest_under(budget))
+        .or_else(|| {
+            if best_ok.is_finite() {
+                most_accurate(budget * EXPLORE_FACTOR)
+            } else {
+                most_accurate(f64::INFINITY)
+            }
+        })
+}
+
+/// Chooses the cheapest configuration for `view` whose misclassification is within `budget`
+/// (module documentation: probe, predict, verify); with `current`, the running configuration is
+/// measured too (`BudgetChoice::current_measured`, for `keep_current`). `None` when no candidate
+/// applies (no light casts a shadow).
+pub fn choose(
+    renderer: &mut umbra::render::Renderer,
+    reference: &ReferenceScene,
+    scene: &Scene,
+    view: &View,
+    (w, h): (u32, u32),
+    budget: f64,
+    current: Option<&super::grid::Config>,
+) -> Result<Option<BudgetChoice>, umbra::gpu::GpuError> {
+    let t0 = std::time::Instant::now();
+    let planner = ScenePlanner::new(scene);
+    let probe = probe_view(reference, &planner, view, w, h, PROBE_STRIDE);
+    // This view's split between the passes, from the default configuration (second of two
+    // frames: the first may compile pipelines or allocate the map).
+    let base = super::grid::Grid::full()
+        .configs()
+        .into_iter()
+        .find(|c| c.name() == COST_BASE);
+    let mut base_ms = None;
+    if let Some(b) = base {
+        let mut v = view.clone();
+        v.shadow = b.shadow;
+        renderer.render(&v, w, h)?;
+        let st = renderer.render(&v, w, h)?.stats;
+        base_ms = st.gpu_camera_ms.zip(st.gpu_shadow_ms);
+    }
+    let preds = predict_all(&probe, &planner, view, base_ms);
+    if preds.is_empty() {
+        return Ok(None);
+    }
+    let mut verified: Vec<Verified> = Vec::new();
+    let mut cal = Calibration::IDENTITY;
+    while verified.len() < MAX_VERIFIED {
+        let Some(i) = next_candidate(&preds, &verified, &cal, budget) else {
+            break;
+        };
+        let m = measure(renderer, &probe, view, &preds[i].config)?;
+        log::debug!(
+            "budget {budget:e}: tried {} (cost {:.2}, predicted {:.2e}, calibrated {:.2e}) measured {m:.2e}",
+            preds[i].config.name(),
+            preds[i].relative_cost,
+            preds[i].predicted,
+            cal.apply(preds[i].predicted)
+        );
+        verified.push(Verified {
+            prediction: preds[i].clone(),
+            measured: m,
+        });
+        cal = Calibration::fit(&verified);
+    }
+    let ok = verified
+        .iter()
+        .filter(|v| v.measured <= budget)
+        .min_by(|a, b| {
+            a.prediction
+                .relative_cost
+                .total_cmp(&b.prediction.relative_cost)
+        });
+    let (chosen, measured, met) = match ok {
+        Some(v) => (v.prediction.clone(), Some(v.measured), true),
+        None => {
+            // Not reachable within the renders: the most accurate measured (or predicted).
+            match verified
+                .iter()
+                .min_by(|a, b| a.measured.total_cmp(&b.measured))
+            {
+                Some(v) => (v.prediction.clone(), Some(v.measured), false),
+                None => {
+                    let p = cheapest_within(&preds, budget)
+                        .cloned()
+                        .unwrap_or_else(|| preds[0].clone());
+                    let met = p.predicted <= budget;
+                    (p, None, met)
+                }
+            }
+        }
+    };
+    // The running configuration (the viewer's), measured with the same probe.
+    let current_measured = match current {
+        None => None,
+        Some(c) => match verified.iter().find(|v| &v.prediction.config == c) {
+            Some(v) => Some(v.measured),
+            None => Some(measure(renderer, &probe, view, c)?),
+        },
+    };
+    Ok(Some(BudgetChoice {
+        budget,
+        chosen,
+        measured,
+        met,
+        verified,
+        current_measured,
+        probes: probe.probes.len(),
+        ms: t0.elapsed().as_secs_f64() * 1e3,
+    }))
+}
+
+/// The budget mode checked on one view against its sweep.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct CheckRow {
+    /// Scene.
+    pub scene: String,
+    /// View.
+    pub view: String,
+    /// Budget (fraction).
+    pub budget: f64,
+    /// Chosen configuration.
+    pub chosen: String,
+    /// Its prediction before verification.
+    pub predicted: f64,
+    /// Misclassification of the chosen configuration by `reference::compare` (full image).
+    pub measured: f64,
+    /// Whether `measured` ≤ `budget`.
+    pub within_budget: bool,
+    /// The chosen configuration's GPU ms in the sweep.
+    pub chosen_sweep_gpu_ms: f64,
+    /// The cheapest configuration of the sweep that meets the budget ("" if none).
+    pub cheapest: String,
+    /// Its GPU ms in the sweep.
+    pub cheapest_gpu_ms: f64,
+    /// chosen / cheapest GPU time (sweep figures).
+    pub time_ratio: f64,
+    /// The same with both times from `denoised_ms` (and the cheapest within budget by those).
+    pub denoised_time_ratio: f64,
+    /// Renders the choice took.
+    pub renders: usize,
+    /// Time the choice took (ms).
+    pub choose_ms: f64,
+}
+
+/// Runs the budget mode on `camera`'s view and checks it against that view's sweep rows: the
+/// chosen configuration's full-image misclassification (`reference::compare`) and its GPU time
+/// against the cheapest swept configuration within the budget.
+#[allow(clippy::too_many_arguments)]
+pub fn check_view(
+    renderer: &mut umbra::render::Renderer,
+    reference: &ReferenceScene,
+    scene: &Scene,
+    view_name: &str,
+    camera: umbra::scene::Camera,
+    w: u32,
+    h: u32,
+    budget: f64,
+    rows: &[super::sweep::Row],
+) -> Result<Option<CheckRow>, umbra::gpu::GpuError> {
+    let view = View::new(camera);
+    let Some(c) = choose(renderer, reference, scene, &view, (w, h), budget, None)? else {
+        return Ok(None);
+    };
+    let mut v = view.clone();
+    v.shadow = c.chosen.config.shadow;
+    let m = crate::score::score(renderer, reference, &v, (w, h), &mut None)?.metrics;
+    let of: Vec<&super::sweep::Row> = rows
+        .iter()
+        .filter(|r| r.scene == scene.name && r.view == view_name)
+        .collect();
+    let name = c.chosen.config.name();
+    let chosen_ms = of
+        .iter()
+        .find(|r| r.config == name)
+        .map_or(f64::NAN, |r| r.gpu_ms);
+    let cheapest = of
+        .iter()
+        .filter(|r| r.misclassified <= budget)
+        .min_by(|a, b| a.gpu_ms.total_cmp(&b.gpu_ms));
+    Ok(Some(CheckRow {
+        scene: scene.name.clone(),
+        view: view_name.into(),
+        budget,
+        chosen: name.clone(),
+        predicted: c.chosen.predicted,
+        measured: m.misclassified,
+        within_budget: m.misclassified <= budget,
+        chosen_sweep_gpu_ms: chosen_ms,
+        cheapest: cheapest.map(|r| r.config.clone()).unwrap_or_default(),
+        cheapest_gpu_ms: cheapest.map_or(f64::NAN, |r| r.gpu_ms),
+        time_ratio: cheapest.map_or(f64::NAN, |r| chosen_ms / r.gpu_ms),
+        denoised_time_ratio: {
+            let est = denoised_ms(&of);
+            let ms = |n: &str| {
+                est.iter()
+                    .find(|e| e.0 == n)
+                    .map_or(f64::NAN, |e| e.1 + e.2)
+            };
+            let best = of
+                .iter()
+                .filter(|r| r.misclassified <= budget)
+                .map(|r| ms(&r.config))
+                .fold(f64::INFINITY, f64::min);
+            ms(&name) / best
+        },
+        renders: c.verified.len(),
+        choose_ms: c.ms,
+    }))
+}

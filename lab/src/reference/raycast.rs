@@ -1,0 +1,751 @@
+//! Exact shadow visibility and a Blinn-Phong reference image by ray casting, for the same view
+//! (same pixel centres, lights and material constants) as a GPU frame.
+
+use super::bvh::{Bvh, Hit};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use rayon::prelude::*;
+use umbra::math::interp::perturb_normal;
+use umbra::math::projection::pixel_to_ndc;
+use umbra::math::ray::Ray;
+use umbra::plan::FramePlan;
+use umbra::scene::{
+    blinn_phong_params, shade_blinn_phong, AlphaMode, Filter, LightKind, Sampler, Scene, Texture,
+    TextureRef, BLEND_SHADOW_CUTOFF,
+};
+
+/// Where a world triangle came from.
+#[derive(Clone, Copy, Debug)]
+struct TriRef {
+    instance: u32,
+    mesh: u32,
+    primitive: u32,
+    /// Index of the triangle's first index in the primitive.
+    first: u32,
+}
+
+/// A scene prepared for ray casting: world-space triangles in a BVH, plus what shading needs.
+/// Like the renderer, it works relative to [`Scene::render_origin`] (rays, hits and the plans it
+/// reads are in those coordinates).
+pub struct ReferenceScene<'a> {
+    scene: &'a Scene,
+    /// Each instance's model → world relative to `origin`.
+    matrices: Vec<Mat4>,
+    /// The point its coordinates are relative to.
+    pub origin: Vec3,
+    /// The hierarchy.
+    pub bvh: Bvh,
+    refs: Vec<TriRef>,
+    normal_mats: Vec<Mat3>,
+    srgb_lut: [f32; 256],
+    eps: f32,
+}
+
+/// The reference result for one view.
+pub struct ReferenceFrame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Per pixel: None when no surface is hit; else exact visibility of the shadowed light
+    /// (facing and unoccluded → true).
+    pub visibility: Vec<Option<bool>>,
+    /// Per pixel: None when no surface is hit; else the fraction of the shadowed light's
+    /// emitter visible (`AREA_SAMPLES` shadow rays over it when it has a size, 0 or 1 for a
+    /// punctual light; 0 where the surface faces away): ground truth for soft shadows.
+    pub coverage: Vec<Option<f32>>,
+    /// Per pixel: distance along the primary ray (∞ for none).
+    pub distance: Vec<f32>,
+    /// The reference image (sRGB), exact hard shadows.
+    pub image: image::RgbaImage,
+    /// Per pixel: the surface seen is curved (its interpolated normal leaves the flat face's by
+    /// more than 1°); false for flat faces and for the background.
+    pub curved: Vec<bool>,
+    /// Per pixel: the cosine between the surface's interpolated normal (facing the viewer) and
+    /// the direction to the shadowed light, the n·l that decides whether it faces the light; 1
+    /// where no surface is hit or no light is shadowed.
+    pub incidence: Vec<f32>,
+}
+
+/// One reference pixel: (centre visibility, visible fraction) of the shadowed light where a
+/// surface is hit, distance, colour, curved, incidence.
+type PixelResult = (Option<(bool, f32)>, f32, [u8; 4], bool, f32);
+
+impl ReferenceFrame {
+    /// The shadowed light's visible fraction as the GPU's shadow view writes visibility: grey
+    /// bytes of fraction × 255 (the view writes linear values to an sRGB target, so the byte
+    /// is the value), the clear colour where no surface is hit.
+    pub fn coverage_image(&self) -> image::RgbaImage {
+        let c = umbra::plan::CLEAR_COLOR;
+        let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];
+        image::RgbaImage::from_fn(self.width, self.height, |x, y| {
+            match self.coverage[(y * self.width + x) as usize] {
+                None => image::Rgba(background),
+                Some(v) => {
+                    let b = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+                    image::Rgba([b, b, b, 255])
+                }
+            }
+        })
+    }
+}
+
+/// cos 1°: a surface whose interpolated normal leaves the face normal by more is curved.
+const CURVED_COS: f32 = 0.999_847_7;
+/// Shadow rays a light with a size casts per shaded point: the emitter is sampled on a fixed
+/// area-uniform golden-angle spiral over its disk (the sun's disk of directions; a sphere light's
+/// disk facing the point).
+pub const AREA_SAMPLES: usize = 128;
+/// Most blended surfaces one primary ray composites (deeper ones are taken as opaque).
+const MAX_BLEND_LAYERS: u32 = 8;
+
+/// What a probe ray found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Probe {
+    /// World position of the hit.
+    pub position: Vec3,
+    /// Geometric normal, facing the camera.
+    pub normal: Vec3,
+    /// Distance along the ray.
+    pub distance: f32,
+    /// Exact visibility of the shadowed light (facing it and unoccluded).
+    pub visible: bool,
+}
+
+/// Sample `k` of `n` on the unit disk: an area-uniform golden-angle spiral.
+fn spiral(k: usize, n: usize) -> Vec2 {
+    let r = ((k as f32 + 0.5) / n as f32).sqrt();
+    let a = k as f32 * 2.399_963_2;
+    Vec2::new(r * a.cos(), r * a.sin())
+}
+
+/// Light `l` seen from point `p`: unit direction towards it, distance (∞ for a directional
+/// light) and radiance arriving (inverse square and the spot cone applied).
+fn light_at(l: &umbra::scene::Light, p: Vec3) -> (Vec3, f32, Vec3) {
+    match l.kind {
+        LightKind::Directional => (
+            -l.direction.normalize_or(Vec3::NEG_Y),
+            f32::INFINITY,
+            l.color * l.intensity,
+        ),
+        _ => {
+            let d = l.position - p;
+            let r2 = d.length_squared().max(1e-8);
+            let dir = d / r2.sqrt();
+            let mut rad = l.color * l.intensity / r2 * l.range_window(r2.sqrt());
+            let cd = (-dir).dot(l.direction.normalize_or(Vec3::NEG_Y));
+            rad *= l.cone_attenuation(cd);
+            (dir, r2.sqrt(), rad)
+        }
+    }
+}
+
+/// The interpolated TEXCOORD_0, TEXCOORD_1 and COLOR_0 at hit `h` on the triangle whose first
+/// index is `first` (zeros without texture coordinates, white without colours).
+fn surface_inputs(prim: &umbra::scene::Primitive, first: usize, h: &Hit) -> ([Vec2; 2], Vec4) {
+    let i = [0, 1, 2].map(|k| prim.indices[first + k] as usize);
+    let w = [1.0 - h.u - h.v, h.u, h.v];
+    let uv0 = |v: usize| prim.uvs.get(v).copied().unwrap_or_default();
+    let (mut uvs, mut color) = ([Vec2::ZERO; 2], Vec4::ZERO);
+    for (v, w) in i.into_iter().zip(w) {
+        uvs[0] += uv0(v) * w;
+        uvs[1] += prim.uv1(v) * w;
+        color += prim.color(v) * w;
+    }
+    (uvs, color)
+}
+
+/// What a click on the image hits (`ReferenceScene::pick`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pick {
+    /// Index into `Scene::instances` (its `node` names the glTF node).
+    pub instance: usize,
+    /// Index into `Scene::meshes`.
+    pub mesh: usize,
+    /// Index into the mesh's primitives (as loaded).
+    pub primitive: usize,
+    /// Index into `Scene::materials`.
+    pub material: usize,
+    /// Triangle index within the primitive (its indices `3t..3t+3`).
+    pub triangle: usize,
+    /// World position of the hit (the scene's own coordinates).
+    pub position: Vec3,
+    /// Geometric normal, facing the camera.
+    pub normal: Vec3,
+    /// Distance from the eye.
+    pub distance: f32,
+    /// Per light of the plan: exactly lit there (facing it and unoccluded).
+    pub lights_visible: Vec<bool>,
+}
+
+/// The primary ray through image position (x, y) of the camera with clip → world `inv` at `eye`.
+fn primary_ray(inv: &glam::Mat4, eye: Vec3, x: f32, y: f32, w: u32, h: u32) -> Ray {
+    let n = pixel_to_ndc(x, y, w, h);
+    let far = *inv * Vec4::new(n.x, n.y, 1e-3, 1.0);
+    Ray::new(
+        eye,
+        (far.truncate() / far.w - eye).normalize_or(Vec3::NEG_Z),
+    )
+}
+
+/// Turns a hit's geometric normal towards the viewer along `dir`, as the shader does; the
+/// returned flag says whether the shading normals flip too (a back face whose interpolated normal
+/// also faces away).
+fn face_viewer(ng: Vec3, n_geo: Vec3, dir: Vec3) -> (Vec3, bool) {
+    if ng.dot(dir) > 0.0 {
+        (-ng, n_geo.dot(dir) > 0.0)
+    } else {
+        (ng, false)
+    }
+}
+
+fn srgb_encode(c: f32) -> u8 {
+    (umbra::math::tonemap::linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0).round() as u8
+}
+
+impl<'a> ReferenceScene<'a> {
+    /// Collects world-space triangles of every instance and builds the BVH.
+    pub fn new(scene: &'a Scene) -> Self {
+        let mut tris = Vec::new();
+        let mut refs = Vec::new();
+        let mut normal_mats = Vec::new();
+        let origin = scene.render_origin();
+        let matrices: Vec<Mat4> = scene
+            .instances
+            .iter()
+            .map(|i| umbra::scene::rebased(i.world_from_model, origin))
+            .collect();
+        for (ii, inst) in scene.instances.iter().enumerate() {
+            let world_from_model = matrices[ii];
+            let m3 = Mat3::from_mat4(world_from_model);
+            normal_mats.push(if m3.determinant().abs() > 1e-30 {
+                m3.inverse().transpose()
+            } else {
+                m3
+            });
+            for (pi, p) in scene.meshes[inst.mesh].primitives.iter().enumerate() {
+                let world: Vec<Vec3> = p
+                    .positions
+                    .iter()
+                    .map(|v| world_from_model.transform_point3(*v))
+                    .collect();
+                for (k, t) in p.indices.chunks_exact(3).enumerate() {
+                    tris.push([
+                        world[t[0] as usize],
+                        world[t[1] as usize],
+                        world[t[2] as usize],
+                    ]);
+                    refs.push(TriRef {
+                        instance: ii as u32,
+                        mesh: inst.mesh as u32,
+                        primitive: pi as u32,
+                        first: (k * 3) as u32,
+                    });
+                }
+            }
+        }
+        let bvh = Bvh::build(&tris);
+        let mut srgb_lut = [0.0; 256];
+        for (i, v) in srgb_lut.iter_mut().enumerate() {
+            *v = umbra::math::tonemap::srgb_to_linear(i as f32 / 255.0);
+        }
+        let eps = (scene.bounds().diagonal() * 2e-5).max(1e-6);
+        Self {
+            scene,
+            matrices,
+            origin,
+            bvh,
+            refs,
+            normal_mats,
+            srgb_lut,
+            eps,
+        }
+    }
+
+    fn texel(&self, t: &Texture, s: &Sampler, x: i64, y: i64, srgb: bool) -> Vec4 {
+        let (w, h) = (t.width as i64, t.height as i64);
+        let (x, y) = (s.wrap_u.texel(x, w), s.wrap_v.texel(y, h));
+        let i = ((y * w + x) * 4) as usize;
+        let px = &t.rgba[i..i + 4];
+        if srgb {
+            Vec4::new(
+                self.srgb_lut[px[0] as usize],
+                self.srgb_lut[px[1] as usize],
+                self.srgb_lut[px[2] as usize],
+                px[3] as f32 / 255.0,
+            )
+        } else {
+            Vec4::new(px[0] as f32, px[1] as f32, px[2] as f32, px[3] as f32) / 255.0
+        }
+    }
+
+    /// Sample of mip 0 at `uv` after the slot's texture transform, with the texture's sampler: its magnification filter (nearest or
+    /// bilinear) and wrap modes (decoded from sRGB when `srgb`). Mip 0 only: the reference has
+    /// no pixel footprint, so minification filters and mipmaps are not modelled.
+    /// `uvs` are the hit's TEXCOORD_0 and TEXCOORD_1; the slot reads its own set.
+    fn sample(&self, tex: Option<TextureRef>, uvs: [Vec2; 2], srgb: bool, default: Vec4) -> Vec4 {
+        let Some((t, s, uv)) = tex.and_then(|r| {
+            Some((
+                self.scene.textures.get(r.texture)?,
+                r.sampler,
+                r.transform.apply(uvs[(r.tex_coord as usize).min(1)]),
+            ))
+        }) else {
+            return default;
+        };
+        let x = uv.x * t.width as f32;
+        let y = uv.y * t.height as f32;
+        if s.mag == Filter::Nearest {
+            return self.texel(t, &s, x.floor() as i64, y.floor() as i64, srgb);
+        }
+        let (x, y) = (x - 0.5, y - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let a = self
+            .texel(t, &s, x0, y0, srgb)
+            .lerp(self.texel(t, &s, x0 + 1, y0, srgb), fx);
+        let b = self
+            .texel(t, &s, x0, y0 + 1, srgb)
+            .lerp(self.texel(t, &s, x0 + 1, y0 + 1, srgb), fx);
+        a.lerp(b, fy)
+    }
+
+    /// Exact visibility of world point `p` (geometric normal `ng`, facing normal `n`) from light
+    /// `i`: whether its centre is visible, the fraction of its emitter that is (the same for a
+    /// punctual light), the direction towards it and the radiance arriving.
+    fn visible(
+        &self,
+        plan: &FramePlan,
+        i: usize,
+        p: Vec3,
+        ng: Vec3,
+        n_facing: Vec3,
+    ) -> (bool, f32, Vec3, Vec3) {
+        let l = &plan.lights[i];
+        let (dir, dist, radiance) = light_at(l, p);
+        let facing = n_facing.dot(dir) > 0.0;
+        if !facing {
+            return (false, 0.0, dir, radiance);
+        }
+        if !plan.is_shadowed(i) {
+            return (true, 1.0, dir, radiance);
+        }
+        let centre = !self.occluded(p, ng, dir, dist);
+        let size = umbra::plan::soft_size(l);
+        if size <= 0.0 {
+            return (centre, if centre { 1.0 } else { 0.0 }, dir, radiance);
+        }
+        // The emitter's disk across the direction to it: the sun's directions within its
+        // angular radius (tan = size), a sphere light's disk of radius `size`.
+        let (e1, e2) = dir.any_orthonormal_pair();
+        let open = (0..AREA_SAMPLES)
+            .filter(|&k| {
+                let u = spiral(k, AREA_SAMPLES);
+                let (d, t) = match l.kind {
+                    LightKind::Directional => (
+                        (dir + (e1 * u.x + e2 * u.y) * size).normalize(),
+                        f32::INFINITY,
+                    ),
+                    _ => {
+                        let to = l.position + (e1 * u.x + e2 * u.y) * size - p;
+                        let t = to.length();
+                        (to / t.max(1e-20), t)
+                    }
+                };
+                !self.occluded(p, ng, d, t)
+            })
+            .count();
+        (centre, open as f32 / AREA_SAMPLES as f32, dir, radiance)
+    }
+
+    /// Whether anything lies between surface point `p` (geometric normal `ng`) and a light
+    /// `dist` away along `dir`.
+    fn occluded(&self, p: Vec3, ng: Vec3, dir: Vec3, dist: f32) -> bool {
+        // Start the shadow ray off the surface, on the light's side of the true face.
+        let side = if ng.dot(dir) >= 0.0 { ng } else { -ng };
+        let origin = p + side * self.eps;
+        self.bvh.occluded_where(
+            &Ray::new(origin, dir),
+            self.eps,
+            dist - self.eps,
+            &|h: &Hit| self.stops(h, true),
+        )
+    }
+
+    /// Whether a caster of light `i` lies within `radius` of surface point `p` (geometric normal
+    /// `ng`) across the light's direction: shadow rays start from 32 points of a disk of that
+    /// radius around `p` (across the direction to the light, moved along it onto `p`'s tangent
+    /// plane). A shadow map resolves
+    /// casters to its lookup's reach, so a false shadow with such a caster nearby is a shadow
+    /// drawn too wide, not the receiver shadowing itself.
+    pub fn caster_within(
+        &self,
+        plan: &FramePlan,
+        i: usize,
+        p: Vec3,
+        ng: Vec3,
+        radius: f32,
+    ) -> bool {
+        let Some(l) = plan.lights.get(i) else {
+            return false;
+        };
+        let (dir, _, _) = light_at(l, p);
+        let cos = ng.dot(dir);
+        if cos.abs() < 1e-3 {
+            return false;
+        }
+        let side = if cos >= 0.0 { ng } else { -ng };
+        let (e1, e2) = dir.any_orthonormal_pair();
+        (0..32).any(|k| {
+            let u = spiral(k, 32) * radius;
+            let o = e1 * u.x + e2 * u.y;
+            // Onto the tangent plane along the light's direction.
+            let start = p + o - dir * (ng.dot(o) / cos) + side * self.eps;
+            let (d, t) = match l.kind {
+                LightKind::Directional => (dir, f32::INFINITY),
+                _ => {
+                    let to = l.position - start;
+                    let t = to.length();
+                    (to / t.max(1e-20), t)
+                }
+            };
+            self.bvh
+                .occluded_where(&Ray::new(start, d), self.eps, t - self.eps, &|h: &Hit| {
+                    self.stops(h, true)
+                })
+        })
+    }
+
+    /// The nearest surface along a primary ray from `t_min` (alpha-masked texels let it
+    /// through).
+    fn intersect_from(&self, ray: &Ray, t_min: f32) -> Option<Hit> {
+        self.bvh
+            .intersect_where(ray, t_min, f32::INFINITY, &|h: &Hit| self.stops(h, false))
+    }
+
+    /// The nearest surface along a primary ray.
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_from(ray, 0.0)
+    }
+
+    /// Whether a hit stops a primary ray or (`shadow`) a shadow ray: always, except where the
+    /// base colour's alpha (factor × texture, bilinear on mip 0 as everywhere here) is below the
+    /// cutoff of an alpha-masked material (where the GPU's masked pipelines discard, camera and
+    /// shadow pass alike), and, for shadow rays, below `BLEND_SHADOW_CUTOFF` on a blended one.
+    fn stops(&self, h: &Hit, shadow: bool) -> bool {
+        let cutoff = match self.material_of(h).map(|m| m.alpha_mode) {
+            Some(AlphaMode::Mask(c)) => c,
+            Some(AlphaMode::Blend) if shadow => BLEND_SHADOW_CUTOFF,
+            _ => return true,
+        };
+        self.alpha_at(h) >= cutoff
+    }
+
+    /// The material of the triangle hit (None: the default material).
+    fn material_of(&self, h: &Hit) -> Option<&umbra::scene::Material> {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        self.scene.materials.get(prim.material)
+    }
+
+    /// Base-colour alpha (factor × texture) at hit `h`.
+    fn alpha_at(&self, h: &Hit) -> f32 {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let Some(mat) = self.scene.materials.get(prim.material) else {
+            return 1.0;
+        };
+        let (uvs, color) = surface_inputs(prim, r.first as usize, h);
+        let tex = mat.base_color_texture;
+        color.w * mat.base_color.w * self.sample(tex, uvs, true, Vec4::ONE).w
+    }
+
+    /// The linear colour seen along `ray` beyond `t_min`: the first surface's shading, and where
+    /// it is blended, that over what lies behind it (up to `MAX_BLEND_LAYERS` blended surfaces);
+    /// the clear colour where nothing is hit.
+    fn radiance(
+        &self,
+        plan: &FramePlan,
+        ray: &Ray,
+        t_min: f32,
+        ambient: Vec3,
+        layers: u32,
+    ) -> Vec3 {
+        let c = umbra::plan::CLEAR_COLOR;
+        let Some(h) = self.intersect_from(ray, t_min) else {
+            return Vec3::new(c[0], c[1], c[2]);
+        };
+        let (_, _, rgb) = self.shade(plan, ray, &h, ambient);
+        self.blend_behind(plan, ray, &h, plan.display(rgb), ambient, layers)
+    }
+
+    /// `rgb`, the shading of hit `h`, blended over what lies behind it when its material is
+    /// blended (the GPU's over operator: a·rgb + (1 − a)·behind).
+    fn blend_behind(
+        &self,
+        plan: &FramePlan,
+        ray: &Ray,
+        h: &Hit,
+        rgb: Vec3,
+        ambient: Vec3,
+        layers: u32,
+    ) -> Vec3 {
+        if layers >= MAX_BLEND_LAYERS
+            || self.material_of(h).map(|m| m.alpha_mode) != Some(AlphaMode::Blend)
+        {
+            return rgb;
+        }
+        let a = self.alpha_at(h).clamp(0.0, 1.0);
+        if a >= 1.0 {
+            return rgb;
+        }
+        // Past this surface: a relative step so that the same triangle is not hit again.
+        let behind = self.radiance(
+            plan,
+            ray,
+            h.t * (1.0 + 1e-5) + self.eps,
+            ambient,
+            layers + 1,
+        );
+        rgb * a + behind * (1.0 - a)
+    }
+
+    /// What lies under image position (`x`, `y`) (pixel units, centres at +0.5) of `plan`'s
+    /// camera: the surface the primary ray hits first, with each of the plan's lights' exact
+    /// verdict there (facing it, and unoccluded whether or not the GPU shadows that light).
+    pub fn pick(&self, plan: &FramePlan, x: f32, y: f32, width: u32, height: u32) -> Option<Pick> {
+        debug_assert_eq!(
+            plan.origin, self.origin,
+            "plan and reference share an origin"
+        );
+        let inv = plan.clip_from_world.inverse();
+        let ray = primary_ray(&inv, plan.camera_position, x, y, width, height);
+        let h = self.intersect(&ray)?;
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let (ng, mut n_geo) = self.hit_normals(&h);
+        let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+        if flip {
+            n_geo = -n_geo;
+        }
+        let p = ray.at(h.t);
+        let lights = plan
+            .lights
+            .iter()
+            .map(|l| {
+                let (dir, dist, _) = light_at(l, p);
+                n_geo.dot(dir) > 0.0 && !self.occluded(p, ng, dir, dist)
+            })
+            .collect();
+        Some(Pick {
+            instance: r.instance as usize,
+            mesh: r.mesh as usize,
+            primitive: r.primitive as usize,
+            material: prim.material,
+            triangle: r.first as usize / 3,
+            position: p + self.origin,
+            normal: ng,
+            distance: h.t,
+            lights_visible: lights,
+        })
+    }
+
+    /// Geometric and interpolated normals (world space, as stored: not yet turned to the viewer)
+    /// at a hit.
+    fn hit_normals(&self, h: &Hit) -> (Vec3, Vec3) {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let world_from_model = self.matrices[r.instance as usize];
+        let idx = [0, 1, 2].map(|k| prim.indices[r.first as usize + k] as usize);
+        let pw = idx.map(|i| world_from_model.transform_point3(prim.positions[i]));
+        let ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
+        if prim.normals.len() != prim.positions.len() {
+            return (ng, ng);
+        }
+        let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
+        let n =
+            prim.normals[idx[0]] * w.x + prim.normals[idx[1]] * w.y + prim.normals[idx[2]] * w.z;
+        (
+            ng,
+            (self.normal_mats[r.instance as usize] * n).normalize_or(ng),
+        )
+    }
+
+    /// Exact visibility at chosen pixel centres of `plan`'s camera (for sparse probes: the error
+    /// budget's prediction). `None` where the ray hits nothing.
+    pub fn probe(
+        &self,
+        plan: &FramePlan,
+        pixels: &[(f32, f32)],
+        width: u32,
+        height: u32,
+    ) -> Vec<Option<Probe>> {
+        debug_assert_eq!(
+            plan.origin, self.origin,
+            "plan and reference share an origin"
+        );
+        let inv = plan.clip_from_world.inverse();
+        let eye = plan.camera_position;
+        pixels
+            .par_iter()
+            .map(|&(x, y)| {
+                let ray = primary_ray(&inv, eye, x, y, width, height);
+                let h = self.intersect(&ray)?;
+                // The same normals, flips and facing test as `shade`.
+                let (ng, mut n_geo) = self.hit_normals(&h);
+                let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+                if flip {
+                    n_geo = -n_geo;
+                }
+                let p = ray.at(h.t);
+                let visible = match plan.shadow_light {
+                    Some(i) => self.visible(plan, i, p, ng, n_geo).0,
+                    None => true,
+                };
+                Some(Probe {
+                    position: p,
+                    normal: ng,
+                    distance: h.t,
+                    visible,
+                })
+            })
+            .collect()
+    }
+
+    /// Casts one primary ray per pixel centre of `plan`'s camera and shades the hits.
+    pub fn render(
+        &self,
+        plan: &FramePlan,
+        width: u32,
+        height: u32,
+        ambient: Vec3,
+    ) -> ReferenceFrame {
+        debug_assert_eq!(
+            plan.origin, self.origin,
+            "plan and reference share an origin"
+        );
+        let inv = plan.clip_from_world.inverse();
+        let eye = plan.camera_position;
+        let n = (width * height) as usize;
+        let c = umbra::plan::CLEAR_COLOR;
+        let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];
+        let results: Vec<PixelResult> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let (x, y) = (
+                    (i as u32 % width) as f32 + 0.5,
+                    (i as u32 / width) as f32 + 0.5,
+                );
+                let ray = primary_ray(&inv, eye, x, y, width, height);
+                match self.intersect(&ray) {
+                    None => (None, f32::INFINITY, background, false, 1.0),
+                    Some(h) => {
+                        let (vis, cover, rgb) = self.shade(plan, &ray, &h, ambient);
+                        let rgb = self.blend_behind(plan, &ray, &h, plan.display(rgb), ambient, 0);
+                        let (ng, n) = self.hit_normals(&h);
+                        let incidence = plan.shadow_light.map_or(1.0, |i| {
+                            let (_, flip) = face_viewer(ng, n, ray.dir);
+                            let facing = if flip { -n } else { n };
+                            facing.dot(light_at(&plan.lights[i], ray.at(h.t)).0)
+                        });
+                        (
+                            Some((vis, cover)),
+                            h.t,
+                            [
+                                srgb_encode(rgb.x),
+                                srgb_encode(rgb.y),
+                                srgb_encode(rgb.z),
+                                255,
+                            ],
+                            ng.dot(n).abs() < CURVED_COS,
+                            incidence,
+                        )
+                    }
+                }
+            })
+            .collect();
+        let mut image = image::RgbaImage::new(width, height);
+        for (i, r) in results.iter().enumerate() {
+            image.put_pixel(i as u32 % width, i as u32 / width, image::Rgba(r.2));
+        }
+        ReferenceFrame {
+            width,
+            height,
+            visibility: results.iter().map(|r| r.0.map(|v| v.0)).collect(),
+            coverage: results.iter().map(|r| r.0.map(|v| v.1)).collect(),
+            distance: results.iter().map(|r| r.1).collect(),
+            image,
+            curved: results.iter().map(|r| r.3).collect(),
+            incidence: results.iter().map(|r| r.4).collect(),
+        }
+    }
+
+    /// The shown light's centre visibility and emitter fraction, and the lit colour.
+    fn shade(&self, plan: &FramePlan, ray: &Ray, h: &Hit, ambient: Vec3) -> (bool, f32, Vec3) {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let idx = [
+            prim.indices[r.first as usize] as usize,
+            prim.indices[r.first as usize + 1] as usize,
+            prim.indices[r.first as usize + 2] as usize,
+        ];
+        let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
+        let p = ray.at(h.t);
+        let m3 = Mat3::from_mat4(self.matrices[r.instance as usize]);
+        let (ng, mut n_geo) = self.hit_normals(h);
+        let (uv, vertex_color) = surface_inputs(prim, r.first as usize, h);
+        let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];
+        let base = mat.base_color
+            * vertex_color
+            * self.sample(mat.base_color_texture, uv, true, Vec4::ONE);
+        let mut n = n_geo;
+        if mat.normal_texture.is_some() && !prim.tangents.is_empty() {
+            let t4 = prim.tangents[idx[0]] * w.x
+                + prim.tangents[idx[1]] * w.y
+                + prim.tangents[idx[2]] * w.z;
+            // A mirroring transform flips the bitangent, as in the vertex shader.
+            let det_sign = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
+            let s = self.sample(mat.normal_texture, uv, false, Vec4::new(0.5, 0.5, 1.0, 1.0));
+            let tn = s.truncate() * 2.0 - Vec3::ONE;
+            let tn = Vec3::new(tn.x * mat.normal_scale, tn.y * mat.normal_scale, tn.z);
+            n = perturb_normal(
+                n_geo,
+                m3 * t4.truncate(),
+                prim.tangents[idx[0]].w * det_sign,
+                tn,
+            );
+        }
+        // Back faces (seen only on double-sided materials on the GPU) flip like the shader does.
+        let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+        if flip {
+            n_geo = -n_geo;
+            n = -n;
+        }
+        let mr = self.sample(mat.metallic_roughness_texture, uv, false, Vec4::ONE);
+        let bp = blinn_phong_params(base.truncate(), mat.metallic * mr.z, mat.roughness * mr.y);
+        let emissive = mat.emissive
+            * self
+                .sample(mat.emissive_texture, uv, true, Vec4::ONE)
+                .truncate();
+        let v = -ray.dir;
+        let occ = self.sample(mat.occlusion_texture, uv, false, Vec4::ONE).x;
+        let occlusion = if mat.occlusion_texture.is_some() {
+            1.0 + mat.occlusion_strength * (occ - 1.0)
+        } else {
+            1.0
+        };
+        let mut color = bp.ka * ambient * occlusion + emissive;
+        let (mut shadow_vis, mut shadow_cover) = (true, 1.0);
+        for i in 0..plan.lights.len() {
+            let (vis, cover, l, radiance) = self.visible(plan, i, p, ng, n_geo);
+            if plan.shadow_light == Some(i) {
+                (shadow_vis, shadow_cover) = (vis, cover);
+            }
+            color += shade_blinn_phong(&bp, n, l, v, radiance, cover);
+        }
+        if mat.unlit {
+            color = base.truncate();
+        }
+        (shadow_vis, shadow_cover, color)
+    }
+}

@@ -1,0 +1,123 @@
+#!/usr/bin/env python3
+"""The module import graph of umbra's crates: which file uses which (through `crate::`, `super::`,
+`self::` and the other workspace crates' names), its import cycles (strongly connected components
+of more than one module) and the edges that cross a layer the wrong way.
+
+Usage: scripts/imports.py [--edges]   (exit status 1 when there is a cycle)
+"""
+import os
+import re
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CRATES = {"umbra": "src", "umbra_lab": "lab/src", "umbra_cli": "cli/src"}
+
+
+def modules(crate, src):
+    """Map module path tuples (crate, a, b) to files."""
+    out = {}
+    base = os.path.join(ROOT, src)
+    if not os.path.isdir(base):
+        return out
+    for dirpath, _, files in os.walk(base):
+        for f in files:
+            if not f.endswith(".rs"):
+                continue
+            rel = os.path.relpath(os.path.join(dirpath, f), base)[:-3].split(os.sep)
+            if rel[-1] in ("mod", "lib", "main"):
+                rel = rel[:-1]
+            out[(crate, *rel)] = os.path.join(dirpath, f)
+    return out
+
+
+def resolve(mods, path):
+    """Longest prefix of `path` that names a module file."""
+    for n in range(len(path), 0, -1):
+        if tuple(path[:n]) in mods:
+            return tuple(path[:n])
+    return None
+
+
+PATH = re.compile(r"\b((?:crate|super|self|umbra|umbra_lab|umbra_cli)(?:::[A-Za-z_][A-Za-z0-9_]*)+)")
+GROUP = re.compile(r"\b(crate|super|umbra|umbra_lab|umbra_cli)((?:::[a-z_][a-z0-9_]*)*)::\{([^;]*?)\};", re.S)
+
+
+def strip_comments(text):
+    text = re.sub(r"//[^\n]*", "", text)
+    return re.sub(r"/\*.*?\*/", "", text, flags=re.S)
+
+
+def main():
+    mods = {}
+    for crate, src in CRATES.items():
+        mods.update(modules(crate, src))
+    edges = set()
+    for mod, f in mods.items():
+        text = strip_comments(open(f, encoding="utf-8").read())
+        paths = [m.split("::") for m in PATH.findall(text)]
+        for head, mid, body in GROUP.findall(text):
+            for item in re.split(r"[,\s{}]+", body):
+                if item and item[0].islower():
+                    paths.append([head, *[p for p in mid.split("::") if p], item.split("::")[0]])
+        for p in paths:
+            if p[0] == "crate":
+                full = [mod[0], *p[1:]]
+            elif p[0] == "super":
+                ups = len(p) - len([x for x in p if x != "super"])
+                full = [*mod[: len(mod) - ups], *[x for x in p if x != "super"]]
+            elif p[0] == "self":
+                full = [*mod, *p[1:]]
+            else:
+                full = p
+            target = resolve(mods, full)
+            if target and target != mod and not (target == mod[: len(target)] and len(target) < len(mod)):
+                # a module naming its own ancestor's re-export is not a dependency on a sibling
+                if len(target) == 1 and target[0] == mod[0]:
+                    continue
+                edges.add((mod, target))
+    # Tarjan's strongly connected components.
+    graph = {m: sorted({t for s, t in edges if s == m}) for m in mods}
+    index, low, stack, on, comps, counter = {}, {}, [], set(), [], [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                comps.append(sorted(comp))
+
+    sys.setrecursionlimit(10000)
+    for m in sorted(mods):
+        if m not in index:
+            visit(m)
+    name = lambda m: "::".join(m)
+    if "--edges" in sys.argv:
+        for s, t in sorted(edges):
+            print(f"{name(s)} -> {name(t)}")
+    print(f"{len(mods)} modules, {len(edges)} edges, {len(comps)} cycles")
+    for c in comps:
+        print("cycle: " + ", ".join(name(m) for m in c))
+    bad = [(s, t) for s, t in edges if s[1:2] == ("reference",) and t[1:2] == ("render",)]
+    bad += [(s, t) for s, t in edges if s[0] == "umbra" and t[0] != "umbra"]
+    for s, t in sorted(bad):
+        print(f"layering broken: {name(s)} -> {name(t)}")
+    return 1 if comps or bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

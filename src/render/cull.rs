@@ -1,0 +1,59 @@
+//! What the camera pass is told per frame: which draws it records and with which fragment
+//! entry point.
+
+use super::gpu_scene::AlphaDraw;
+use super::receivers::ShadowReach;
+use glam::{Mat4, Vec3};
+
+/// What the camera pass needs per frame to do only the work the frame needs: the camera's world →
+/// clip (draws whose bounds lie outside it are not recorded), its eye with the near plane's reach
+/// (for `Draw::cull_mode`), and which shader variant and entry point to draw with.
+pub struct CameraCull {
+    /// The camera's world → clip.
+    pub clip_from_world: Mat4,
+    /// Eye position and the distance from it to the near plane's farthest corner.
+    pub eye: (Vec3, f32),
+    /// The frame's shader variant bits (`FramePlan::shader_variant`).
+    pub frame_bits: usize,
+    /// A debug view's entry (`Entry::Debug` or `Entry::Overdraw`); `None` for the lit image.
+    pub debug_view: Option<Entry>,
+    /// The (instance, primitive) drawn tinted (`View::highlight`).
+    pub highlight: Option<(usize, usize)>,
+    /// Where the frame's single shadow view can shadow anything, when small receivers are
+    /// drawn unshadowed beyond it (`crate::render::receivers`).
+    pub shadow_reach: Option<ShadowReach>,
+}
+
+/// The fragment entry point of a scene pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Entry {
+    /// `fs_main`: opaque materials, lit image, no discard (early depth on llvmpipe).
+    Opaque,
+    /// `fs_masked`: alpha-masked materials, lit image.
+    Masked,
+    /// `fs_debug`: the debug views (shadow visibility, normals, cascades, UV checker, …).
+    Debug,
+    /// `fs_debug` with additive blending and no depth test: the overdraw view.
+    Overdraw,
+    /// `fs_blend`: blended materials, lit image, blended over (no depth write).
+    Blended,
+    /// `fs_resolve` on a full-screen triangle: a deferred material's pixels (stencil equal to
+    /// its mark), shaded from the G-buffer.
+    Resolve,
+    /// `fs_gbuffer`: a deferred draw's varyings into the G-buffer, its material's mark into the
+    /// stencil (one pipeline for every material).
+    GBuffer,
+}
+
+impl Entry {
+    /// The entry point for a draw of a material treating alpha as `alpha` in a lit or debug view
+    /// (debug views draw blended materials as opaque surfaces, like the reference's primary rays).
+    pub fn of(alpha: AlphaDraw, debug_view: Option<Entry>) -> Entry {
+        match (debug_view, alpha) {
+            (Some(e), _) => e,
+            (None, AlphaDraw::Masked) => Entry::Masked,
+            (None, AlphaDraw::Blended) => Entry::Blended,
+            (None, AlphaDraw::Opaque) => Entry::Opaque,
+        }
+    }
+}
