@@ -5,6 +5,13 @@
 //! descriptor kinds, uniform struct sizes, immediate-block size) so that Rust code never hand-syncs
 //! binding numbers: see `src/gpu/shaders.rs`.
 //!
+//! Shaders are composed from parts: a line `#include "lib/NAME.wgsl"` is replaced by that file
+//! (relative to `shaders/`, each part included once per shader), so structs shared by two shaders
+//! are written once. Only the top-level `shaders/*.wgsl` files are shaders; errors name the part
+//! and its line. Named module-scope constants of a shader (`const VIEW_LIT: u32 = 0u;`) are
+//! generated as Rust constants too, so light kinds, view modes and array sizes are never typed on
+//! both sides of the boundary.
+//!
 //! Y convention: SPIR-V is written with `ADJUST_COORDINATE_SPACE`, so shaders work in a Y-up clip
 //! space (like WebGPU/OpenGL) and naga negates `position.y` on the way out. Shadow-map UVs are
 //! therefore `(x * 0.5 + 0.5, 0.5 - y * 0.5)`.
@@ -15,6 +22,7 @@ use std::path::Path;
 fn main() {
     let out_dir = std::env::var("OUT_DIR").expect("OUT_DIR");
     println!("cargo:rerun-if-changed=shaders");
+    println!("cargo:rerun-if-changed=shaders/lib");
     let mut entries: Vec<_> = std::fs::read_dir("shaders")
         .expect("shaders/ folder")
         .filter_map(|e| e.ok())
@@ -41,23 +49,78 @@ fn main() {
     std::fs::write(Path::new(&out_dir).join("shaders.rs"), generated).expect("write shaders.rs");
 }
 
-fn location_prefix(path: &Path, source: &str, loc: Option<naga::SourceLocation>) -> String {
-    let _ = source;
-    match loc {
-        Some(l) => format!("{}:{}:{}", path.display(), l.line_number, l.line_position),
+/// A shader's source with its `#include` lines expanded, and for each line of it the file and
+/// line it came from.
+struct Composed {
+    source: String,
+    lines: Vec<(String, u32)>,
+}
+
+fn compose(path: &Path) -> Result<Composed, String> {
+    let mut out = Composed {
+        source: String::new(),
+        lines: Vec::new(),
+    };
+    let mut seen = Vec::new();
+    expand(path, &mut out, &mut seen)?;
+    Ok(out)
+}
+
+fn expand(
+    path: &Path,
+    out: &mut Composed,
+    seen: &mut Vec<std::path::PathBuf>,
+) -> Result<(), String> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| format!("{}:1:1: error: {e}", path.display()))?;
+    for (n, line) in text.lines().enumerate() {
+        if let Some(rest) = line.trim().strip_prefix("#include ") {
+            let name = rest.trim().trim_matches('"');
+            let part = Path::new("shaders").join(name);
+            if !part.is_file() {
+                return Err(format!(
+                    "{}:{}:1: error: no shader part {}",
+                    path.display(),
+                    n + 1,
+                    part.display()
+                ));
+            }
+            println!("cargo:rerun-if-changed={}", part.display());
+            if !seen.contains(&part) {
+                seen.push(part.clone());
+                expand(&part, out, seen)?;
+            }
+            continue;
+        }
+        out.source.push_str(line);
+        out.source.push('\n');
+        out.lines.push((path.display().to_string(), n as u32 + 1));
+    }
+    Ok(())
+}
+
+fn location_prefix(path: &Path, composed: &Composed, loc: Option<naga::SourceLocation>) -> String {
+    match loc.and_then(|l| {
+        Some((
+            composed.lines.get(l.line_number.checked_sub(1)? as usize)?,
+            l,
+        ))
+    }) {
+        Some(((file, line), l)) => format!("{file}:{line}:{}", l.line_position),
         None => format!("{}:1:1", path.display()),
     }
 }
 
 fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
-    let source = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let composed = compose(path)?;
+    let source = composed.source.as_str();
     let file = path.display().to_string();
-    let module = naga::front::wgsl::parse_str(&source).map_err(|e| {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| {
         format!(
             "{}: error: {}\n{}",
-            location_prefix(path, &source, e.location(&source)),
+            location_prefix(path, &composed, e.location(source)),
             e.message(),
-            e.emit_to_string_with_path(&source, &file)
+            e.emit_to_string_with_path(source, &file)
         )
     })?;
     let mut validator = naga::valid::Validator::new(
@@ -69,9 +132,9 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
     let info = validator.validate(&module).map_err(|e| {
         format!(
             "{}: error: {}\n{}",
-            location_prefix(path, &source, e.location(&source)),
+            location_prefix(path, &composed, e.location(source)),
             e.as_inner(),
-            e.emit_to_string_with_path(&source, &file)
+            e.emit_to_string_with_path(source, &file)
         )
     })?;
     let options = naga::back::spv::Options {
@@ -194,6 +257,36 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
             code,
             "    /// Variant bit of override `{o}`.\n    #[allow(dead_code)]\n    pub const BIT_{}: usize = 1 << {i};",
             o.to_uppercase()
+        )
+        .unwrap();
+    }
+    for (r, o) in overrides.iter().enumerate() {
+        let dependents: Vec<String> = (0..overrides.len())
+            .filter(|&i| requires[i] == Some(r))
+            .map(|i| format!("BIT_{}", overrides[i].to_uppercase()))
+            .collect();
+        if !dependents.is_empty() {
+            writeln!(
+                code,
+                "    /// `{o}` and the overrides declared `// requires {o}`.\n    #[allow(dead_code)]\n    pub const WITH_{}: usize = BIT_{} | {};",
+                o.to_uppercase(),
+                o.to_uppercase(),
+                dependents.join(" | ")
+            )
+            .unwrap();
+        }
+    }
+    for (_, c) in module.constants.iter() {
+        let Some(name) = &c.name else { continue };
+        let value = match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => format!("u32 = {v}"),
+            naga::Expression::Literal(naga::Literal::I32(v)) => format!("i32 = {v}"),
+            naga::Expression::Literal(naga::Literal::F32(v)) => format!("f32 = {v:?}"),
+            _ => continue,
+        };
+        writeln!(
+            code,
+            "    /// The shader's `const {name}`.\n    #[allow(dead_code)]\n    pub const {name}: {value};"
         )
         .unwrap();
     }

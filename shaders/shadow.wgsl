@@ -13,26 +13,10 @@ struct ShadowImmediates {
 
 var<immediate> pc: ShadowImmediates;
 
-// The camera pass's material block (shaders/scene.wgsl, group 1; WGSL has no includes, so it is
-// repeated here): the masked pipeline binds the same descriptor set, at set 0 of its layout, and
-// a unit test (src/gpu/shaders.rs) checks every binding here against its twin there.
-struct Material {
-    base_color: vec4<f32>,
-    emissive: vec4<f32>,
-    params: vec4<f32>,
-    // y: alpha cutoff of the shadow pass (masked: the material's; blended: 0.5)
-    extra: vec4<f32>,
-    // KHR_texture_transform rows per slot (base colour, normal, metallic-roughness, emissive):
-    // u' = dot(uv[2i].xyz, (u, v, 1)), v' = dot(uv[2i + 1].xyz, (u, v, 1)).
-    uv: array<vec4<f32>, 8>,
-}
-
-// Texture coordinates of slot i (0 base colour, 1 normal, 2 metallic-roughness, 3 emissive).
-// `uvs` holds TEXCOORD_0 (xy) and TEXCOORD_1 (zw); uv[2i].w says which set the slot reads.
-fn slot_uv(i: u32, uvs: vec4<f32>) -> vec2<f32> {
-    let p = vec3<f32>(select(uvs.xy, uvs.zw, material.uv[2u * i].w > 0.5), 1.0);
-    return vec2<f32>(dot(material.uv[2u * i].xyz, p), dot(material.uv[2u * i + 1u].xyz, p));
-}
+// The camera pass's material block (shaders/lib/material.wgsl): the masked pipeline binds the same
+// descriptor set, at set 0 of its layout, and a unit test (src/gpu/shaders.rs) checks every
+// binding here against its twin there.
+#include "lib/material.wgsl"
 
 @group(0) @binding(0) var<uniform> material: Material;
 @group(0) @binding(1) var base_color_tex: texture_2d<f32>;

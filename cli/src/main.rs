@@ -467,9 +467,11 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
             sw::run_view(
                 &mut renderer,
                 &reference,
-                &scene.name,
-                vname,
-                *camera,
+                &sw::SweepView {
+                    scene: &scene.name,
+                    name: vname,
+                    camera: *camera,
+                },
                 &configs,
                 &sw::SweepOptions {
                     width: w,
@@ -479,8 +481,10 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
                     ..Default::default()
                 },
                 &skip,
-                &mut on_row,
-                &mut || bar.inc(1),
+                &mut sw::Sink {
+                    on_row: &mut on_row,
+                    tick: &mut || bar.inc(1),
+                },
             )?;
             if let Some(e) = failed.take() {
                 return Err(e);
@@ -564,10 +568,8 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
                         &mut renderer,
                         &reference,
                         scene,
-                        vname,
-                        *camera,
-                        w,
-                        h,
+                        (vname, *camera),
+                        (w, h),
                         b,
                         &rows,
                     )? {

@@ -10,7 +10,7 @@ use umbra::render::{Renderer, View};
 use umbra::scene::synthetic::town_scene;
 use umbra_lab::analysis::budget::{self, PROBE_STRIDE};
 use umbra_lab::analysis::grid::Grid;
-use umbra_lab::analysis::sweep::{run_view, Row, SweepOptions};
+use umbra_lab::analysis::sweep::{run_view, Row, Sink, SweepOptions, SweepView};
 use umbra_lab::reference::ReferenceScene;
 use umbra_lab::score;
 
@@ -100,17 +100,22 @@ fn sweep_of_one_view_has_sane_rows_and_resumes() {
     let mut rows: Vec<Row> = Vec::new();
     let mut ticks = 0;
     let skip_none = |_: &str| false;
+    let view = SweepView {
+        scene: "demo",
+        name: "camera0",
+        camera: scene.cameras[0],
+    };
     run_view(
         &mut renderer,
         &reference,
-        "demo",
-        "camera0",
-        scene.cameras[0],
+        &view,
         &configs,
         &opts,
         &skip_none,
-        &mut |r| rows.push(r),
-        &mut || ticks += 1,
+        &mut Sink {
+            on_row: &mut |r| rows.push(r),
+            tick: &mut || ticks += 1,
+        },
     )
     .unwrap();
     assert_eq!(rows.len(), 2);
@@ -143,14 +148,14 @@ fn sweep_of_one_view_has_sane_rows_and_resumes() {
     run_view(
         &mut renderer,
         &reference,
-        "demo",
-        "camera0",
-        scene.cameras[0],
+        &view,
         &configs,
         &opts,
         &skip,
-        &mut |r| again.push(r),
-        &mut || {},
+        &mut Sink {
+            on_row: &mut |r| again.push(r),
+            tick: &mut || {},
+        },
     )
     .unwrap();
     assert_eq!(again.len(), 1);

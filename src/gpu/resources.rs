@@ -181,6 +181,16 @@ pub struct Image {
     allocation: Option<Allocation>,
 }
 
+/// The size and layout of an image `Image::create` makes.
+#[derive(Clone, Copy)]
+struct Shape {
+    extent: vk::Extent2D,
+    mip_levels: u32,
+    /// Layer count of an array image; `None`: a plain 2-D image.
+    array: Option<u32>,
+    samples: u32,
+}
+
 impl Image {
     /// Creates a named device-local 2-D image and its view.
     pub fn new(
@@ -191,7 +201,18 @@ impl Image {
         mip_levels: u32,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, GpuError> {
-        Self::create(ctx, name, format, extent, mip_levels, None, usage, 1)
+        Self::create(
+            ctx,
+            name,
+            format,
+            Shape {
+                extent,
+                mip_levels,
+                array: None,
+                samples: 1,
+            },
+            usage,
+        )
     }
 
     /// Creates a named device-local multisampled 2-D image of `samples` samples per pixel (one
@@ -204,7 +225,18 @@ impl Image {
         samples: u32,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, GpuError> {
-        Self::create(ctx, name, format, extent, 1, None, usage, samples)
+        Self::create(
+            ctx,
+            name,
+            format,
+            Shape {
+                extent,
+                mip_levels: 1,
+                array: None,
+                samples,
+            },
+            usage,
+        )
     }
 
     /// Creates a named device-local 2-D array image of `layers` layers (at least 1), one mip
@@ -217,21 +249,34 @@ impl Image {
         layers: u32,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, GpuError> {
-        Self::create(ctx, name, format, extent, 1, Some(layers.max(1)), usage, 1)
+        Self::create(
+            ctx,
+            name,
+            format,
+            Shape {
+                extent,
+                mip_levels: 1,
+                array: Some(layers.max(1)),
+                samples: 1,
+            },
+            usage,
+        )
     }
 
     /// `new` (`array` None) or `new_array` (`array` = its layer count), `samples` per pixel.
-    #[allow(clippy::too_many_arguments)]
     fn create(
         ctx: &Arc<Context>,
         name: &str,
         format: vk::Format,
-        extent: vk::Extent2D,
-        mip_levels: u32,
-        array: Option<u32>,
+        shape: Shape,
         usage: vk::ImageUsageFlags,
-        samples: u32,
     ) -> Result<Self, GpuError> {
+        let Shape {
+            extent,
+            mip_levels,
+            array,
+            samples,
+        } = shape;
         let layers = array.unwrap_or(1);
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)

@@ -10,6 +10,7 @@ use super::settings::{
 use super::uniforms::{
     FrameUniform, LightUniform, ShadowViewUniform, MAX_LIGHTS, MAX_SHADOW_VIEWS,
 };
+use crate::gpu::shaders::scene as sh;
 use crate::math::projection::{perspective_infinite_reversed, perspective_reversed};
 use crate::math::shadow_fit::{
     cascade_splits, fit_directional, fit_point_faces, fit_spot, frustum_box_intersection, widened,
@@ -419,33 +420,57 @@ impl ScenePlanner {
     /// The plan the renderer makes for `view` at `w`×`h`.
     pub fn plan(&self, view: &View, w: u32, h: u32) -> FramePlan {
         let mut plan = plan_frame(
-            &self.lights,
-            &self.bounds,
-            &self.receivers,
+            &PlanScene {
+                lights: &self.lights,
+                bounds: &self.bounds,
+                receivers: &self.receivers,
+            },
             &view.rebased(self.origin),
-            w as f32 / h.max(1) as f32,
-            h,
-            false,
+            &PlanTarget {
+                aspect: w as f32 / h.max(1) as f32,
+                height_px: h,
+                hw_compare: false,
+            },
         );
         plan.origin = self.origin;
         plan
     }
 }
 
-/// Plans a frame for `view` of a scene with `scene_lights` and `bounds`, rendered at `aspect`;
-/// `receivers` (each draw's world box, may be empty) bound the depths cascades are split over;
-/// `height_px`, the image height, sets the pixel footprint the automatic cascade count compares
-/// texels with.
-#[allow(clippy::too_many_arguments)]
-pub fn plan_frame(
-    scene_lights: &[Light],
-    bounds: &Aabb,
-    receivers: &[Aabb],
-    view: &View,
-    aspect: f32,
-    height_px: u32,
-    hw_compare: bool,
-) -> FramePlan {
+/// What a frame is planned against: the scene's lights, its bounds, and each draw's world box
+/// (may be empty), which bound the depths cascades are split over.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanScene<'a> {
+    /// The scene's lights (the default sun is added when there are none).
+    pub lights: &'a [Light],
+    /// The scene's bounds.
+    pub bounds: &'a Aabb,
+    /// The draws' world boxes.
+    pub receivers: &'a [Aabb],
+}
+
+/// The image a frame is planned for.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanTarget {
+    /// Width over height.
+    pub aspect: f32,
+    /// The image height in pixels: the pixel footprint the automatic cascade count compares
+    /// texels with.
+    pub height_px: u32,
+    /// The device filters depth comparisons in hardware (the shader variant's HW_COMPARE).
+    pub hw_compare: bool,
+}
+
+/// Plans a frame for `view` of `scene` rendered into `target`: pure, no GPU.
+pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FramePlan {
+    let PlanScene {
+        lights: scene_lights,
+        bounds,
+        receivers,
+    } = *scene;
+    let PlanTarget {
+        aspect, hw_compare, ..
+    } = *target;
     let lights = effective_lights(scene_lights, view);
     let fit_camera = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
     let proj = camera_projection(&view.camera, aspect);
@@ -464,12 +489,10 @@ pub fn plan_frame(
             // Fewer cascades where the views run short.
             LightKind::Directional if room > 0 => directional_views(
                 l,
-                bounds,
-                receivers,
+                scene,
                 view,
                 fit_camera,
-                aspect,
-                height_px,
+                target,
                 room,
                 view.shadow_hold
                     .as_ref()
@@ -573,11 +596,12 @@ pub fn plan_frame(
     }
     for (i, l) in lights.iter().enumerate() {
         let (kind, cone) = match l.kind {
-            LightKind::Directional => (0.0, Vec4::ZERO),
-            LightKind::Point => (1.0, Vec4::ZERO),
-            LightKind::Spot { inner, outer } => {
-                (2.0, Vec4::new(inner.cos(), outer.cos(), 0.0, 0.0))
-            }
+            LightKind::Directional => (sh::LIGHT_DIRECTIONAL, Vec4::ZERO),
+            LightKind::Point => (sh::LIGHT_POINT, Vec4::ZERO),
+            LightKind::Spot { inner, outer } => (
+                sh::LIGHT_SPOT,
+                Vec4::new(inner.cos(), outer.cos(), 0.0, 0.0),
+            ),
         };
         // z: the range (0 = none).
         let cone = Vec4::new(cone.x, cone.y, l.range.unwrap_or(0.0), 0.0);
@@ -714,8 +738,8 @@ pub fn exposure_scale(exposure: Exposure, metered_lux: f32) -> f32 {
 pub const DEPTH_FIT_MARGIN: f32 = 1.01;
 
 /// Widest penumbra, in shadow texels of radius, that a soft (PCSS) lookup filters: a larger
-/// light or a finer map is softened this much and no more (`SOFT_MAX_TEXELS` in scene.wgsl).
-pub const SOFT_MAX_TEXELS: f32 = 32.0;
+/// light or a finer map is softened this much and no more (the shader's `SOFT_MAX_TEXELS`).
+pub const SOFT_MAX_TEXELS: f32 = sh::SOFT_MAX_TEXELS;
 
 /// A shadowed light's soft-shadow size as the shader's penumbra formula takes it: tan of half
 /// the angular diameter for a directional light, the radius for a point or spot light; 0 for a
@@ -765,18 +789,21 @@ fn point_face_margin(view: &View, soft: bool) -> f32 {
 /// The views of directional light `l`: one map, or cascades when fitted to the camera (count
 /// from the settings, or automatic; at most `max`). `held`: what this light's views used the
 /// frame before, for a camera in motion (`View::shadow_hold`).
-#[allow(clippy::too_many_arguments)]
 fn directional_views(
     l: &Light,
-    bounds: &Aabb,
-    receivers: &[Aabb],
+    scene: &PlanScene,
     view: &View,
     fit_cam: &Camera,
-    aspect: f32,
-    height_px: u32,
+    target: &PlanTarget,
     max: usize,
     held: Option<&HeldLight>,
 ) -> Vec<ShadowView> {
+    let PlanScene {
+        bounds, receivers, ..
+    } = *scene;
+    let PlanTarget {
+        aspect, height_px, ..
+    } = *target;
     let held_range = held.and_then(|h| h.depth_range);
     let held = held.map(|h| h.extents.as_slice());
     let size = view.shadow.map_size.max(1);
@@ -949,7 +976,19 @@ mod tests {
             0.8,
             0.1,
         ));
-        let p = plan_frame(&[sun], &room, &boxes, &v, 1.5, 100, false);
+        let p = plan_frame(
+            &PlanScene {
+                lights: &[sun],
+                bounds: &room,
+                receivers: &boxes,
+            },
+            &v,
+            &PlanTarget {
+                aspect: 1.5,
+                height_px: 100,
+                hw_compare: false,
+            },
+        );
         assert!((p.ambient - Vec3::splat(AUTO_AMBIENT * 3.0)).length() < 1e-5);
         let k = crate::math::tonemap::KEY_VALUE;
         assert!((p.exposure - k / (3.0 * (1.0 + AUTO_AMBIENT))).abs() < 1e-5);
@@ -961,14 +1000,38 @@ mod tests {
         let mut s = demo_scene();
         s.lights.clear();
         let mut v = View::new(s.default_camera(1.5));
-        let p = plan_frame(&s.lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        let p = plan_frame(
+            &PlanScene {
+                lights: &s.lights,
+                bounds: &s.bounds(),
+                receivers: &[],
+            },
+            &v,
+            &PlanTarget {
+                aspect: 1.5,
+                height_px: 720,
+                hw_compare: false,
+            },
+        );
         // The compact demo keeps one map by default (automatic cascade count).
         assert_eq!(p.shadow_views.len(), 1);
         assert_eq!(p.lights.len(), 1);
         assert_eq!(p.shadow_light, Some(0));
         assert!(p.texel_world() > 0.0);
         v.sun_direction = Some(Vec3::new(0.0, -1.0, 0.0));
-        let p = plan_frame(&s.lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        let p = plan_frame(
+            &PlanScene {
+                lights: &s.lights,
+                bounds: &s.bounds(),
+                receivers: &[],
+            },
+            &v,
+            &PlanTarget {
+                aspect: 1.5,
+                height_px: 720,
+                hw_compare: false,
+            },
+        );
         assert_eq!(p.lights[0].direction, Vec3::NEG_Y);
         assert_eq!(p.uniform.modes[3], 1);
         // One light, shadows on, PCF 2×2 by hand (hw_compare false).
@@ -977,7 +1040,19 @@ mod tests {
         assert_eq!(p.shader_variant, want);
         // Cascades: four views, nearest first, each ending where the next blends in.
         v.shadow.cascades = 4;
-        let p = plan_frame(&s.lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        let p = plan_frame(
+            &PlanScene {
+                lights: &s.lights,
+                bounds: &s.bounds(),
+                receivers: &[],
+            },
+            &v,
+            &PlanTarget {
+                aspect: 1.5,
+                height_px: 720,
+                hw_compare: false,
+            },
+        );
         assert_eq!(p.shader_variant, want | sh::BIT_MANY_VIEWS);
         assert_eq!(p.shadow_views.len(), 4);
         for w in p.shadow_views.windows(2) {
@@ -987,7 +1062,19 @@ mod tests {
         assert!(p.shadow_views[3].far.is_infinite());
         // Without shadows the filter, comparison and cascade bits mean nothing: one shader.
         v.shadow.enabled = false;
-        let p = plan_frame(&s.lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        let p = plan_frame(
+            &PlanScene {
+                lights: &s.lights,
+                bounds: &s.bounds(),
+                receivers: &[],
+            },
+            &v,
+            &PlanTarget {
+                aspect: 1.5,
+                height_px: 720,
+                hw_compare: false,
+            },
+        );
         assert_eq!(p.shader_variant, sh::BIT_SINGLE_LIGHT);
     }
     #[test]
@@ -999,7 +1086,21 @@ mod tests {
         let at = |k: f32| Camera::look_at(c + (eye - c) * k, c, cam.fov_y, cam.near);
         let mut v = View::new(cam);
         v.shadow.cascades = 4;
-        let plan = |v: &View| plan_frame(&sun, &s.bounds(), &[], v, 1.5, 720, false);
+        let plan = |v: &View| {
+            plan_frame(
+                &PlanScene {
+                    lights: &sun,
+                    bounds: &s.bounds(),
+                    receivers: &[],
+                },
+                v,
+                &PlanTarget {
+                    aspect: 1.5,
+                    height_px: 720,
+                    hw_compare: false,
+                },
+            )
+        };
         let range = |p: &FramePlan| p.primary_views()[0].depth_range.unwrap();
         let splits = |p: &FramePlan| p.primary_views().iter().map(|v| v.far).collect::<Vec<_>>();
         let first = plan(&v);
@@ -1060,7 +1161,19 @@ mod tests {
         let lights = vec![sun, point(-2.0), dark, spot, point(2.0), point(4.0)];
         let mut v = View::new(s.default_camera(1.5));
         v.shadow.cascades = 4;
-        let p = plan_frame(&lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        let p = plan_frame(
+            &PlanScene {
+                lights: &lights,
+                bounds: &s.bounds(),
+                receivers: &[],
+            },
+            &v,
+            &PlanTarget {
+                aspect: 1.5,
+                height_px: 720,
+                hw_compare: false,
+            },
+        );
         // Sun 4 cascades, point 6 faces, spot 1: 11 of 16; the next two point lights need 6
         // each, more than the 5 left, and the light that casts none gets none.
         let per_light: Vec<usize> = (0..lights.len()).map(|i| p.light_views(i).len()).collect();
@@ -1078,7 +1191,19 @@ mod tests {
         // The shown light: the first shadowed one, or the one asked for if it has views.
         assert_eq!(p.shadow_light, Some(0));
         v.shown_light = Some(3);
-        let p = plan_frame(&lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        let p = plan_frame(
+            &PlanScene {
+                lights: &lights,
+                bounds: &s.bounds(),
+                receivers: &[],
+            },
+            &v,
+            &PlanTarget {
+                aspect: 1.5,
+                height_px: 720,
+                hw_compare: false,
+            },
+        );
         assert_eq!(
             (
                 p.shadow_light,
@@ -1088,7 +1213,19 @@ mod tests {
             (Some(3), 10.0, 1.0)
         );
         v.shown_light = Some(4);
-        let p = plan_frame(&lights, &s.bounds(), &[], &v, 1.5, 720, false);
+        let p = plan_frame(
+            &PlanScene {
+                lights: &lights,
+                bounds: &s.bounds(),
+                receivers: &[],
+            },
+            &v,
+            &PlanTarget {
+                aspect: 1.5,
+                height_px: 720,
+                hw_compare: false,
+            },
+        );
         assert_eq!(p.shadow_light, Some(0));
         // A point light's faces look along ±x, ±y, ±z: each face's centre direction lands in the
         // middle of its own layer.

@@ -47,20 +47,21 @@ pub enum ViewMode {
 impl ViewMode {
     /// Shader constant.
     pub fn shader_value(self) -> u32 {
+        use crate::gpu::shaders::scene as sh;
         match self {
-            ViewMode::Lit | ViewMode::ShadowMap => 0,
-            ViewMode::Shadow => 1,
-            ViewMode::Normals => 2,
-            ViewMode::Cascades => 3,
-            ViewMode::UvChecker => 4,
-            ViewMode::Tangents => 5,
-            ViewMode::Bitangents => 6,
-            ViewMode::BaseColor => 7,
-            ViewMode::Metallic => 8,
-            ViewMode::Roughness => 9,
-            ViewMode::Depth => 10,
-            ViewMode::TexelDensity => 11,
-            ViewMode::Overdraw => 12,
+            ViewMode::Lit | ViewMode::ShadowMap => sh::VIEW_LIT,
+            ViewMode::Shadow => sh::VIEW_SHADOW,
+            ViewMode::Normals => sh::VIEW_NORMALS,
+            ViewMode::Cascades => sh::VIEW_CASCADES,
+            ViewMode::UvChecker => sh::VIEW_UV_CHECKER,
+            ViewMode::Tangents => sh::VIEW_TANGENTS,
+            ViewMode::Bitangents => sh::VIEW_BITANGENTS,
+            ViewMode::BaseColor => sh::VIEW_BASE_COLOR,
+            ViewMode::Metallic => sh::VIEW_METALLIC,
+            ViewMode::Roughness => sh::VIEW_ROUGHNESS,
+            ViewMode::Depth => sh::VIEW_DEPTH,
+            ViewMode::TexelDensity => sh::VIEW_TEXEL_DENSITY,
+            ViewMode::Overdraw => sh::VIEW_OVERDRAW,
         }
     }
 }
@@ -126,7 +127,8 @@ pub enum ShadowFit {
 pub struct ShadowSettings {
     /// Shadows on or off.
     pub enabled: bool,
-    /// Map size in texels (square).
+    /// Map size in texels (square), within [`ShadowSettings::MAP_SIZES`] (the renderer clamps
+    /// other values into it).
     pub map_size: u32,
     /// Depth format.
     pub format: ShadowFormat,
@@ -173,6 +175,18 @@ pub struct ShadowSettings {
 
 /// Most cascades a directional light can have.
 pub const MAX_CASCADES: u32 = 4;
+
+impl ShadowSettings {
+    /// The shadow-map sizes the renderer accepts, in texels: the one range every front end
+    /// checks against.
+    pub const MAP_SIZES: std::ops::RangeInclusive<u32> = 16..=16384;
+
+    /// `map_size` clamped into [`Self::MAP_SIZES`].
+    pub fn clamped_map_size(&self) -> u32 {
+        self.map_size
+            .clamp(*Self::MAP_SIZES.start(), *Self::MAP_SIZES.end())
+    }
+}
 
 impl Default for ShadowSettings {
     fn default() -> Self {

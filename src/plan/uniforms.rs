@@ -6,10 +6,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
 
 /// Most lights the camera pass shades.
-pub const MAX_LIGHTS: usize = 8;
+pub const MAX_LIGHTS: usize = shaders::scene::MAX_LIGHTS as usize;
 /// Most shadow views (layers of the shadow map) in one frame: a directional light takes one per
 /// cascade, a spot light one, a point light six (cube faces).
-pub const MAX_SHADOW_VIEWS: usize = 16;
+pub const MAX_SHADOW_VIEWS: usize = shaders::scene::MAX_SHADOW_VIEWS as usize;
 
 /// One light as the shader sees it.
 #[repr(C)]

@@ -323,20 +323,22 @@ impl CameraPass {
     /// G-buffer first, and their materials are resolved before the forward draws. Returns the
     /// draws recorded, how many of them were deferred, and how many were drawn (in part) without
     /// the shadow lookup (`receivers::split`).
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
         cmd: vk::CommandBuffer,
         slot: usize,
         scene: &GpuScene,
-        color: vk::ImageView,
-        depth: vk::ImageView,
-        resolve: Resolve,
-        extent: vk::Extent2D,
-        clear: [f32; 4],
+        targets: &CameraTargets,
         shadow_map_view: bool,
         cull: &CameraCull,
     ) -> CameraCounts {
+        let CameraTargets {
+            color,
+            depth,
+            resolve,
+            extent,
+            clear,
+        } = *targets;
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         ctx.begin_label(cmd, "camera pass");
@@ -354,8 +356,7 @@ impl CameraPass {
         let mut unshadowed = 0;
         let mut deferred_draws = 0;
         if deferring {
-            deferred_draws =
-                self.record_gbuffer(cmd, scene, depth, extent, frame_set, &plan, cull.eye);
+            deferred_draws = self.record_gbuffer(cmd, scene, targets, frame_set, &plan, cull.eye);
         }
         let mut color_att = vk::RenderingAttachmentInfo::default()
             .image_view(color)
@@ -455,7 +456,6 @@ impl CameraPass {
                             d.cmd_set_scissor(cmd, 0, &[s]);
                         }
                         scene.record_draw(
-                            d,
                             cmd,
                             self.layout,
                             dr,
@@ -482,17 +482,16 @@ impl CameraPass {
     /// Records the G-buffer pass of `plan`'s deferred draws (clearing depth and stencil, each
     /// draw marking its material), then makes the targets readable and the depth and stencil
     /// visible to the next rendering. Returns the number of draws.
-    #[allow(clippy::too_many_arguments)]
     fn record_gbuffer(
         &mut self,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-        depth: vk::ImageView,
-        extent: vk::Extent2D,
+        targets: &CameraTargets,
         frame_set: vk::DescriptorSet,
         plan: &DeferPlan,
         eye: (Vec3, f32),
     ) -> usize {
+        let (depth, extent) = (targets.depth, targets.extent);
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         // Both made by `ensure_pipelines` for this frame.
@@ -527,7 +526,6 @@ impl CameraPass {
         for &(dr, mark) in &plan.deferred {
             unsafe { d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, mark) };
             scene.record_draw(
-                d,
                 cmd,
                 self.layout,
                 dr,
@@ -690,6 +688,22 @@ fn full_rect(extent: vk::Extent2D) -> vk::Rect2D {
         offset: vk::Offset2D::default(),
         extent,
     }
+}
+
+/// The attachments a camera pass draws into (already in attachment layouts), where it resolves
+/// to, its size and its clear colour.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraTargets {
+    /// The colour attachment (multisampled with MSAA).
+    pub color: vk::ImageView,
+    /// The depth attachment (multisampled with MSAA).
+    pub depth: vk::ImageView,
+    /// The single-sample images MSAA resolves into.
+    pub resolve: Resolve,
+    /// The image size.
+    pub extent: vk::Extent2D,
+    /// The linear clear colour.
+    pub clear: [f32; 4],
 }
 
 /// Where a multisampled camera pass resolves to (both None without MSAA).

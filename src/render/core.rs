@@ -2,7 +2,7 @@
 //! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
 //! record exactly the same commands, so the window and the capture give the same pixels.
 
-use super::camera_pass::{CameraPass, Resolve};
+use super::camera_pass::{CameraPass, CameraTargets, Resolve};
 use super::cull::CameraCull;
 use super::gpu_scene::GpuScene;
 use super::receivers::ShadowReach;
@@ -12,7 +12,7 @@ use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::scene as sh;
 use crate::math::shadow_fit::spot_near;
-use crate::plan::frame::{plan_frame, FramePlan};
+use crate::plan::frame::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::settings::{SceneOptions, ShadowSettings, View, ViewMode};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
 use crate::scene::{Light, Scene};
@@ -117,7 +117,7 @@ impl FrameCore {
         height: u32,
     ) -> Result<Prepared, GpuError> {
         let map_size = if view.shadow.enabled {
-            view.shadow.map_size.clamp(16, 16384)
+            view.shadow.clamped_map_size()
         } else {
             1
         };
@@ -125,13 +125,17 @@ impl FrameCore {
         let mut v = view.rebased(self.origin);
         v.shadow.map_size = map_size;
         let mut plan = plan_frame(
-            &self.lights,
-            &self.gpu.bounds,
-            &self.receiver_bounds,
+            &PlanScene {
+                lights: &self.lights,
+                bounds: &self.gpu.bounds,
+                receivers: &self.receiver_bounds,
+            },
             &v,
-            width as f32 / height.max(1) as f32,
-            height,
-            hw,
+            &PlanTarget {
+                aspect: width as f32 / height.max(1) as f32,
+                height_px: height,
+                hw_compare: hw,
+            },
         );
         plan.origin = self.origin;
         let layers = plan.shadow_views.len().max(1) as u32;
@@ -252,19 +256,22 @@ impl FrameCore {
                 (color.view, depth.view, Resolve::default())
             }
         };
-        let counts = self.camera.record(
-            cmd,
-            slot,
-            &self.gpu,
-            draw_color,
-            draw_depth,
+        let targets = CameraTargets {
+            color: draw_color,
+            depth: draw_depth,
             resolve,
             extent,
-            if frame.mode == ViewMode::Overdraw {
+            clear: if frame.mode == ViewMode::Overdraw {
                 [0.0, 0.0, 0.0, 1.0]
             } else {
                 CLEAR_COLOR
             },
+        };
+        let counts = self.camera.record(
+            cmd,
+            slot,
+            &self.gpu,
+            &targets,
             frame.mode == ViewMode::ShadowMap,
             cull,
         );

@@ -455,10 +455,8 @@ pub struct GpuScene {
 impl GpuScene {
     /// Records draw `dr` of a pass seen from `eye` (`Draw::cull_mode`): its cull mode and front
     /// face, the pass's `immediates` (pushed to both stages of `layout`), and its triangles.
-    #[allow(clippy::too_many_arguments)]
     pub fn record_draw(
         &self,
-        device: &ash::Device,
         cmd: vk::CommandBuffer,
         layout: vk::PipelineLayout,
         dr: &Draw,
@@ -467,6 +465,7 @@ impl GpuScene {
         immediates: &[u8],
     ) {
         let cull = dr.cull_mode(eye);
+        let device = &self.ctx.device;
         unsafe {
             device.cmd_set_cull_mode(cmd, cull);
             device.cmd_set_front_face(cmd, dr.front_face());

@@ -225,12 +225,7 @@ pub fn split(
 /// The shader variant of `bits` without shadows: the SHADOWS override and those that mean
 /// nothing without it off (the canonical index of that SPIR-V).
 pub fn unshadowed(bits: usize) -> usize {
-    bits & !(sh::BIT_SHADOWS
-        | sh::BIT_HW_COMPARE
-        | sh::BIT_PCF_BIT0
-        | sh::BIT_PCF_BIT1
-        | sh::BIT_MANY_VIEWS
-        | sh::BIT_SOFT)
+    bits & !sh::WITH_SHADOWS
 }
 
 fn intersect(a: vk::Rect2D, b: vk::Rect2D) -> vk::Rect2D {

@@ -255,7 +255,7 @@ impl ShadowPass {
             self.pipeline = depth_pipeline(&self.ctx, self.layout, self.module, false, fmt)?;
             self.pipeline_format = fmt;
         }
-        let size = size.clamp(1, 16384);
+        let size = size.clamp(1, *ShadowSettings::MAP_SIZES.end());
         // More layers than needed are kept: a frame that needs fewer cascades (the automatic
         // count changes as the camera moves) reuses the map.
         if self.map.as_ref().is_some_and(|m| {
@@ -609,7 +609,7 @@ impl ShadowPass {
                             world_from_model: dr.world_from_model,
                         };
                         let pc = bytemuck::bytes_of(&pc);
-                        scene.record_draw(d, cmd, layout, dr, eye, from, pc);
+                        scene.record_draw(cmd, layout, dr, eye, from, pc);
                         drawn += 1;
                     }
                 }

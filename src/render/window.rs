@@ -85,14 +85,11 @@ impl WindowRenderer {
     /// Creates a surface for the window, a swapchain of `width`×`height` on it and the passes
     /// for its format. `ctx` must have been created with [`surface_extensions`] of the display
     /// and `swapchain: true`; the window must outlive the renderer.
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
-        display: RawDisplayHandle,
-        window: RawWindowHandle,
-        width: u32,
-        height: u32,
+        (display, window): (RawDisplayHandle, RawWindowHandle),
+        (width, height): (u32, u32),
         vsync: bool,
         options: &SceneOptions,
     ) -> Result<Self, GpuError> {

@@ -696,8 +696,14 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         }
     }
     v.shown_light = a.shadow_light;
-    if !(16..=16384).contains(&a.shadow_map) {
-        bail!("--shadow-map {} must be within 16..16384", a.shadow_map);
+    let sizes = ShadowSettings::MAP_SIZES;
+    if !sizes.contains(&a.shadow_map) {
+        bail!(
+            "--shadow-map {} must be within {}..{}",
+            a.shadow_map,
+            sizes.start(),
+            sizes.end()
+        );
     }
     v.shadow = ShadowSettings {
         enabled: !a.no_shadows,

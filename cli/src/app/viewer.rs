@@ -253,10 +253,8 @@ impl App {
         let renderer = WindowRenderer::new(
             &ctx,
             &self.opts.scene,
-            display,
-            handle,
-            size.width,
-            size.height,
+            (display, handle),
+            (size.width, size.height),
             self.opts.vsync,
             &self.opts.scene_options,
         )?;

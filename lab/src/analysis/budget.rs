@@ -1018,18 +1018,16 @@ pub struct CheckRow {
     pub choose_ms: f64,
 }
 
-/// Runs the budget mode on `camera`'s view and checks it against that view's sweep rows: the
-/// chosen configuration's full-image misclassification (`reference::compare`) and its GPU time
-/// against the cheapest swept configuration within the budget.
-#[allow(clippy::too_many_arguments)]
+/// Runs the budget mode on `camera`'s view (named `view_name`) at `w`×`h` and checks it against
+/// that view's sweep rows: the chosen configuration's full-image misclassification
+/// (`reference::compare`) and its GPU time against the cheapest swept configuration within the
+/// budget.
 pub fn check_view(
     renderer: &mut umbra::render::Renderer,
     reference: &ReferenceScene,
     scene: &Scene,
-    view_name: &str,
-    camera: umbra::scene::Camera,
-    w: u32,
-    h: u32,
+    (view_name, camera): (&str, umbra::scene::Camera),
+    (w, h): (u32, u32),
     budget: f64,
     rows: &[super::sweep::Row],
 ) -> Result<Option<CheckRow>, umbra::gpu::GpuError> {

@@ -17,4 +17,6 @@ pub mod sweep;
 
 pub use grid::{sweep_views, Config, Grid};
 pub use pareto::pareto_front;
-pub use sweep::{mean_by_config, read_csv, run_view, write_json, CsvAppender, Row, SweepOptions};
+pub use sweep::{
+    mean_by_config, read_csv, run_view, write_json, CsvAppender, Row, Sink, SweepOptions, SweepView,
+};

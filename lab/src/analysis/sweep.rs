@@ -127,8 +127,27 @@ fn median_split(frames: &[FrameStats]) -> (f64, f64) {
     v.get(v.len() / 2).copied().unwrap_or((f64::NAN, f64::NAN))
 }
 
-/// Renders `camera`'s view with every configuration of `configs` that `skip` does not name and
-/// hands each row to `on_row`; `tick` is called once per configuration scored and once per
+/// One view of a sweep: the scene's name and the view's, and its camera.
+#[derive(Clone, Copy, Debug)]
+pub struct SweepView<'a> {
+    /// The scene's name (the rows' `scene`).
+    pub scene: &'a str,
+    /// The view's name (the rows' `view`).
+    pub name: &'a str,
+    /// The camera.
+    pub camera: Camera,
+}
+
+/// Where a sweep's results go: each row as it is made, and a tick per unit of progress.
+pub struct Sink<'a> {
+    /// Called with each row.
+    pub on_row: &'a mut dyn FnMut(Row),
+    /// Called once per configuration scored and per configuration per timing round.
+    pub tick: &'a mut dyn FnMut(),
+}
+
+/// Renders `view` with every configuration of `configs` that `skip` does not name and
+/// hands each row to `sink.on_row`; `sink.tick` is called once per configuration scored and once per
 /// configuration per timing round (`repeat + 1` ticks per configuration). Configurations go in
 /// batches of `opts.batch`: every configuration of a batch is first scored once against the exact
 /// reference (ray-cast once per view: it does not depend on shadow settings); then the batch's
@@ -137,18 +156,14 @@ fn median_split(frames: &[FrameStats]) -> (f64, f64) {
 /// the median; then its rows are handed over. Within a round configurations go in order of map
 /// format and size, and a frame whose map changed is rendered once untimed first (allocation and
 /// first touch are not the configuration's cost).
-#[allow(clippy::too_many_arguments)]
 pub fn run_view(
     renderer: &mut Renderer,
     reference: &ReferenceScene,
-    scene: &str,
-    view_name: &str,
-    camera: Camera,
+    view: &SweepView,
     configs: &[Config],
     opts: &SweepOptions,
     skip: &dyn Fn(&str) -> bool,
-    on_row: &mut dyn FnMut(Row),
-    tick: &mut dyn FnMut(),
+    sink: &mut Sink,
 ) -> Result<(), GpuError> {
     let todo: Vec<&Config> = configs.iter().filter(|c| !skip(&c.name())).collect();
     let mut exact: Option<ReferenceFrame> = None;
@@ -156,32 +171,31 @@ pub fn run_view(
         run_batch(
             renderer,
             reference,
-            scene,
-            view_name,
-            camera,
+            view,
             batch.to_vec(),
             opts,
             &mut exact,
-            on_row,
-            tick,
+            sink,
         )?;
     }
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
 fn run_batch(
     renderer: &mut Renderer,
     reference: &ReferenceScene,
-    scene: &str,
-    view_name: &str,
-    camera: Camera,
+    view: &SweepView,
     mut todo: Vec<&Config>,
     opts: &SweepOptions,
     exact: &mut Option<ReferenceFrame>,
-    on_row: &mut dyn FnMut(Row),
-    tick: &mut dyn FnMut(),
+    sink: &mut Sink,
 ) -> Result<(), GpuError> {
+    let SweepView {
+        scene,
+        name: view_name,
+        camera,
+    } = *view;
+    let Sink { on_row, tick } = sink;
     let (w, h) = (opts.width, opts.height);
     if todo.is_empty() {
         return Ok(());

@@ -249,15 +249,17 @@ impl Bvh {
             sp -= 1;
             let n = &self.nodes[stack[sp] as usize];
             if n.count > 0 {
-                if self.test_range(
+                let mut found = Found { t_max, best };
+                let stop = self.test_range(
                     n.first as usize..(n.first + n.count) as usize,
                     ray,
                     t_min,
-                    &mut t_max,
                     any,
-                    &mut best,
                     accept,
-                ) {
+                    &mut found,
+                );
+                (t_max, best) = (found.t_max, found.best);
+                if stop {
                     return best;
                 }
                 continue;
@@ -293,36 +295,28 @@ impl Bvh {
         &self,
         ray: &Ray,
         t_min: f32,
-        mut t_max: f32,
+        t_max: f32,
         any: bool,
         accept: &impl Fn(&Hit) -> bool,
     ) -> Option<Hit> {
-        let mut best = None;
-        self.test_range(
-            0..self.tris.len(),
-            ray,
-            t_min,
-            &mut t_max,
-            any,
-            &mut best,
-            accept,
-        );
-        best
+        let mut found = Found { t_max, best: None };
+        self.test_range(0..self.tris.len(), ray, t_min, any, accept, &mut found);
+        found.best
     }
 
     /// Tests triangles `range` (in BVH order), keeping the nearest hit that `accept` keeps in
-    /// `best` and shrinking `t_max`; returns true when `any` is set and something was hit.
-    #[allow(clippy::too_many_arguments)]
+    /// `found.best` and shrinking `found.t_max`; returns true when `any` is set and something
+    /// was hit.
     fn test_range(
         &self,
         range: std::ops::Range<usize>,
         ray: &Ray,
         t_min: f32,
-        t_max: &mut f32,
         any: bool,
-        best: &mut Option<Hit>,
         accept: &impl Fn(&Hit) -> bool,
+        found: &mut Found,
     ) -> bool {
+        let Found { t_max, best } = found;
         let len = ray.dir.length();
         for k in range {
             let t = &self.tris[k];
@@ -351,6 +345,12 @@ impl Bvh {
     pub fn intersect_brute_force(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
         self.brute(ray, t_min, t_max, false, &|_: &Hit| true)
     }
+}
+
+/// The nearest accepted hit so far and the distance a nearer one must beat.
+struct Found {
+    t_max: f32,
+    best: Option<Hit>,
 }
 
 fn half_area(b: &Aabb) -> f32 {
