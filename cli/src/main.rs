@@ -375,20 +375,16 @@ fn stability(a: app::cli::StabilityArgs) -> anyhow::Result<()> {
 
 #[cfg(feature = "sweep")]
 fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
-    use umbra_lab::analysis::{chart, grid, sweep as sw};
-    let mut grid = if a.quick {
-        grid::Grid::quick()
-    } else {
-        grid::Grid::full()
-    };
+    use umbra_lab::analysis::campaign::{Campaign, Progress};
+    use umbra_lab::analysis::{grid::Grid, sweep::SweepOptions};
     if let Some(s) = a.light_size {
         if !(s.is_finite() && s > 0.0 && s <= 1e6) {
             anyhow::bail!("--light-size must be a number within 0..1e6, above 0");
         }
     }
+    let mut grid = if a.quick { Grid::quick() } else { Grid::full() };
     grid.sdsm = a.depth_fit;
     grid.pcss = a.light_size.is_some();
-    let configs = grid.configs();
     let specs = if a.scenes.is_empty() {
         vec!["demo".to_string()]
     } else {
@@ -398,42 +394,25 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
         .iter()
         .map(|s| app::cli::load_named(s, a.ground))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    let csv_path = a.out.join("sweep.csv");
-    let done: std::collections::HashSet<(String, String, String)> =
-        sw::read_csv(&csv_path)?.iter().map(sw::Row::key).collect();
-    let (w, h) = a.size;
-    let aspect = w as f32 / h as f32;
-    let views: Vec<Vec<(String, umbra::Camera)>> = scenes
-        .iter()
-        .map(|s| {
-            let mut v = grid::sweep_views(s, aspect);
-            v.truncate(a.views.max(1));
-            v
-        })
-        .collect();
-    let total: usize = views.iter().map(|v| v.len() * configs.len()).sum();
-    let already = scenes
-        .iter()
-        .zip(&views)
-        .flat_map(|(s, vs)| vs.iter().map(move |v| (s, v)))
-        .flat_map(|(s, v)| {
-            configs
-                .iter()
-                .map(move |c| (s.name.clone(), v.0.clone(), c.name()))
-        })
-        .filter(|k| done.contains(k))
-        .count();
+    let (width, height) = a.size;
+    let opts = SweepOptions {
+        width,
+        height,
+        repeat: a.repeat,
+        light_size: a.light_size,
+        ..Default::default()
+    };
+    let campaign = Campaign::new(&scenes, grid.configs(), a.views, opts, &a.out)?;
     let ctx = offscreen_context(a.validation, a.device.clone())?;
+    let (total, already) = (campaign.total(), campaign.already());
     eprintln!(
         "sweep: {} scene(s), {} configuration(s) per view, {total} runs ({already} already in {}) on {}",
         scenes.len(),
-        configs.len(),
-        csv_path.display(),
+        campaign.configs.len(),
+        campaign.csv_path().display(),
         ctx.device_name
     );
-    let ticks_per_run = a.repeat.max(1) as u64 + 1;
-    let bar = indicatif::ProgressBar::new((total - already) as u64 * ticks_per_run);
+    let bar = indicatif::ProgressBar::new(campaign.ticks_left());
     bar.set_style(
         indicatif::ProgressStyle::with_template(
             "{bar:40} {percent}% [{elapsed_precise}, ETA {eta_precise}] {msg}",
@@ -441,175 +420,56 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let started = std::time::Instant::now();
-    let mut out = sw::CsvAppender::open(&csv_path)?;
-    let mut failed: Option<anyhow::Error> = None;
-    for (scene, vs) in scenes.iter().zip(&views) {
-        let pending = |v: &str| {
-            configs
-                .iter()
-                .any(|c| !done.contains(&(scene.name.clone(), v.to_string(), c.name())))
-        };
-        if !vs.iter().any(|v| pending(&v.0)) {
-            continue;
-        }
-        let mut renderer = Renderer::with_options(&ctx, scene, &Default::default())?;
-        let reference = umbra_lab::reference::ReferenceScene::new(scene);
-        for (vname, camera) in vs {
-            bar.set_message(format!("{} / {vname}", scene.name));
-            let skip = |c: &str| done.contains(&(scene.name.clone(), vname.clone(), c.to_string()));
-            let mut on_row = |r: sw::Row| {
-                if failed.is_none() {
-                    if let Err(e) = out.push(&r) {
-                        failed = Some(e.into());
-                    }
-                }
-            };
-            sw::run_view(
-                &mut renderer,
-                &reference,
-                &sw::SweepView {
-                    scene: &scene.name,
-                    name: vname,
-                    camera: *camera,
-                },
-                &configs,
-                &sw::SweepOptions {
-                    width: w,
-                    height: h,
-                    repeat: a.repeat,
-                    light_size: a.light_size,
-                    ..Default::default()
-                },
-                &skip,
-                &mut sw::Sink {
-                    on_row: &mut on_row,
-                    tick: &mut || bar.inc(1),
-                },
-            )?;
-            if let Some(e) = failed.take() {
-                return Err(e);
-            }
-        }
-    }
+    campaign.run(&ctx, &mut |p| match p {
+        Progress::View(scene, view) => bar.set_message(format!("{scene} / {view}")),
+        Progress::Tick => bar.inc(1),
+    })?;
     bar.finish_and_clear();
-    drop(out);
-    let rows = sw::read_csv(&csv_path)?;
-    sw::write_json(&a.out.join("sweep.json"), &rows)?;
-    let mut names: Vec<String> = Vec::new();
-    for r in &rows {
-        if !names.contains(&r.scene) {
-            names.push(r.scene.clone());
-        }
-    }
-    for n in &names {
-        let of: Vec<sw::Row> = rows.iter().filter(|r| &r.scene == n).cloned().collect();
-        let file = n.replace(|c: char| !c.is_ascii_alphanumeric() && c != '-', "_");
-        chart::write_pareto(
-            &sw::mean_by_config(&of),
-            &format!(
-                "{n}: mean over {} view(s)",
-                of.iter()
-                    .map(|r| &r.view)
-                    .collect::<std::collections::HashSet<_>>()
-                    .len()
-            ),
-            &a.out.join(format!("pareto-{file}.svg")),
-            &a.out.join(format!("pareto-{file}.png")),
-        )?;
-    }
-    chart::write_pareto(
-        &sw::mean_by_config(&rows),
-        &format!("all scenes ({}): mean over every view", names.join(", ")),
-        &a.out.join("pareto.svg"),
-        &a.out.join("pareto.png"),
-    )?;
+    let (rows, names) = campaign.write_results()?;
     if a.features {
-        let all = grid::Grid::full().configs();
-        let mut feats = Vec::new();
-        for (scene, vs) in scenes.iter().zip(&views) {
-            let reference = umbra_lab::reference::ReferenceScene::new(scene);
-            feats.extend(umbra_lab::analysis::budget::feature_rows(
-                &reference, scene, vs, &all, &rows,
-            ));
-        }
-        let p = a.out.join("budget-features.csv");
-        let mut wr =
-            csv::Writer::from_path(&p).with_context(|| format!("writing {}", p.display()))?;
-        for f in &feats {
-            wr.serialize(f)?;
-        }
-        wr.flush()?;
-        if a.fit_budget {
-            use umbra_lab::analysis::budget;
-            let provenance = format!(
-                "Fitted to {} rows of {} (sweep.csv) at {}x{} on {}.",
-                feats.len(),
-                names.join(", "),
-                w,
-                h,
-                ctx.device_name
-            );
-            let p = a.out.join("budget-model.rs");
-            std::fs::write(&p, budget::fit_model(&feats, &rows, &provenance))
-                .with_context(|| format!("writing {}", p.display()))?;
-        }
+        let fit = a.fit_budget.then_some(ctx.device_name.as_str());
+        campaign.write_features(&Grid::full().configs(), (&rows, &names), fit)?;
     }
     if !a.check_budget.is_empty() {
-        use umbra_lab::analysis::budget;
-        let p = a.out.join("budget-check.csv");
-        let mut wr =
-            csv::Writer::from_path(&p).with_context(|| format!("writing {}", p.display()))?;
-        for (scene, vs) in scenes.iter().zip(&views) {
-            let mut renderer = Renderer::with_options(&ctx, scene, &Default::default())?;
-            let reference = umbra_lab::reference::ReferenceScene::new(scene);
-            for (vname, camera) in vs {
-                for &b in &a.check_budget {
-                    if let Some(row) = budget::check_view(
-                        &mut renderer,
-                        &reference,
-                        scene,
-                        (vname, *camera),
-                        (w, h),
-                        b,
-                        &rows,
-                    )? {
-                        if row.cheapest.is_empty() {
-                            println!(
-                                "budget {:.3} % on {} / {vname}: no swept configuration meets it; chose {} ({:.4} %, the most accurate tried)",
-                                b * 100.0,
-                                scene.name,
-                                row.chosen,
-                                row.measured * 100.0
-                            );
-                        } else {
-                            println!(
-                            "budget {:.3} % on {} / {vname}: {} measured {:.4} % ({}), {:.2}x the cheapest within budget ({}; {:.2}x by per-pass medians)",
-                            b * 100.0,
-                            scene.name,
-                            row.chosen,
-                            row.measured * 100.0,
-                            if row.within_budget { "within" } else { "OVER" },
-                            row.time_ratio,
-                            row.cheapest,
-                            row.denoised_time_ratio
-                        );
-                        }
-                        wr.serialize(&row)?;
-                    }
-                }
-            }
-        }
-        wr.flush()?;
+        campaign.check_budgets(&ctx, &rows, &a.check_budget, &mut print_budget_check)?;
     }
     println!(
         "swept {} run(s) in {:.1} s; {} rows in {} (+ sweep.json, pareto.svg/.png and {} per-scene chart(s))",
         total - already,
         started.elapsed().as_secs_f64(),
         rows.len(),
-        csv_path.display(),
+        campaign.csv_path().display(),
         names.len()
     );
     finish_context(ctx)
+}
+
+/// One line per `--check-budget` result.
+#[cfg(feature = "sweep")]
+fn print_budget_check(row: &umbra_lab::analysis::budget::CheckRow) {
+    let at = format!(
+        "budget {:.3} % on {} / {}",
+        row.budget * 100.0,
+        row.scene,
+        row.view
+    );
+    if row.cheapest.is_empty() {
+        println!(
+            "{at}: no swept configuration meets it; chose {} ({:.4} %, the most accurate tried)",
+            row.chosen,
+            row.measured * 100.0
+        );
+    } else {
+        println!(
+            "{at}: {} measured {:.4} % ({}), {:.2}x the cheapest within budget ({}; {:.2}x by per-pass medians)",
+            row.chosen,
+            row.measured * 100.0,
+            if row.within_budget { "within" } else { "OVER" },
+            row.time_ratio,
+            row.cheapest,
+            row.denoised_time_ratio
+        );
+    }
 }
 
 fn inspect(a: app::cli::InspectArgs) -> anyhow::Result<()> {

@@ -6,6 +6,7 @@
 //! these functions.
 
 pub mod budget;
+pub mod campaign;
 pub mod chart;
 pub mod coeffs;
 pub mod grid;
