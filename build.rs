@@ -210,11 +210,48 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
         std::fs::write(&spv_path, bytes).map_err(|e| e.to_string())?;
     }
 
-    // Reflection.
+    let shader = Shader {
+        file: &file,
+        stem: &stem,
+        module: &module,
+        info: &info,
+        overrides: &overrides,
+        requires: &requires,
+        canonical: (0..variants).map(canonical).collect(),
+    };
+    reflect(&shader)
+}
+
+/// What `reflect` writes Rust constants from: a validated module, its overrides and the
+/// canonical variant of every override combination.
+struct Shader<'a> {
+    file: &'a str,
+    stem: &'a str,
+    module: &'a naga::Module,
+    info: &'a naga::valid::ModuleInfo,
+    overrides: &'a [String],
+    requires: &'a [Option<usize>],
+    canonical: Vec<usize>,
+}
+
+/// The generated module of one shader: its SPIR-V variants, override bits and dependants, named
+/// constants, bindings, immediate size and entry points.
+fn reflect(shader: &Shader) -> Result<String, String> {
+    let Shader {
+        file,
+        stem,
+        module,
+        info,
+        overrides,
+        requires,
+        ..
+    } = *shader;
+    let canonical = &shader.canonical;
+    let variants = canonical.len();
     let mut layouter = naga::proc::Layouter::default();
     layouter
         .update(module.to_ctx())
-        .map_err(|e| format!("{}:1:1: error: layout: {e}", path.display()))?;
+        .map_err(|e| format!("{file}:1:1: error: layout: {e}"))?;
     let mut code = String::new();
     writeln!(code, "/// Generated from `{}`.", file).unwrap();
     writeln!(code, "pub mod {stem} {{").unwrap();
@@ -226,7 +263,7 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
     .unwrap();
     let list: Vec<String> = (0..variants)
         .map(|m| {
-            let m = canonical(m);
+            let m = canonical[m];
             format!("include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{stem}_{m}.spv\"))")
         })
         .collect();

@@ -13,11 +13,8 @@ pub use super::load_error::{LoadError, MAX_TEXTURE_SIDE};
 use super::tangents::{
     compute_smooth_normals, count_degenerate, fallback_tangent, generate_mikktspace,
 };
-use super::{
-    AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Primitive, Sampler, Scene,
-    Texture, TextureRef, UvTransform,
-};
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use super::{Material, Mesh, Primitive, Scene, Texture};
+use glam::{Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 
 /// Extensions that may appear in `extensionsRequired`.
@@ -92,7 +89,49 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         ..Default::default()
     };
 
-    // Buffers.
+    let buffers = read_buffers(path, &gltf, &base)?;
+    let image_slots = read_images(path, &gltf, &buffers, &base, &mut scene)?;
+    super::gltf_material::read_materials(&gltf, &image_slots, &mut scene);
+    let default_material = scene.materials.len();
+    scene.materials.push(Material::default());
+
+    // Meshes.
+    for mesh in gltf.meshes() {
+        let mut out = Mesh {
+            name: mesh.name().unwrap_or("").to_string(),
+            primitives: Vec::new(),
+        };
+        for prim in mesh.primitives() {
+            if let Some(p) =
+                read_primitive(path, &mut scene, &buffers, &mesh, &prim, default_material)?
+            {
+                out.primitives.push(p);
+            }
+        }
+        scene.meshes.push(out);
+    }
+
+    let walk = super::gltf_nodes::walk_nodes(path, &gltf, &mut scene)?;
+    let rig = read_rig(
+        &mut scene,
+        &gltf,
+        &buffers,
+        &walk.parents,
+        walk.light_nodes,
+        walk.camera_nodes,
+    );
+    if let Some(rig) = rig {
+        rest_pose(&mut scene, rig);
+    }
+    if scene.instances.is_empty() {
+        scene.warn("SCENE_EMPTY", "", "the scene has no mesh instances");
+    }
+    Ok(scene)
+}
+
+/// Reads every buffer (the GLB chunk or a URI inside the model's folder) and checks every
+/// buffer view and accessor against them.
+fn read_buffers(path: &Path, gltf: &gltf::Gltf, base: &Path) -> Result<Vec<Vec<u8>>, LoadError> {
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for b in gltf.buffers() {
         let data = match b.source() {
@@ -106,7 +145,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 )
             })?,
             gltf::buffer::Source::Uri(uri) => {
-                read_uri(path, &base, uri, &format!("buffer {}", b.index()))?
+                read_uri(path, base, uri, &format!("buffer {}", b.index()))?
             }
         };
         if data.len() < b.length() {
@@ -139,6 +178,18 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         check_accessor(path, &a)?;
     }
 
+    Ok(buffers)
+}
+
+/// Reads and decodes every image; returns the texture index of each glTF image (`None` where it
+/// could not be loaded: a warning, and the material slot falls back).
+fn read_images(
+    path: &Path,
+    gltf: &gltf::Gltf,
+    buffers: &[Vec<u8>],
+    base: &Path,
+    scene: &mut Scene,
+) -> Result<Vec<Option<usize>>, LoadError> {
     // Images (decoded once; a broken image becomes a warning and the material slot falls back).
     // Read in order, then decoded in parallel (PNG/JPEG decoding dominates loading textured
     // models), then recorded in order so warnings and texture indices do not depend on timing.
@@ -150,7 +201,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
                 let buf = &buffers[view.buffer().index()];
                 Ok(buf[view.offset()..view.offset() + view.length()].to_vec())
             }
-            gltf::image::Source::Uri { uri, .. } => read_uri(path, &base, uri, &what),
+            gltf::image::Source::Uri { uri, .. } => read_uri(path, base, uri, &what),
         };
         if let Err(e @ LoadError::OutsideFolder { .. }) = data {
             return Err(e);
@@ -190,314 +241,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         }
     }
     scene.image_textures = image_slots.clone();
-    let tex_ref = |t: gltf::Texture, transform: UvTransform, tex_coord: u32| {
-        image_slots
-            .get(t.source().index())
-            .copied()
-            .flatten()
-            .map(|texture| TextureRef {
-                texture,
-                sampler: Sampler::from_gltf(&t.sampler()),
-                transform,
-                tex_coord,
-            })
-    };
-    const EXT_TRANSFORM: &str = "KHR_texture_transform";
-    let json_transform =
-        |v: Option<&serde_json::Value>| v.map(UvTransform::from_json).unwrap_or_default();
-    // The transform's texCoord override (JSON), else the textureInfo's own set.
-    let json_set = |v: Option<&serde_json::Value>, own: u32| {
-        v.and_then(|v| v.get("texCoord"))
-            .and_then(|c| c.as_u64())
-            .map_or(own, |c| c.min(u32::MAX as u64) as u32)
-    };
-    // A textureInfo's KHR_texture_transform (identity without one).
-    let info_ref = |i: gltf::texture::Info| {
-        let transform = i
-            .texture_transform()
-            .map(|x| UvTransform {
-                offset: Vec2::from_array(x.offset()),
-                rotation: x.rotation(),
-                scale: Vec2::from_array(x.scale()),
-            })
-            .filter(|x| x.offset.is_finite() && x.rotation.is_finite() && x.scale.is_finite())
-            .unwrap_or_default();
-        let set = i
-            .texture_transform()
-            .and_then(|x| x.tex_coord())
-            .unwrap_or(i.tex_coord());
-        tex_ref(i.texture(), transform, set)
-    };
-
-    // Materials (index = glTF index; the default material goes last).
-    for m in gltf.materials() {
-        let pbr = m.pbr_metallic_roughness();
-        let mut mat = Material {
-            name: m.name().unwrap_or("").to_string(),
-            base_color: Vec4::from_array(pbr.base_color_factor()),
-            base_color_texture: pbr.base_color_texture().and_then(info_ref),
-            metallic: pbr.metallic_factor(),
-            roughness: pbr.roughness_factor(),
-            metallic_roughness_texture: pbr.metallic_roughness_texture().and_then(info_ref),
-            // gltf 1.4 types the extension on textureInfo only: normal and occlusion textureInfos
-            // carry it as JSON.
-            normal_texture: m.normal_texture().and_then(|t| {
-                let ext = t.extension_value(EXT_TRANSFORM);
-                tex_ref(
-                    t.texture(),
-                    json_transform(ext),
-                    json_set(ext, t.tex_coord()),
-                )
-            }),
-            normal_scale: m.normal_texture().map(|t| t.scale()).unwrap_or(1.0),
-            // KHR_materials_emissive_strength scales the factor (finite, >= 0; else 1).
-            emissive: Vec3::from_array(m.emissive_factor())
-                * m.emissive_strength()
-                    .filter(|s| s.is_finite() && *s >= 0.0)
-                    .unwrap_or(1.0),
-            emissive_texture: m.emissive_texture().and_then(info_ref),
-            occlusion_texture: m.occlusion_texture().and_then(|t| {
-                let ext = t.extension_value(EXT_TRANSFORM);
-                tex_ref(
-                    t.texture(),
-                    json_transform(ext),
-                    json_set(ext, t.tex_coord()),
-                )
-            }),
-            occlusion_strength: m
-                .occlusion_texture()
-                .map(|t| t.strength())
-                .filter(|s| s.is_finite())
-                .unwrap_or(1.0)
-                .clamp(0.0, 1.0),
-            alpha_mode: match m.alpha_mode() {
-                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-                gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
-                gltf::material::AlphaMode::Blend => AlphaMode::Blend,
-            },
-            double_sided: m.double_sided(),
-            unlit: m.unlit(),
-        };
-        if mat.alpha_mode == AlphaMode::Blend {
-            let i = m.index().unwrap_or(0);
-            scene.warn(
-                "MATERIAL_ALPHA_BLEND",
-                format!("/materials/{i}"),
-                format!(
-                    "material {i} '{}': alpha-blended, sorted per draw (not per triangle), \
-                     casts where alpha >= 0.5",
-                    mat.name
-                ),
-            );
-        }
-        if !mat.base_color.is_finite() {
-            mat.base_color = Vec4::ONE;
-        }
-        // TEXCOORD_0 and _1 are loaded; a slot reading another set reads set 0.
-        let i = m.index().unwrap_or(0);
-        let name = mat.name.clone();
-        for (slot, t) in [
-            (
-                "pbrMetallicRoughness/baseColorTexture",
-                &mut mat.base_color_texture,
-            ),
-            ("normalTexture", &mut mat.normal_texture),
-            (
-                "pbrMetallicRoughness/metallicRoughnessTexture",
-                &mut mat.metallic_roughness_texture,
-            ),
-            ("emissiveTexture", &mut mat.emissive_texture),
-            ("occlusionTexture", &mut mat.occlusion_texture),
-        ] {
-            if let Some(t) = t.as_mut().filter(|t| t.tex_coord > 1) {
-                scene.warn(
-                    "TEXCOORD_FALLBACK",
-                    format!("/materials/{i}/{slot}"),
-                    format!(
-                        "material {i} '{name}': {slot} reads TEXCOORD_{}; only sets 0 and 1 \
-                         are loaded, set 0 read instead",
-                        t.tex_coord
-                    ),
-                );
-                t.tex_coord = 0;
-            }
-        }
-        // Occlusion is drawn from the metallic-roughness texture's red channel (glTF's ORM
-        // packing; a separate image is packed in at upload), so it must be sampled alike.
-        if let (Some(o), Some(mr)) = (mat.occlusion_texture, mat.metallic_roughness_texture) {
-            let size = |t: usize| scene.textures.get(t).map(|t| (t.width, t.height));
-            if o.sampler != mr.sampler
-                || o.transform != mr.transform
-                || o.tex_coord != mr.tex_coord
-                || size(o.texture) != size(mr.texture)
-            {
-                let i = m.index().unwrap_or(0);
-                scene.warn(
-                    "MATERIAL_OCCLUSION_IGNORED",
-                    format!("/materials/{i}/occlusionTexture"),
-                    format!(
-                        "material {i} '{}': occlusion texture differs from metallic-roughness in \
-                         size, sampler, transform or TEXCOORD set; ignored",
-                        mat.name
-                    ),
-                );
-                mat.occlusion_texture = None;
-            }
-        }
-        scene.materials.push(mat);
-    }
-    let default_material = scene.materials.len();
-    scene.materials.push(Material::default());
-
-    // Meshes.
-    for mesh in gltf.meshes() {
-        let mut out = Mesh {
-            name: mesh.name().unwrap_or("").to_string(),
-            primitives: Vec::new(),
-        };
-        for prim in mesh.primitives() {
-            if let Some(p) =
-                read_primitive(path, &mut scene, &buffers, &mesh, &prim, default_material)?
-            {
-                out.primitives.push(p);
-            }
-        }
-        scene.meshes.push(out);
-    }
-
-    // Node hierarchy.
-    scene.node_names = gltf
-        .nodes()
-        .map(|n| n.name().unwrap_or_default().to_string())
-        .collect();
-    let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
-        Some(s) => s.nodes().collect(),
-        None => {
-            let mut is_child = vec![false; gltf.nodes().len()];
-            for n in gltf.nodes() {
-                for c in n.children() {
-                    is_child[c.index()] = true;
-                }
-            }
-            gltf.nodes().filter(|n| !is_child[n.index()]).collect()
-        }
-    };
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
-        roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
-    let mut visited = 0usize;
-    // What motion needs from the walk: each node's parent, and the nodes lights and cameras
-    // hang on.
-    let mut parents: Vec<Option<usize>> = vec![None; gltf.nodes().len()];
-    let (mut light_nodes, mut camera_nodes) = (Vec::new(), Vec::new());
-    while let Some((node, parent, depth)) = stack.pop() {
-        visited += 1;
-        if depth > 256 || visited > 1_000_000 {
-            return Err(corrupt(path, "node hierarchy too deep or cyclic".into()));
-        }
-        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
-        let world = parent * local;
-        if !world.is_finite() {
-            scene.warn(
-                "NODE_NONFINITE_TRANSFORM",
-                format!("/nodes/{}", node.index()),
-                format!("node {} has a non-finite transform; skipped", node.index()),
-            );
-            continue;
-        }
-        if let Some(m) = node.mesh() {
-            scene.instances.push(Instance {
-                mesh: m.index(),
-                world_from_model: world,
-                node: Some(node.index()),
-            });
-        }
-        if let Some(c) = node.camera() {
-            match c.projection() {
-                gltf::camera::Projection::Perspective(p) => {
-                    // Remove scale from the camera transform.
-                    let (_, rot, pos) = world.to_scale_rotation_translation();
-                    camera_nodes.push(node.index());
-                    scene.cameras.push(Camera {
-                        world_from_view: Mat4::from_rotation_translation(rot, pos),
-                        fov_y: p.yfov().clamp(0.01, 3.1),
-                        near: p.znear().max(1e-6),
-                        far: p.zfar(),
-                    });
-                }
-                gltf::camera::Projection::Orthographic(_) => {
-                    scene.warn(
-                        "CAMERA_ORTHOGRAPHIC",
-                        format!("/cameras/{}", c.index()),
-                        format!(
-                            "camera {} is orthographic; not supported, skipped",
-                            c.index()
-                        ),
-                    );
-                }
-            }
-        }
-        if let Some(l) = node.light() {
-            let (_, rot, pos) = world.to_scale_rotation_translation();
-            let dir = (rot * -Vec3::Z).normalize_or_zero();
-            let kind = match l.kind() {
-                gltf::khr_lights_punctual::Kind::Directional => LightKind::Directional,
-                gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
-                gltf::khr_lights_punctual::Kind::Spot {
-                    inner_cone_angle,
-                    outer_cone_angle,
-                } => LightKind::Spot {
-                    inner: inner_cone_angle,
-                    outer: outer_cone_angle.max(inner_cone_angle + 1e-4),
-                },
-            };
-            let size =
-                light_size_extra(l.extras().as_deref().map(|r| r.get())).unwrap_or_else(|e| {
-                    scene.warn(
-                        "LIGHT_SIZE_INVALID",
-                        format!(
-                            "/extensions/KHR_lights_punctual/lights/{}/extras",
-                            l.index()
-                        ),
-                        format!("light {}: {e}; the light casts hard shadows", l.index()),
-                    );
-                    0.0
-                });
-            light_nodes.push(node.index());
-            scene.lights.push(Light {
-                kind,
-                position: pos,
-                direction: dir,
-                color: Vec3::from_array(l.color()),
-                intensity: l.intensity().max(0.0),
-                casts_shadows: true,
-                range: l.range().filter(|r| r.is_finite() && *r > 0.0),
-                size: if kind == LightKind::Directional {
-                    size.to_radians()
-                } else {
-                    size
-                },
-            });
-        }
-        for c in node.children() {
-            parents[c.index()] = Some(node.index());
-            stack.push((c, world, depth + 1));
-        }
-    }
-    let rig = read_rig(
-        &mut scene,
-        &gltf,
-        &buffers,
-        &parents,
-        light_nodes,
-        camera_nodes,
-    );
-    if let Some(rig) = rig {
-        rest_pose(&mut scene, rig);
-    }
-    if scene.instances.is_empty() {
-        scene.warn("SCENE_EMPTY", "", "the scene has no mesh instances");
-    }
-    Ok(scene)
+    Ok(image_slots)
 }
 
 /// Gives each instance of a deforming mesh past the first its own copy (each is posed on its
@@ -520,23 +264,6 @@ fn rest_pose(scene: &mut Scene, rig: crate::scene::anim::Rig) {
     let pose = rig.pose(&crate::scene::anim::Playing::Rest, 0.0);
     scene.apply_pose(&rig, &pose, false);
     scene.rig = Some(std::sync::Arc::new(rig));
-}
-
-/// The emitter size in a glTF light's `extras` (`{"light_size": S}`: degrees of angular
-/// diameter for a directional light, scene units of radius otherwise); 0 without one.
-fn light_size_extra(extras: Option<&str>) -> Result<f32, String> {
-    let Some(json) = extras else {
-        return Ok(0.0);
-    };
-    let v: serde_json::Value =
-        serde_json::from_str(json).map_err(|e| format!("extras are not JSON: {e}"))?;
-    match v.get("light_size") {
-        None => Ok(0.0),
-        Some(s) => match s.as_f64() {
-            Some(x) if x.is_finite() && (0.0..=1e6).contains(&x) => Ok(x as f32),
-            _ => Err(format!("extras.light_size {s} is not a number in 0..1e6")),
-        },
-    }
 }
 
 /// An image's name, its label for messages ("image 3") and its encoded bytes (or why not).
@@ -861,7 +588,7 @@ fn read_primitive(
 
 #[cfg(test)]
 mod tests {
-    use super::light_size_extra;
+    use super::super::gltf_nodes::light_size_extra;
 
     #[test]
     fn light_size_comes_from_the_lights_extras() {

@@ -6,6 +6,8 @@ pub mod clusters;
 pub mod demo;
 mod gltf_input;
 pub mod gltf_load;
+mod gltf_material;
+mod gltf_nodes;
 pub mod inspect;
 pub mod load_error;
 pub mod material;
