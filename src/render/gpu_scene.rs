@@ -12,7 +12,7 @@ use crate::plan::uniforms::{MaterialUniform, SceneImmediates};
 use crate::plan::Viewpoint;
 use crate::scene::clusters::{self, Cluster};
 use crate::scene::topology::{is_closed, plane_of};
-use crate::scene::{AlphaMode, Scene, BLEND_SHADOW_CUTOFF};
+use crate::scene::{AlphaMode, Material, Scene, TextureRef, BLEND_SHADOW_CUTOFF};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
@@ -52,7 +52,6 @@ fn uv_rows(slots: [Option<crate::scene::TextureRef>; 4]) -> [Vec4; 8] {
 /// channel (glTF's ORM layout; the loader keeps an occlusion texture only where its sampler and
 /// transform are the metallic-roughness texture's and its size too): the reference to sample, and
 /// the (metallic-roughness, occlusion) image pair to merge when they are different images.
-#[allow(clippy::type_complexity)]
 fn orm_slot(
     m: &crate::scene::Material,
     textures: usize,
@@ -560,80 +559,13 @@ impl GpuScene {
         origin: glam::Vec3,
     ) -> Result<Self, GpuError> {
         let anisotropy = options.resolved_anisotropy(ctx);
-        // Geometry: one entry per mesh primitive, shared by all instances.
-        let mut positions: Vec<[f32; 3]> = Vec::new();
-        let mut attrs: Vec<VertexAttributes> = Vec::new();
-        let mut indices: Vec<u32> = Vec::new();
-        let mut ranges: Vec<Vec<PrimitiveRange>> = Vec::new();
-        let mut all_clusters: Vec<Cluster> = Vec::new();
-        // Shape analysis per primitive (closed? flat? clusters), on all cores.
-        let prims: Vec<&crate::scene::Primitive> =
-            scene.meshes.iter().flat_map(|m| &m.primitives).collect();
-        let mut analyses = crate::parallel::map(&prims, |p| {
-            let double_sided = scene
-                .materials
-                .get(p.material)
-                .is_some_and(|m| m.double_sided);
-            PrimitiveShape {
-                area: p
-                    .indices
-                    .chunks_exact(3)
-                    .map(|t| {
-                        let v =
-                            |k: usize| p.positions.get(t[k] as usize).copied().unwrap_or_default();
-                        0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length()
-                    })
-                    .sum(),
-                // Only double-sided materials can use it; skip the check for the others.
-                closed: options.culling && double_sided && is_closed(&p.positions, &p.indices),
-                plane: options
-                    .culling
-                    .then(|| plane_of(&p.positions, &p.indices))
-                    .flatten(),
-                clusters: options
-                    .culling
-                    .then(|| clusters::build(&p.positions, &p.indices))
-                    .flatten(),
-            }
-        })
-        .into_iter();
-        for mesh in &scene.meshes {
-            let mut r = Vec::new();
-            for p in &mesh.primitives {
-                let shape = analyses.next().expect("one analysis per primitive");
-                let first = indices.len() as u32;
-                let base = positions.len() as i32;
-                positions.extend(p.positions.iter().map(|v| v.to_array()));
-                attrs.extend(vertex_attributes(p));
-                // Large primitives are split into clusters (their indices reordered cluster by
-                // cluster) so that clusters facing away can be skipped.
-                let cluster_start = all_clusters.len() as u32;
-                match shape.clusters {
-                    Some((reordered, cl)) => {
-                        indices.extend_from_slice(&reordered);
-                        all_clusters.extend(cl);
-                    }
-                    None => indices.extend_from_slice(&p.indices),
-                }
-                let cluster_range = (cluster_start, all_clusters.len() as u32 - cluster_start);
-                r.push(PrimitiveRange {
-                    clusters: cluster_range,
-                    first_index: first,
-                    index_count: indices.len() as u32 - first,
-                    vertex_offset: base,
-                    material: p.material.min(scene.materials.len().saturating_sub(1)),
-                    bounds: p.bounds(),
-                    closed: shape.closed,
-                    plane: shape.plane,
-                    white: p
-                        .colors
-                        .iter()
-                        .all(|c| c.clamp(Vec4::ZERO, Vec4::ONE) == Vec4::ONE),
-                    area: shape.area,
-                });
-            }
-            ranges.push(r);
-        }
+        let Geometry {
+            positions,
+            attrs,
+            indices,
+            ranges,
+            clusters: all_clusters,
+        } = pack_geometry(scene, options);
         let moving = scene.moving_instances();
         let (draws, triangles, bounds) = build_draws(scene, &ranges, origin, &moving);
         let mut pipeline_keys: Vec<(usize, AlphaDraw)> =
@@ -661,56 +593,7 @@ impl GpuScene {
             bytemuck::cast_slice(&indices),
         )?;
 
-        // Textures, created per (image, colour space) actually used, and per packed
-        // (metallic-roughness, occlusion) pair; their mip chains computed on all cores first.
-        let mut jobs: Vec<TextureJob> = scene
-            .materials
-            .iter()
-            .flat_map(|m| texture_jobs(m, scene.textures.len()))
-            .flatten()
-            .collect();
-        let mut seen = std::collections::HashSet::new();
-        jobs.retain(|j| seen.insert(*j));
-        // Mip chains computed here (`SceneOptions::cpu_mips`: by default on CPU devices), a few
-        // textures at a time on all cores (a 2048² chain is 21 MiB, dropped once uploaded), or
-        // blitted on the device.
-        let cpu_mips = options.resolved_cpu_mips(ctx);
-        let batch = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let mut textures: Vec<Image> = Vec::new();
-        let mut tex_index: HashMap<TextureJob, usize> = HashMap::new();
-        for part in jobs.chunks(batch.max(1)) {
-            let done = crate::parallel::map(part, |j| {
-                let t = match *j {
-                    TextureJob::Image(i, _) => std::borrow::Cow::Borrowed(&scene.textures[i]),
-                    TextureJob::Packed((mr, o)) => std::borrow::Cow::Owned(packed_occlusion(
-                        &scene.textures[o],
-                        mr.map(|i| &scene.textures[i]),
-                    )),
-                };
-                let srgb = matches!(j, TextureJob::Image(_, true));
-                let chain = cpu_mips.then(|| mip_chain(t.width, t.height, &t.rgba, srgb));
-                (t, chain, srgb)
-            });
-            for (j, (t, chain, srgb)) in part.iter().zip(done) {
-                textures.push(match chain {
-                    Some(c) => Image::texture_mips(ctx, &t.name, &c, srgb)?,
-                    None => Image::texture_rgba8(ctx, &t.name, t.width, t.height, &t.rgba, srgb)?,
-                });
-                tex_index.insert(*j, textures.len() - 1);
-            }
-        }
-        let white_srgb = Image::texture_rgba8(ctx, "default white sRGB", 1, 1, &[255; 4], true)?;
-        let white_linear = Image::texture_rgba8(ctx, "default white", 1, 1, &[255; 4], false)?;
-        let flat_normal = Image::texture_rgba8(
-            ctx,
-            "default flat normal",
-            1,
-            1,
-            &[128, 128, 255, 255],
-            false,
-        )?;
-        let defaults = textures.len();
-        textures.extend([white_srgb, white_linear, flat_normal]);
+        let (textures, tex_index, defaults) = upload_textures(ctx, scene, options)?;
 
         let material_layout = set_layout(ctx, sh::BINDINGS, 1, "material set layout")?;
         let (pool, sets) =
@@ -720,31 +603,7 @@ impl GpuScene {
         let mut material_buffers = Vec::new();
         for (i, m) in scene.materials.iter().enumerate() {
             let (orm_ref, _) = orm_slot(m, scene.textures.len());
-            let u = MaterialUniform {
-                base_color: m.base_color,
-                emissive: m.emissive.extend(m.normal_scale),
-                params: Vec4::new(
-                    m.metallic,
-                    m.roughness,
-                    if m.occlusion_texture.is_some() {
-                        m.occlusion_strength
-                    } else {
-                        0.0
-                    },
-                    m.unlit as u32 as f32,
-                ),
-                extra: match m.alpha_mode {
-                    AlphaMode::Mask(c) => Vec4::new(c.max(1e-6), c.max(1e-6), 0.0, 0.0),
-                    AlphaMode::Blend => Vec4::new(0.0, BLEND_SHADOW_CUTOFF, 0.0, 0.0),
-                    AlphaMode::Opaque => Vec4::ZERO,
-                },
-                uv: uv_rows([
-                    m.base_color_texture,
-                    m.normal_texture,
-                    orm_ref,
-                    m.emissive_texture,
-                ]),
-            };
+            let u = material_uniform(m, orm_ref);
             let mut buf = Buffer::new(
                 ctx,
                 &format!("material {i} '{}'", m.name),
@@ -753,53 +612,13 @@ impl GpuScene {
                 MemoryLocation::CpuToGpu,
             )?;
             buf.write(0, bytemuck::bytes_of(&u))?;
-            let jobs = texture_jobs(m, scene.textures.len());
-            let [base, normal, mr, emissive]: [vk::ImageView; 4] = std::array::from_fn(|k| {
-                textures[jobs[k].map_or(defaults + DEFAULT_TEXTURES[k], |j| tex_index[&j])].view
-            });
-            let buf_info = [vk::DescriptorBufferInfo {
-                buffer: buf.raw,
-                offset: 0,
-                range: vk::WHOLE_SIZE,
-            }];
-            let img = |v| {
-                [vk::DescriptorImageInfo {
-                    sampler: vk::Sampler::null(),
-                    image_view: v,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }]
+            let views = TextureViews {
+                scene_textures: scene.textures.len(),
+                textures: &textures,
+                index: &tex_index,
+                defaults,
             };
-            let (i_base, i_normal, i_mr, i_em) = (img(base), img(normal), img(mr), img(emissive));
-            let mut samp = |t: Option<crate::scene::TextureRef>| -> Result<_, GpuError> {
-                Ok([vk::DescriptorImageInfo {
-                    sampler: samplers.get(t.map(|t| t.sampler).unwrap_or_default())?,
-                    image_view: vk::ImageView::null(),
-                    image_layout: vk::ImageLayout::UNDEFINED,
-                }])
-            };
-            let s_base = samp(m.base_color_texture)?;
-            let s_normal = samp(m.normal_texture)?;
-            let s_mr = samp(orm_ref)?;
-            let s_em = samp(m.emissive_texture)?;
-            let set = sets[i];
-            let w = |b: &crate::gpu::shaders::ReflectedBinding| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(b.binding)
-                    .descriptor_type(b.descriptor_type())
-            };
-            let writes = [
-                w(&sh::MATERIAL).buffer_info(&buf_info),
-                w(&sh::BASE_COLOR_TEX).image_info(&i_base),
-                w(&sh::NORMAL_TEX).image_info(&i_normal),
-                w(&sh::METAL_ROUGH_TEX).image_info(&i_mr),
-                w(&sh::EMISSIVE_TEX).image_info(&i_em),
-                w(&sh::BASE_COLOR_SAMPLER).image_info(&s_base),
-                w(&sh::NORMAL_SAMPLER).image_info(&s_normal),
-                w(&sh::METAL_ROUGH_SAMPLER).image_info(&s_mr),
-                w(&sh::EMISSIVE_SAMPLER).image_info(&s_em),
-            ];
-            unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+            write_material_set(ctx, sets[i], &buf, m, &views, &mut samplers)?;
             material_buffers.push(buf);
         }
         Ok(Self {
@@ -835,4 +654,262 @@ impl Drop for GpuScene {
             d.destroy_descriptor_set_layout(self.material_layout, None);
         }
     }
+}
+
+/// The scene's primitives packed into shared vertex and index arrays (large ones split into
+/// clusters), with each primitive's range and shape.
+struct Geometry {
+    positions: Vec<[f32; 3]>,
+    attrs: Vec<VertexAttributes>,
+    indices: Vec<u32>,
+    ranges: Vec<Vec<PrimitiveRange>>,
+    clusters: Vec<Cluster>,
+}
+
+/// Packs every mesh primitive once (instances share it), analysing each (closed? flat?
+/// clusters) on all cores.
+fn pack_geometry(scene: &Scene, options: &SceneOptions) -> Geometry {
+    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut attrs: Vec<VertexAttributes> = Vec::new();
+    let mut indices: Vec<u32> = Vec::new();
+    let mut ranges: Vec<Vec<PrimitiveRange>> = Vec::new();
+    let mut all_clusters: Vec<Cluster> = Vec::new();
+    // Shape analysis per primitive (closed? flat? clusters), on all cores.
+    let prims: Vec<&crate::scene::Primitive> =
+        scene.meshes.iter().flat_map(|m| &m.primitives).collect();
+    let mut analyses = crate::parallel::map(&prims, |p| {
+        let double_sided = scene
+            .materials
+            .get(p.material)
+            .is_some_and(|m| m.double_sided);
+        PrimitiveShape {
+            area: p
+                .indices
+                .chunks_exact(3)
+                .map(|t| {
+                    let v = |k: usize| p.positions.get(t[k] as usize).copied().unwrap_or_default();
+                    0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length()
+                })
+                .sum(),
+            // Only double-sided materials can use it; skip the check for the others.
+            closed: options.culling && double_sided && is_closed(&p.positions, &p.indices),
+            plane: options
+                .culling
+                .then(|| plane_of(&p.positions, &p.indices))
+                .flatten(),
+            clusters: options
+                .culling
+                .then(|| clusters::build(&p.positions, &p.indices))
+                .flatten(),
+        }
+    })
+    .into_iter();
+    for mesh in &scene.meshes {
+        let mut r = Vec::new();
+        for p in &mesh.primitives {
+            let shape = analyses.next().expect("one analysis per primitive");
+            let first = indices.len() as u32;
+            let base = positions.len() as i32;
+            positions.extend(p.positions.iter().map(|v| v.to_array()));
+            attrs.extend(vertex_attributes(p));
+            // Large primitives are split into clusters (their indices reordered cluster by
+            // cluster) so that clusters facing away can be skipped.
+            let cluster_start = all_clusters.len() as u32;
+            match shape.clusters {
+                Some((reordered, cl)) => {
+                    indices.extend_from_slice(&reordered);
+                    all_clusters.extend(cl);
+                }
+                None => indices.extend_from_slice(&p.indices),
+            }
+            let cluster_range = (cluster_start, all_clusters.len() as u32 - cluster_start);
+            r.push(PrimitiveRange {
+                clusters: cluster_range,
+                first_index: first,
+                index_count: indices.len() as u32 - first,
+                vertex_offset: base,
+                material: p.material.min(scene.materials.len().saturating_sub(1)),
+                bounds: p.bounds(),
+                closed: shape.closed,
+                plane: shape.plane,
+                white: p
+                    .colors
+                    .iter()
+                    .all(|c| c.clamp(Vec4::ZERO, Vec4::ONE) == Vec4::ONE),
+                area: shape.area,
+            });
+        }
+        ranges.push(r);
+    }
+    Geometry {
+        positions,
+        attrs,
+        indices,
+        ranges,
+        clusters: all_clusters,
+    }
+}
+
+/// Uploads the textures the materials use: one per (image, colour space), one per packed
+/// (metallic-roughness, occlusion) pair, then the three defaults (white sRGB, white linear, flat
+/// normal) from the returned index on.
+fn upload_textures(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    options: &SceneOptions,
+) -> Result<Uploaded, GpuError> {
+    // Textures, created per (image, colour space) actually used, and per packed
+    // (metallic-roughness, occlusion) pair; their mip chains computed on all cores first.
+    let mut jobs: Vec<TextureJob> = scene
+        .materials
+        .iter()
+        .flat_map(|m| texture_jobs(m, scene.textures.len()))
+        .flatten()
+        .collect();
+    let mut seen = std::collections::HashSet::new();
+    jobs.retain(|j| seen.insert(*j));
+    // Mip chains computed here (`SceneOptions::cpu_mips`: by default on CPU devices), a few
+    // textures at a time on all cores (a 2048² chain is 21 MiB, dropped once uploaded), or
+    // blitted on the device.
+    let cpu_mips = options.resolved_cpu_mips(ctx);
+    let batch = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut textures: Vec<Image> = Vec::new();
+    let mut tex_index: HashMap<TextureJob, usize> = HashMap::new();
+    for part in jobs.chunks(batch.max(1)) {
+        let done = crate::parallel::map(part, |j| {
+            let t = match *j {
+                TextureJob::Image(i, _) => std::borrow::Cow::Borrowed(&scene.textures[i]),
+                TextureJob::Packed((mr, o)) => std::borrow::Cow::Owned(packed_occlusion(
+                    &scene.textures[o],
+                    mr.map(|i| &scene.textures[i]),
+                )),
+            };
+            let srgb = matches!(j, TextureJob::Image(_, true));
+            let chain = cpu_mips.then(|| mip_chain(t.width, t.height, &t.rgba, srgb));
+            (t, chain, srgb)
+        });
+        for (j, (t, chain, srgb)) in part.iter().zip(done) {
+            textures.push(match chain {
+                Some(c) => Image::texture_mips(ctx, &t.name, &c, srgb)?,
+                None => Image::texture_rgba8(ctx, &t.name, t.width, t.height, &t.rgba, srgb)?,
+            });
+            tex_index.insert(*j, textures.len() - 1);
+        }
+    }
+    let white_srgb = Image::texture_rgba8(ctx, "default white sRGB", 1, 1, &[255; 4], true)?;
+    let white_linear = Image::texture_rgba8(ctx, "default white", 1, 1, &[255; 4], false)?;
+    let flat_normal = Image::texture_rgba8(
+        ctx,
+        "default flat normal",
+        1,
+        1,
+        &[128, 128, 255, 255],
+        false,
+    )?;
+    let defaults = textures.len();
+    textures.extend([white_srgb, white_linear, flat_normal]);
+    Ok((textures, tex_index, defaults))
+}
+
+/// What `upload_textures` made: the images, the image of each texture job, and the index of the
+/// first default texture.
+type Uploaded = (Vec<Image>, HashMap<TextureJob, usize>, usize);
+
+/// Material `m`'s uniform block; `orm_ref` is the texture its metallic-roughness slot reads.
+fn material_uniform(m: &Material, orm_ref: Option<TextureRef>) -> MaterialUniform {
+    MaterialUniform {
+        base_color: m.base_color,
+        emissive: m.emissive.extend(m.normal_scale),
+        params: Vec4::new(
+            m.metallic,
+            m.roughness,
+            if m.occlusion_texture.is_some() {
+                m.occlusion_strength
+            } else {
+                0.0
+            },
+            m.unlit as u32 as f32,
+        ),
+        extra: match m.alpha_mode {
+            AlphaMode::Mask(c) => Vec4::new(c.max(1e-6), c.max(1e-6), 0.0, 0.0),
+            AlphaMode::Blend => Vec4::new(0.0, BLEND_SHADOW_CUTOFF, 0.0, 0.0),
+            AlphaMode::Opaque => Vec4::ZERO,
+        },
+        uv: uv_rows([
+            m.base_color_texture,
+            m.normal_texture,
+            orm_ref,
+            m.emissive_texture,
+        ]),
+    }
+}
+
+/// The uploaded textures, where each texture job landed, where the defaults start, and the
+/// scene's texture count (which texture references are valid).
+struct TextureViews<'a> {
+    scene_textures: usize,
+    textures: &'a [Image],
+    index: &'a HashMap<TextureJob, usize>,
+    defaults: usize,
+}
+
+/// Writes material `m`'s descriptor set: its uniform buffer `buf`, its four textures (a default
+/// where a slot is empty) and their samplers.
+fn write_material_set(
+    ctx: &Arc<Context>,
+    set: vk::DescriptorSet,
+    buf: &Buffer,
+    m: &Material,
+    views: &TextureViews,
+    samplers: &mut SamplerCache,
+) -> Result<(), GpuError> {
+    let (orm_ref, _) = orm_slot(m, views.scene_textures);
+    let jobs = texture_jobs(m, views.scene_textures);
+    let [base, normal, mr, emissive]: [vk::ImageView; 4] = std::array::from_fn(|k| {
+        views.textures[jobs[k].map_or(views.defaults + DEFAULT_TEXTURES[k], |j| views.index[&j])]
+            .view
+    });
+    let buf_info = [vk::DescriptorBufferInfo {
+        buffer: buf.raw,
+        offset: 0,
+        range: vk::WHOLE_SIZE,
+    }];
+    let img = |v| {
+        [vk::DescriptorImageInfo {
+            sampler: vk::Sampler::null(),
+            image_view: v,
+            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        }]
+    };
+    let (i_base, i_normal, i_mr, i_em) = (img(base), img(normal), img(mr), img(emissive));
+    let mut samp = |t: Option<TextureRef>| -> Result<_, GpuError> {
+        Ok([vk::DescriptorImageInfo {
+            sampler: samplers.get(t.map(|t| t.sampler).unwrap_or_default())?,
+            image_view: vk::ImageView::null(),
+            image_layout: vk::ImageLayout::UNDEFINED,
+        }])
+    };
+    let s_base = samp(m.base_color_texture)?;
+    let s_normal = samp(m.normal_texture)?;
+    let s_mr = samp(orm_ref)?;
+    let s_em = samp(m.emissive_texture)?;
+    let w = |b: &crate::gpu::shaders::ReflectedBinding| {
+        vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(b.binding)
+            .descriptor_type(b.descriptor_type())
+    };
+    let writes = [
+        w(&sh::MATERIAL).buffer_info(&buf_info),
+        w(&sh::BASE_COLOR_TEX).image_info(&i_base),
+        w(&sh::NORMAL_TEX).image_info(&i_normal),
+        w(&sh::METAL_ROUGH_TEX).image_info(&i_mr),
+        w(&sh::EMISSIVE_TEX).image_info(&i_em),
+        w(&sh::BASE_COLOR_SAMPLER).image_info(&s_base),
+        w(&sh::NORMAL_SAMPLER).image_info(&s_normal),
+        w(&sh::METAL_ROUGH_SAMPLER).image_info(&s_mr),
+        w(&sh::EMISSIVE_SAMPLER).image_info(&s_em),
+    ];
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+    Ok(())
 }
