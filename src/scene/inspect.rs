@@ -110,11 +110,65 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
     for w in &scene.warnings {
         findings.push(finding(w.code, w.pointer.clone(), w.message.clone()));
     }
-    let accessors = arr(&doc, "accessors");
     let glb = bytes.starts_with(b"glTF");
+    let (buffers, images) = resources(&doc, scene, glb);
+    let (used, required, supported) = extensions(&doc, &mut findings);
+    let Tree {
+        scene_index,
+        roots,
+        instances,
+        seen,
+    } = scene_tree(&doc);
+    let (node_list, cameras, lights) = tree_lists(&doc, &seen);
+    let mesh = mesh_report(&doc, &instances, &mut findings);
+    let [tris, verts, draws, r_tris, r_verts, r_draws] = mesh.totals;
+    let (material_list, texture_used, srgb) =
+        material_report(&doc, scene, &mesh.material_used, &mut findings);
+    let (texture_list, texture_bytes) =
+        texture_report(&doc, scene, (&texture_used, &srgb), &mut findings);
+    // Geometry as uploaded: 48 bytes per vertex (position, normal, uv, tangent) + 4 per index.
+    let geometry_bytes: u64 = scene
+        .meshes
+        .iter()
+        .flat_map(|m| &m.primitives)
+        .map(|p| p.positions.len() as u64 * 48 + p.indices.len() as u64 * 4)
+        .sum();
 
-    // Resources.
-    let buffers: Vec<Value> = arr(&doc, "buffers")
+    let scale = scale_report(scene);
+    let (nodes, meshes, textures_doc) = (
+        arr(&doc, "nodes"),
+        arr(&doc, "meshes"),
+        arr(&doc, "textures"),
+    );
+    let meta = std::fs::metadata(path).map_err(io)?;
+    Ok(json!({
+        "schema": SCHEMA,
+        "file": {"path": path.display().to_string(), "bytes": meta.len(), "container": if glb { "glb" } else { "gltf" }},
+        "asset": {"version": doc["asset"]["version"], "min_version": doc["asset"]["minVersion"],
+                  "generator": doc["asset"]["generator"], "copyright": doc["asset"]["copyright"]},
+        "resources": {"buffers": buffers, "images": images},
+        "extensions": {"used": used, "required": required, "supported": supported},
+        "scene_tree": {"scene": scene_index, "roots": roots, "nodes": node_list,
+                       "cameras": cameras, "lights": lights},
+        "meshes": mesh.list,
+        "materials": material_list,
+        "textures": texture_list,
+        "totals": {"triangles": tris, "vertices": verts, "draw_calls": draws,
+                   "rendered": {"triangles": r_tris, "vertices": r_verts, "draw_calls": r_draws},
+                   "meshes": meshes.len(), "materials": arr(&doc, "materials").len(),
+                   "textures": textures_doc.len(), "images": arr(&doc, "images").len(),
+                   "nodes": nodes.len(), "extensions_used": used.len(),
+                   "gpu_bytes": {"geometry": geometry_bytes, "textures": texture_bytes}},
+        "scale": scale,
+        "motion": super::anim::report::motion_report(&doc, scene),
+        "findings": findings,
+    }))
+}
+
+/// The buffers and images of `doc` (a GLB's chunk when `glb`), images with what loading made of
+/// them.
+fn resources(doc: &Value, scene: &Scene, glb: bool) -> (Vec<Value>, Vec<Value>) {
+    let buffers: Vec<Value> = arr(doc, "buffers")
         .iter()
         .enumerate()
         .map(|(i, b)| {
@@ -129,7 +183,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                    "uri": uri.filter(|u| !u.starts_with("data:"))})
         })
         .collect();
-    let images: Vec<Value> = arr(&doc, "images")
+    let images: Vec<Value> = arr(doc, "images")
         .iter()
         .enumerate()
         .map(|(i, im)| {
@@ -147,13 +201,20 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                    "loaded": tex.is_some()})
         })
         .collect();
+    (buffers, images)
+}
 
-    // Extensions.
-    let used: Vec<String> = arr(&doc, "extensionsUsed")
+/// The extensions used, required, and whether umbra supports each (a finding for each it
+/// ignores).
+fn extensions(
+    doc: &Value,
+    findings: &mut Vec<Value>,
+) -> (Vec<String>, Vec<String>, Map<String, Value>) {
+    let used: Vec<String> = arr(doc, "extensionsUsed")
         .iter()
         .filter_map(|v| v.as_str().map(String::from))
         .collect();
-    let required: Vec<String> = arr(&doc, "extensionsRequired")
+    let required: Vec<String> = arr(doc, "extensionsRequired")
         .iter()
         .filter_map(|v| v.as_str().map(String::from))
         .collect();
@@ -169,11 +230,22 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
             ));
         }
     }
+    (used, required, supported)
+}
 
-    // The scene tree: instances per mesh from the rendered scene's nodes.
-    let nodes = arr(&doc, "nodes");
+/// The default scene's roots, and walking from them which nodes are in the scene and how many
+/// instances each mesh has.
+struct Tree {
+    scene_index: usize,
+    roots: Vec<usize>,
+    instances: Vec<u64>,
+    seen: Vec<bool>,
+}
+
+fn scene_tree(doc: &Value) -> Tree {
+    let nodes = arr(doc, "nodes");
     let scene_index = doc["scene"].as_u64().unwrap_or(0) as usize;
-    let roots: Vec<usize> = match arr(&doc, "scenes").get(scene_index) {
+    let roots: Vec<usize> = match arr(doc, "scenes").get(scene_index) {
         Some(s) => arr(s, "nodes")
             .iter()
             .filter_map(|n| n.as_u64().map(|n| n as usize))
@@ -192,8 +264,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
             (0..nodes.len()).filter(|&i| !child[i]).collect()
         }
     };
-    let meshes = arr(&doc, "meshes");
-    let mut instances = vec![0u64; meshes.len()];
+    let mut instances = vec![0u64; arr(doc, "meshes").len()];
     let mut stack = roots.clone();
     let mut seen = vec![false; nodes.len()];
     while let Some(n) = stack.pop() {
@@ -212,6 +283,17 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
             }
         }
     }
+    Tree {
+        scene_index,
+        roots,
+        instances,
+        seen,
+    }
+}
+
+/// The nodes (with whether each is in the scene), cameras and lights of `doc`.
+fn tree_lists(doc: &Value, seen: &[bool]) -> (Vec<Value>, Vec<Value>, Vec<Value>) {
+    let nodes = arr(doc, "nodes");
     let node_list: Vec<Value> = nodes
         .iter()
         .enumerate()
@@ -223,7 +305,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                    "children": n["children"]})
         })
         .collect();
-    let cameras: Vec<Value> = arr(&doc, "cameras")
+    let cameras: Vec<Value> = arr(doc, "cameras")
         .iter()
         .enumerate()
         .map(|(i, c)| {
@@ -245,9 +327,22 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                    "inner_cone": l["spot"]["innerConeAngle"], "outer_cone": l["spot"]["outerConeAngle"]})
         })
         .collect();
+    (node_list, cameras, lights)
+}
 
-    // Meshes and primitives, totals the way glTF-Validator counts them (per instance).
-    let mut material_used = vec![false; arr(&doc, "materials").len()];
+/// The meshes and their primitives, with totals counted as glTF-Validator counts them and as
+/// rendered, and which materials a drawn primitive uses.
+struct MeshReport {
+    list: Vec<Value>,
+    material_used: Vec<bool>,
+    /// Triangles, vertices, draws in the file; then as rendered.
+    totals: [u64; 6],
+}
+
+fn mesh_report(doc: &Value, instances: &[u64], findings: &mut Vec<Value>) -> MeshReport {
+    let accessors = arr(doc, "accessors");
+    let meshes = arr(doc, "meshes");
+    let mut material_used = vec![false; arr(doc, "materials").len()];
     // Counted as glTF-Validator's info block counts them (every primitive of every mesh once,
     // whether or not a node uses it: what the file holds) and as rendered (triangle primitives
     // per instance in the default scene: what umbra draws).
@@ -314,9 +409,23 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                               "primitives": prims}),
         );
     }
+    MeshReport {
+        list: mesh_list,
+        material_used,
+        totals: [tris, verts, draws, r_tris, r_verts, r_draws],
+    }
+}
 
-    // Materials and textures.
-    let textures_doc = arr(&doc, "textures");
+/// The materials (their texture slots, tangents and Blinn-Phong constants), and which textures
+/// they use and which of those hold colour (sRGB).
+fn material_report(
+    doc: &Value,
+    scene: &Scene,
+    material_used: &[bool],
+    findings: &mut Vec<Value>,
+) -> (Vec<Value>, Vec<bool>, Vec<bool>) {
+    let meshes = arr(doc, "meshes");
+    let textures_doc = arr(doc, "textures");
     let mut texture_used = vec![false; textures_doc.len()];
     let slots = [
         ("baseColor", "/pbrMetallicRoughness/baseColorTexture"),
@@ -330,7 +439,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
     ];
     let mut srgb = vec![false; textures_doc.len()];
     let mut material_list = Vec::new();
-    for (i, m) in arr(&doc, "materials").iter().enumerate() {
+    for (i, m) in arr(doc, "materials").iter().enumerate() {
         if !material_used[i] {
             findings.push(finding(
                 "UNUSED_MATERIAL",
@@ -373,6 +482,18 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
             "tangents": if !normal_mapped { "not needed" } else if stored_tangents { "stored" } else { "generated (MikkTSpace)" },
             "blinn_phong": bp.map(|b| json!({"kd": b.kd.to_array(), "ks": b.ks.to_array(), "shininess": b.p}))}));
     }
+    (material_list, texture_used, srgb)
+}
+
+/// The textures with their GPU format, colour space and mip-chain bytes (the sum over used
+/// textures returned too).
+fn texture_report(
+    doc: &Value,
+    scene: &Scene,
+    (texture_used, srgb): (&[bool], &[bool]),
+    findings: &mut Vec<Value>,
+) -> (Vec<Value>, u64) {
+    let textures_doc = arr(doc, "textures");
     let mut texture_list = Vec::new();
     let mut texture_bytes = 0u64;
     for (i, t) in textures_doc.iter().enumerate() {
@@ -396,18 +517,13 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
             "format": "RGBA8", "color_space": if srgb[i] { "sRGB" } else { "linear" },
             "mip_levels": levels, "gpu_bytes": bytes}));
     }
+    (texture_list, texture_bytes)
+}
 
-    // Geometry as uploaded: 48 bytes per vertex (position, normal, uv, tangent) + 4 per index.
-    let geometry_bytes: u64 = scene
-        .meshes
-        .iter()
-        .flat_map(|m| &m.primitives)
-        .map(|p| p.positions.len() as u64 * 48 + p.indices.len() as u64 * 4)
-        .sum();
-
-    // Scale and depth precision.
+/// The scene's scale and the reversed-z depth precision at its far corner.
+fn scale_report(scene: &Scene) -> Value {
     let b = scene.bounds();
-    let scale = if b.is_empty() {
+    if b.is_empty() {
         Value::Null
     } else {
         let far = b.center().length() as f64 + b.diagonal() as f64 * 0.5;
@@ -417,30 +533,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                "distance_from_origin": b.center().length(),
                "reversed_z_relative_step_at_far_corner": relative_gap(DepthMapping::ReversedInfiniteF32, near, far.max(near)),
                "near_plane_assumed": near})
-    };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    Ok(json!({
-        "schema": SCHEMA,
-        "file": {"path": path.display().to_string(), "bytes": meta.len(), "container": if glb { "glb" } else { "gltf" }},
-        "asset": {"version": doc["asset"]["version"], "min_version": doc["asset"]["minVersion"],
-                  "generator": doc["asset"]["generator"], "copyright": doc["asset"]["copyright"]},
-        "resources": {"buffers": buffers, "images": images},
-        "extensions": {"used": used, "required": required, "supported": supported},
-        "scene_tree": {"scene": scene_index, "roots": roots, "nodes": node_list,
-                       "cameras": cameras, "lights": lights},
-        "meshes": mesh_list,
-        "materials": material_list,
-        "textures": texture_list,
-        "totals": {"triangles": tris, "vertices": verts, "draw_calls": draws,
-                   "rendered": {"triangles": r_tris, "vertices": r_verts, "draw_calls": r_draws},
-                   "meshes": meshes.len(), "materials": arr(&doc, "materials").len(),
-                   "textures": textures_doc.len(), "images": arr(&doc, "images").len(),
-                   "nodes": nodes.len(), "extensions_used": used.len(),
-                   "gpu_bytes": {"geometry": geometry_bytes, "textures": texture_bytes}},
-        "scale": scale,
-        "motion": super::anim::report::motion_report(&doc, scene),
-        "findings": findings,
-    }))
+    }
 }
 
 #[cfg(test)]
