@@ -8,6 +8,7 @@ mod gltf_input;
 pub mod gltf_load;
 mod gltf_material;
 mod gltf_nodes;
+mod gltf_primitive;
 pub mod inspect;
 pub mod load_error;
 pub mod material;
