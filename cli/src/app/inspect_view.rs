@@ -52,6 +52,23 @@ pub fn format_report(r: &Value, md: bool) -> String {
         }
     };
     let mut out = String::new();
+    out += &asset(r, md, &h);
+    out += &totals(r, md, &h);
+    out += &scale(r, md, &h);
+    out += &exposure(r, &h);
+    out += &shadow_plan(r, md, &h);
+    out += &meshes(r, md, &h);
+    out += &materials(r, md, &h);
+    out += &textures(r, md, &h);
+    out += &tree(r, md, &h);
+    out += &motion(&r["motion"], md, &h);
+    out += &findings(r, md, &h);
+    out
+}
+
+/// The file and its asset block, with the extensions used.
+fn asset(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     out += &if md {
         format!("## {}\n", cell(&r["file"]["path"]))
     } else {
@@ -86,7 +103,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
     t.row(vec!["extensions required".into(), cell(&ext["required"])]);
     out += &h("Asset");
     out += &t.render(md);
+    out
+}
 
+/// Triangles, vertices, draws and GPU bytes, in the file and as rendered.
+fn totals(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let tot = &r["totals"];
     let mut t = Table::new(&["total", "value"]);
     for k in ["triangles", "vertices", "draw_calls"] {
@@ -110,7 +132,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
     ]);
     out += &h("Totals");
     out += &t.render(md);
+    out
+}
 
+/// The scene's size and depth precision.
+fn scale(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let s = &r["scale"];
     if !s.is_null() {
         let mut t = Table::new(&["measure", "value"]);
@@ -128,7 +155,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
         out += &h("Scale");
         out += &t.render(md);
     }
+    out
+}
 
+/// The default view's metering and exposure.
+fn exposure(r: &Value, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let e = &r["exposure"];
     if !e.is_null() {
         out += &h("Exposure (default view)");
@@ -142,7 +174,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
             cell(&e["tonemap"])
         );
     }
+    out
+}
 
+/// The default view's shadow plan: the light, the map and each view.
+fn shadow_plan(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let p = &r["shadow_plan"];
     out += &h("Shadow plan (default view)");
     if p["light"].is_null() {
@@ -179,7 +216,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
         }
         out += &t.render(md);
     }
+    out
+}
 
+/// One row per primitive.
+fn meshes(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let mut t = Table::new(&[
         "mesh",
         "name",
@@ -210,7 +252,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
     }
     out += &h("Meshes");
     out += &t.render(md);
+    out
+}
 
+/// One row per material, as Blinn-Phong.
+fn materials(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let mut t = Table::new(&[
         "material",
         "name",
@@ -266,7 +313,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
     }
     out += &h("Materials (as Blinn-Phong)");
     out += &t.render(md);
+    out
+}
 
+/// One row per texture.
+fn textures(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let mut t = Table::new(&["texture", "image", "size", "colour space", "mips", "GPU"]);
     for x in arr(&r["textures"]) {
         t.row(vec![
@@ -280,7 +332,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
     }
     out += &h("Textures");
     out += &t.render(md);
+    out
+}
 
+/// The node tree (the first 40 nodes), cameras and lights.
+fn tree(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let st = &r["scene_tree"];
     let nodes = arr(&st["nodes"]);
     let mut t = Table::new(&[
@@ -340,9 +397,12 @@ pub fn format_report(r: &Value, md: bool) -> String {
         out += &h("Cameras and lights");
         out += &t.render(md);
     }
+    out
+}
 
-    out += &motion(&r["motion"], md, &h);
-
+/// Every finding.
+fn findings(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
     let f = arr(&r["findings"]);
     out += &h(&format!("Findings ({})", f.len()));
     if f.is_empty() {
