@@ -463,20 +463,98 @@ pub struct PlanTarget {
 
 /// Plans a frame for `view` of `scene` rendered into `target`: pure, no GPU.
 pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FramePlan {
-    let PlanScene {
-        lights: scene_lights,
-        bounds,
-        receivers,
-    } = *scene;
     let PlanTarget {
         aspect, hw_compare, ..
     } = *target;
-    let lights = effective_lights(scene_lights, view);
+    let bounds = scene.bounds;
+    let lights = effective_lights(scene.lights, view);
     let fit_camera = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
     let proj = camera_projection(&view.camera, aspect);
     let clip_from_world = proj * view.camera.view_from_world();
     let size = view.shadow.map_size.max(1);
-    // Every shadow-casting light gets its views, in light order, while the frame's views last.
+    let (views, unshadowed) = shadow_views(&lights, scene, view, target);
+    let has_views = |i: usize| views.iter().any(|v| v.light == i);
+    let shadow_light = view
+        .shown_light
+        .filter(|&i| has_views(i))
+        .or_else(|| views.first().map(|v| v.light));
+    let shadows_on = view.shadow.enabled && shadow_light.is_some();
+    let (ambient, metered_lux, exposure) = metering(&lights, scene, view);
+    let u = FrameUniform {
+        clip_from_world,
+        world_from_clip: clip_from_world.as_dmat4().inverse().as_mat4(),
+        camera_position: view.camera.position().extend(1.0),
+        ambient: ambient.extend(0.0),
+        shadow: Vec4::new(
+            size as f32,
+            view.shadow.normal_offset,
+            far_view_depth(&view.camera, bounds),
+            if shadows_on { 1.0 } else { 0.0 },
+        ),
+        // No shown light: an index the shader's light loop never reaches. xyz: the eye the
+        // cascades were split from (the fitting camera, which is the view's unless a test or
+        // the stability suite fits the shadows to another camera).
+        shadow_light: fit_camera
+            .position()
+            .extend(shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32)),
+        bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
+        camera_forward: (fit_camera
+            .view_from_world()
+            .inverse()
+            .transform_vector3(Vec3::NEG_Z))
+        .normalize_or(Vec3::NEG_Z)
+        .extend(0.0),
+        modes: [
+            view.mode.shader_value(),
+            view.shadow.pcf.taps(),
+            hw_compare as u32,
+            lights.len() as u32,
+        ],
+        output: Vec4::new(exposure, view.tonemap.shader_value(), 0.0, 0.0),
+        lights: light_uniforms(&lights, &views, view),
+        views: view_uniforms(&views),
+    };
+    // Soft where a shadowed light's uniform carries a size (set above).
+    let soft = shadows_on && u.lights.iter().any(|l| l.direction.w > 0.0);
+    FramePlan {
+        uniform: u,
+        shadows_on,
+        soft,
+        shadow_map_size: size,
+        camera_position: view.camera.position(),
+        shader_variant: frame_variant_bits(
+            lights.len(),
+            shadows_on,
+            hw_compare,
+            view.shadow.pcf,
+            views.len(),
+            soft,
+        ),
+        lights,
+        shadow_light,
+        shadow_views: views,
+        unshadowed,
+        clip_from_world,
+        casters: Vec::new(),
+        origin: Vec3::ZERO,
+        exposure,
+        tonemap: view.tonemap,
+        ambient,
+        metered_lux,
+    }
+}
+
+/// The shadow views of every shadow-casting light, in light order, while the frame's views
+/// last, and the lights left without (their views did not fit).
+fn shadow_views(
+    lights: &[Light],
+    scene: &PlanScene,
+    view: &View,
+    target: &PlanTarget,
+) -> (Vec<ShadowView>, Vec<usize>) {
+    let bounds = scene.bounds;
+    let fit_camera = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
+    let size = view.shadow.map_size.max(1);
     let mut views: Vec<ShadowView> = Vec::new();
     let mut unshadowed = Vec::new();
     let any_soft = view.shadow.soft && lights.iter().any(|l| l.casts_shadows && soft_size(l) > 0.0);
@@ -530,14 +608,14 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         }
         views.extend(own);
     }
-    let has_views = |i: usize| views.iter().any(|v| v.light == i);
-    let shadow_light = view
-        .shown_light
-        .filter(|&i| has_views(i))
-        .or_else(|| views.first().map(|v| v.light));
-    let shadows_on = view.shadow.enabled && shadow_light.is_some();
-    // Metered once: the default ambient follows the direct part, auto exposure the sum.
-    let direct = metered_illuminance(&lights, Vec3::ZERO, receivers, bounds);
+    (views, unshadowed)
+}
+
+/// The ambient Ia (the view's, else a share of the metered direct light), the metered
+/// illuminance, and the exposure scale. Metered once: the default ambient follows the direct
+/// part, auto exposure the sum.
+fn metering(lights: &[Light], scene: &PlanScene, view: &View) -> (Vec3, f32, f32) {
+    let direct = metered_illuminance(lights, Vec3::ZERO, scene.receivers, scene.bounds);
     let ambient = view.ambient.unwrap_or_else(|| {
         Vec3::splat(if direct.is_finite() && direct > 0.0 {
             AUTO_AMBIENT * direct
@@ -548,52 +626,35 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
     let metered_lux = direct + luminance(ambient.max(Vec3::ZERO));
     let exposure = exposure_scale(view.exposure, metered_lux)
         * view.exposure_compensation.clamp(-64.0, 64.0).exp2();
-    let mut u = FrameUniform {
-        clip_from_world,
-        world_from_clip: clip_from_world.as_dmat4().inverse().as_mat4(),
-        camera_position: view.camera.position().extend(1.0),
-        ambient: ambient.extend(0.0),
-        shadow: Vec4::new(
-            size as f32,
-            view.shadow.normal_offset,
-            far_view_depth(&view.camera, bounds),
-            if shadows_on { 1.0 } else { 0.0 },
-        ),
-        // No shown light: an index the shader's light loop never reaches. xyz: the eye the
-        // cascades were split from (the fitting camera, which is the view's unless a test or
-        // the stability suite fits the shadows to another camera).
-        shadow_light: fit_camera
-            .position()
-            .extend(shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32)),
-        bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
-        camera_forward: (fit_camera
-            .view_from_world()
-            .inverse()
-            .transform_vector3(Vec3::NEG_Z))
-        .normalize_or(Vec3::NEG_Z)
-        .extend(0.0),
-        modes: [
-            view.mode.shader_value(),
-            view.shadow.pcf.taps(),
-            hw_compare as u32,
-            lights.len() as u32,
-        ],
-        output: Vec4::new(exposure, view.tonemap.shader_value(), 0.0, 0.0),
-        lights: [LightUniform::default(); MAX_LIGHTS],
-        // Set per view below (rectangles with the casters, `shadow_pass::plan_casters`; until
-        // then every lookup is lit); slots past the views are never read.
-        views: [ShadowViewUniform::default(); MAX_SHADOW_VIEWS],
-    };
+    (ambient, metered_lux, exposure)
+}
+
+/// Each shadow view's uniform: its matrix and cascade range; the rectangle with the casters is
+/// set when the casters are planned (until then every lookup is lit). Slots past the views are
+/// never read.
+fn view_uniforms(views: &[ShadowView]) -> [ShadowViewUniform; MAX_SHADOW_VIEWS] {
+    let mut u = [ShadowViewUniform::default(); MAX_SHADOW_VIEWS];
     for (c, v) in views.iter().enumerate() {
         // f32::MAX rather than infinity: the shader compares and subtracts these.
-        u.views[c].clip = v.light_clip_from_world;
-        u.views[c].cascade = Vec4::new(
+        u[c].clip = v.light_clip_from_world;
+        u[c].cascade = Vec4::new(
             v.far.min(f32::MAX),
             v.blend.min(f32::MAX),
             v.texel_world,
             v.res as f32,
         );
     }
+    u
+}
+
+/// Each light's uniform: kind, position, direction with its soft-shadow size, colour, cone and
+/// range, and its shadow views.
+fn light_uniforms(
+    lights: &[Light],
+    views: &[ShadowView],
+    view: &View,
+) -> [LightUniform; MAX_LIGHTS] {
+    let mut u = [LightUniform::default(); MAX_LIGHTS];
     for (i, l) in lights.iter().enumerate() {
         let (kind, cone) = match l.kind {
             LightKind::Directional => (sh::LIGHT_DIRECTIONAL, Vec4::ZERO),
@@ -613,7 +674,7 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
             0.0
         };
         let count = views.iter().filter(|v| v.light == i).count();
-        u.lights[i] = LightUniform {
+        u[i] = LightUniform {
             position: l.position.extend(kind),
             direction: l.direction.normalize_or(Vec3::NEG_Y).extend(soft),
             color: (l.color * l.intensity).extend(0.0),
@@ -621,34 +682,7 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
             shadow: Vec4::new(first.map_or(-1.0, |f| f as f32), count as f32, 0.0, 0.0),
         };
     }
-    // Soft where a shadowed light's uniform carries a size (set above).
-    let soft = shadows_on && u.lights.iter().any(|l| l.direction.w > 0.0);
-    FramePlan {
-        uniform: u,
-        shadows_on,
-        soft,
-        shadow_map_size: size,
-        camera_position: view.camera.position(),
-        shader_variant: frame_variant_bits(
-            lights.len(),
-            shadows_on,
-            hw_compare,
-            view.shadow.pcf,
-            views.len(),
-            soft,
-        ),
-        lights,
-        shadow_light,
-        shadow_views: views,
-        unshadowed,
-        clip_from_world,
-        casters: Vec::new(),
-        origin: Vec3::ZERO,
-        exposure,
-        tonemap: view.tonemap,
-        ambient,
-        metered_lux,
-    }
+    u
 }
 
 /// The illuminance (lux, as luminance) that auto exposure meters: the median, over the
