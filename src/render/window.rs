@@ -211,77 +211,32 @@ impl WindowRenderer {
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
         let f = self.frame;
-        let sync = &self.frames[f];
-        unsafe { d.wait_for_fences(&[sync.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        let (fence, acquired, cmd) = {
+            let sync = &self.frames[f];
+            (sync.fence, sync.acquired, sync.cmd)
+        };
+        unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")?;
         if let Some(t) = self.core.gpu_times(f) {
             self.last_gpu = Some(t);
         }
-        let slot = &mut self.depth_reads[f];
-        if let (Some(buf), Some((proj, n))) = (slot.0.as_mut(), slot.1.take()) {
-            if let Some(bytes) = buf.mapped() {
-                self.seen_depths =
-                    visible_depths(bytemuck::cast_slice::<u8, f32>(&bytes[..n * 4]), &proj);
-            }
-        }
-        let fit = view.shadow.depth_fit
-            && view.shadow.enabled
-            && view.visible_depths.is_none()
-            && view.shadow_fit_camera.is_none();
-        let extent = self.swapchain.extent;
-        // A camera in motion holds the previous frame's shadow extents (less shimmer); one that
-        // stands still for a frame is fitted afresh, as a still is.
-        let shot = (view.camera, extent.width, extent.height);
-        let moving = self.last_shot.is_some_and(|last| last != shot);
-        self.last_shot = Some(shot);
-        let mut v = view.clone();
-        if fit {
-            v.visible_depths = self.seen_depths;
-        }
-        if moving && v.shadow_hold.is_none() {
-            v.shadow_hold = self.held.take();
-        }
+        let (v, fit) = self.frame_view(view, f);
         let view = &v;
+        let extent = self.swapchain.extent;
         if extent.width == 0 || extent.height == 0 || self.swapchain.raw == vk::SwapchainKHR::null()
         {
             return Ok(DrawResult::Skipped);
         }
-        let Some((index, _suboptimal)) = self.swapchain.acquire(sync.acquired)? else {
+        let Some((index, _suboptimal)) = self.swapchain.acquire(acquired)? else {
             let (w, h) = self.wanted;
             self.resize(w, h)?;
             return Ok(DrawResult::Skipped);
         };
-        unsafe { d.reset_fences(&[sync.fence]) }.vk("vkResetFences")?;
+        unsafe { d.reset_fences(&[fence]) }.vk("vkResetFences")?;
         let prepared = self.core.prepare(f, view, extent.width, extent.height)?;
         self.held = Some(ShadowHold::from_plan(&prepared.plan));
         let pixels = extent.width as usize * extent.height as usize;
-        if fit
-            && self.depth_reads[f]
-                .0
-                .as_ref()
-                .is_none_or(|b| b.size < pixels as u64 * 4)
-        {
-            self.depth_reads[f].0 = Some(Buffer::new(
-                &ctx,
-                "depth readback",
-                pixels as u64 * 4,
-                vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuToCpu,
-            )?);
-        }
         let want_copy = screenshot && self.swapchain.can_copy;
-        if want_copy {
-            let need = extent.width as u64 * extent.height as u64 * 4;
-            if self.screenshot.as_ref().is_none_or(|b| b.size < need) {
-                self.screenshot = Some(Buffer::new(
-                    &ctx,
-                    "screenshot readback",
-                    need,
-                    vk::BufferUsageFlags::TRANSFER_DST,
-                    MemoryLocation::GpuToCpu,
-                )?);
-            }
-        }
-        let cmd = sync.cmd;
+        self.ensure_readbacks(f, fit, want_copy)?;
         let (_, depth) = self.depth.as_mut().expect("depth exists with a swapchain");
         let mut color = Attachment {
             image: self.swapchain.images[index as usize],
@@ -334,35 +289,12 @@ impl WindowRenderer {
             transfer_to_host_barrier(d, cmd);
         }
         color.transition(d, cmd, Access::Present);
-        unsafe {
-            d.end_command_buffer(cmd).vk("vkEndCommandBuffer")?;
-            let waits = [vk::SemaphoreSubmitInfo::default()
-                .semaphore(sync.acquired)
-                // The same stage the acquired image's first barrier waits at (barrier table).
-                .stage_mask(access_info(Access::Acquired).0)];
-            let signals = [vk::SemaphoreSubmitInfo::default()
-                .semaphore(self.swapchain.render_finished[index as usize])
-                .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let submit = [vk::SubmitInfo2::default()
-                .wait_semaphore_infos(&waits)
-                .command_buffer_infos(&cmds)
-                .signal_semaphore_infos(&signals)];
-            d.queue_submit2(ctx.queue, &submit, sync.fence)
-                .vk("vkQueueSubmit2")?;
-        }
+        self.submit(cmd, acquired, fence, index)?;
         let stale = self.swapchain.present(index)?;
         self.frame = (f + 1) % FRAMES_IN_FLIGHT;
         let mut shot = None;
         if want_copy {
-            unsafe { d.wait_for_fences(&[self.frames[f].fence], true, u64::MAX) }
-                .vk("vkWaitForFences")?;
-            let bgra = self.swapchain.format == vk::Format::B8G8R8A8_SRGB;
-            let buf = self.screenshot.as_mut().expect("buffer");
-            let bytes = buf
-                .mapped()
-                .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
-            shot = Some(rgba_from_readback(bytes, extent.width, extent.height, bgra));
+            shot = Some(self.read_screenshot(fence, extent)?);
         } else if screenshot {
             log::warn!(
                 "this swapchain cannot be copied from (no TRANSFER_SRC usage); no screenshot"
@@ -376,6 +308,119 @@ impl WindowRenderer {
             casters,
             screenshot: shot,
         })
+    }
+
+    /// The view this frame draws: with a depth fit, the depths the latest completed frame read
+    /// back; for a camera in motion, the previous frame's shadow extents held. Also whether this
+    /// frame reads its depth back (`ShadowSettings::depth_fit`).
+    fn frame_view(&mut self, view: &View, f: usize) -> (View, bool) {
+        let slot = &mut self.depth_reads[f];
+        if let (Some(buf), Some((proj, n))) = (slot.0.as_mut(), slot.1.take()) {
+            if let Some(bytes) = buf.mapped() {
+                self.seen_depths =
+                    visible_depths(bytemuck::cast_slice::<u8, f32>(&bytes[..n * 4]), &proj);
+            }
+        }
+        let fit = view.shadow.depth_fit
+            && view.shadow.enabled
+            && view.visible_depths.is_none()
+            && view.shadow_fit_camera.is_none();
+        let extent = self.swapchain.extent;
+        // A camera in motion holds the previous frame's shadow extents (less shimmer); one that
+        // stands still for a frame is fitted afresh, as a still is.
+        let shot = (view.camera, extent.width, extent.height);
+        let moving = self.last_shot.is_some_and(|last| last != shot);
+        self.last_shot = Some(shot);
+        let mut v = view.clone();
+        if fit {
+            v.visible_depths = self.seen_depths;
+        }
+        if moving && v.shadow_hold.is_none() {
+            v.shadow_hold = self.held.take();
+        }
+        (v, fit)
+    }
+
+    /// Makes frame slot `f`'s depth readback (with `fit`) and the screenshot buffer (with
+    /// `want_copy`) large enough for the swapchain.
+    fn ensure_readbacks(&mut self, f: usize, fit: bool, want_copy: bool) -> Result<(), GpuError> {
+        let ctx = self.core.ctx.clone();
+        let extent = self.swapchain.extent;
+        let pixels = extent.width as usize * extent.height as usize;
+        if fit
+            && self.depth_reads[f]
+                .0
+                .as_ref()
+                .is_none_or(|b| b.size < pixels as u64 * 4)
+        {
+            self.depth_reads[f].0 = Some(Buffer::new(
+                &ctx,
+                "depth readback",
+                pixels as u64 * 4,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?);
+        }
+        if want_copy {
+            let need = extent.width as u64 * extent.height as u64 * 4;
+            if self.screenshot.as_ref().is_none_or(|b| b.size < need) {
+                self.screenshot = Some(Buffer::new(
+                    &ctx,
+                    "screenshot readback",
+                    need,
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuToCpu,
+                )?);
+            }
+        }
+        Ok(())
+    }
+
+    /// Submits `cmd`, waiting for `acquired` and signalling the image's render-finished
+    /// semaphore and `fence`.
+    fn submit(
+        &self,
+        cmd: vk::CommandBuffer,
+        acquired: vk::Semaphore,
+        fence: vk::Fence,
+        index: u32,
+    ) -> Result<(), GpuError> {
+        let ctx = &self.core.ctx;
+        let d = &ctx.device;
+        unsafe {
+            d.end_command_buffer(cmd).vk("vkEndCommandBuffer")?;
+            let waits = [vk::SemaphoreSubmitInfo::default()
+                .semaphore(acquired)
+                // The same stage the acquired image's first barrier waits at (barrier table).
+                .stage_mask(access_info(Access::Acquired).0)];
+            let signals = [vk::SemaphoreSubmitInfo::default()
+                .semaphore(self.swapchain.render_finished[index as usize])
+                .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = [vk::SubmitInfo2::default()
+                .wait_semaphore_infos(&waits)
+                .command_buffer_infos(&cmds)
+                .signal_semaphore_infos(&signals)];
+            d.queue_submit2(ctx.queue, &submit, fence)
+                .vk("vkQueueSubmit2")?;
+        }
+        Ok(())
+    }
+
+    /// The screenshot the frame guarded by `fence` copied, as RGBA.
+    fn read_screenshot(
+        &mut self,
+        fence: vk::Fence,
+        extent: vk::Extent2D,
+    ) -> Result<image::RgbaImage, GpuError> {
+        let d = &self.core.ctx.device;
+        unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        let bgra = self.swapchain.format == vk::Format::B8G8R8A8_SRGB;
+        let buf = self.screenshot.as_mut().expect("buffer");
+        let bytes = buf
+            .mapped()
+            .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
+        Ok(rgba_from_readback(bytes, extent.width, extent.height, bgra))
     }
 }
 
