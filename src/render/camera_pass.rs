@@ -407,67 +407,9 @@ impl CameraPass {
                 self.record_resolve(cmd, scene, &plan, cull.frame_bits, extent);
             }
             if !plan.forward.is_empty() {
-                bind_geometry(d, cmd, scene);
-                let mut bound_material = usize::MAX;
-                let mut bound_pipeline = vk::Pipeline::null();
-                for dr in plan.forward {
-                    let entry = Entry::of(dr.alpha, cull.debug_view);
-                    let bits = dr.material_bits | cull.frame_bits;
-                    let split = cull.shadow_reach.as_ref().map_or(Split::Shadowed, |r| {
-                        receivers::split(r, dr, &cull.clip_from_world, extent)
-                    });
-                    unshadowed += usize::from(split != Split::Shadowed);
-                    // (variant, scissor) of each piece; None: the whole image.
-                    let pieces: Vec<(usize, Option<vk::Rect2D>)> = match split {
-                        Split::Shadowed => vec![(bits, None)],
-                        Split::Unshadowed => vec![(receivers::unshadowed(bits), None)],
-                        Split::Both { inside, outside } => std::iter::once((bits, Some(inside)))
-                            .chain(
-                                outside
-                                    .into_iter()
-                                    .map(|r| (receivers::unshadowed(bits), Some(r))),
-                            )
-                            .collect(),
-                    };
-                    drawn += 1;
-                    if dr.material != bound_material {
-                        d.cmd_bind_descriptor_sets(
-                            cmd,
-                            vk::PipelineBindPoint::GRAPHICS,
-                            self.layout,
-                            1,
-                            &[scene.material_sets[dr.material]],
-                            &[],
-                        );
-                        bound_material = dr.material;
-                    }
-                    let mut imm = dr.immediates;
-                    if cull.highlight == Some(dr.source) {
-                        imm.normal_y.w = 1.0;
-                    }
-                    for &(variant, scissor) in &pieces {
-                        // Created by `ensure_pipelines` for this frame's bits.
-                        let pipeline = self.pipelines[&(variant, entry)];
-                        if pipeline != bound_pipeline {
-                            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                            bound_pipeline = pipeline;
-                        }
-                        if let Some(s) = scissor {
-                            d.cmd_set_scissor(cmd, 0, &[s]);
-                        }
-                        scene.record_draw(
-                            cmd,
-                            self.layout,
-                            dr,
-                            Some(cull.eye),
-                            Viewpoint::Eye(cull.eye.0),
-                            bytemuck::bytes_of(&imm),
-                        );
-                    }
-                    if pieces.iter().any(|p| p.1.is_some()) {
-                        d.cmd_set_scissor(cmd, 0, &[full_rect(extent)]);
-                    }
-                }
+                let (n, u) = self.record_forward(cmd, scene, &plan.forward, cull, extent);
+                drawn += n;
+                unshadowed += u;
             }
             d.cmd_end_rendering(cmd);
         }
@@ -477,6 +419,74 @@ impl CameraPass {
             deferred: deferred_draws,
             unshadowed,
         }
+    }
+
+    /// Records the forward draws of the frame, splitting each into its shadowed and unshadowed
+    /// pieces (`receivers::split`). Returns the draws recorded and how many of them were drawn (in
+    /// part) without the shadow lookup.
+    fn record_forward(
+        &self,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        forward: &[&Draw],
+        cull: &CameraCull,
+        extent: vk::Extent2D,
+    ) -> (usize, usize) {
+        let d = &self.ctx.device;
+        let (mut drawn, mut unshadowed) = (0, 0);
+        unsafe {
+            bind_geometry(d, cmd, scene);
+            let mut bound_material = usize::MAX;
+            let mut bound_pipeline = vk::Pipeline::null();
+            for &dr in forward {
+                let entry = Entry::of(dr.alpha, cull.debug_view);
+                let bits = dr.material_bits | cull.frame_bits;
+                let split = cull.shadow_reach.as_ref().map_or(Split::Shadowed, |r| {
+                    receivers::split(r, dr, &cull.clip_from_world, extent)
+                });
+                unshadowed += usize::from(split != Split::Shadowed);
+                let pieces = pieces(bits, split);
+                drawn += 1;
+                if dr.material != bound_material {
+                    d.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        self.layout,
+                        1,
+                        &[scene.material_sets[dr.material]],
+                        &[],
+                    );
+                    bound_material = dr.material;
+                }
+                let mut imm = dr.immediates;
+                if cull.highlight == Some(dr.source) {
+                    imm.normal_y.w = 1.0;
+                }
+                for &(variant, scissor) in &pieces {
+                    // Created by `ensure_pipelines` for this frame's bits.
+                    let pipeline = self.pipelines[&(variant, entry)];
+                    if pipeline != bound_pipeline {
+                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                        bound_pipeline = pipeline;
+                    }
+                    if let Some(s) = scissor {
+                        d.cmd_set_scissor(cmd, 0, &[s]);
+                    }
+                    scene.record_draw(
+                        cmd,
+                        self.layout,
+                        dr,
+                        Some(cull.eye),
+                        Viewpoint::Eye(cull.eye.0),
+                        bytemuck::bytes_of(&imm),
+                    );
+                }
+                if pieces.iter().any(|p| p.1.is_some()) {
+                    d.cmd_set_scissor(cmd, 0, &[full_rect(extent)]);
+                }
+            }
+        }
+        (drawn, unshadowed)
     }
 
     /// Records the G-buffer pass of `plan`'s deferred draws (clearing depth and stencil, each
@@ -804,5 +814,21 @@ impl Drop for CameraPass {
             d.destroy_sampler(self.linear_sampler, None);
             d.destroy_sampler(self.nearest_sampler, None);
         }
+    }
+}
+
+/// The (variant, scissor) of each piece a draw of variant `bits` is drawn in (`None`: the whole
+/// image): the unshadowed variant where `split` says the lookup cannot shadow anything.
+fn pieces(bits: usize, split: Split) -> Vec<(usize, Option<vk::Rect2D>)> {
+    match split {
+        Split::Shadowed => vec![(bits, None)],
+        Split::Unshadowed => vec![(receivers::unshadowed(bits), None)],
+        Split::Both { inside, outside } => std::iter::once((bits, Some(inside)))
+            .chain(
+                outside
+                    .into_iter()
+                    .map(|r| (receivers::unshadowed(bits), Some(r))),
+            )
+            .collect(),
     }
 }
