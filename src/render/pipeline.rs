@@ -92,56 +92,8 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .line_width(1.0);
     let multisample = vk::PipelineMultisampleStateCreateInfo::default()
         .rasterization_samples(vk::SampleCountFlags::from_raw(d.samples.max(1)));
-    let mut depth = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(d.depth_test)
-        .depth_write_enable(d.depth_test && d.blend != ColorBlend::Over)
-        .depth_compare_op(vk::CompareOp::GREATER);
-    let stencil_op = |compare, pass, write_mask| vk::StencilOpState {
-        fail_op: vk::StencilOp::KEEP,
-        pass_op: pass,
-        depth_fail_op: vk::StencilOp::KEEP,
-        compare_op: compare,
-        compare_mask: 0xff,
-        write_mask,
-        reference: 0,
-    };
-    let stencil = match d.stencil {
-        Stencil::Off => None,
-        Stencil::Mark => Some(stencil_op(
-            vk::CompareOp::ALWAYS,
-            vk::StencilOp::REPLACE,
-            0xff,
-        )),
-        Stencil::Equal => Some(stencil_op(vk::CompareOp::EQUAL, vk::StencilOp::KEEP, 0)),
-    };
-    if let Some(op) = stencil {
-        depth = depth.stencil_test_enable(true).front(op).back(op);
-    }
-    let mut blend_attachment = vk::PipelineColorBlendAttachmentState::default()
-        .color_write_mask(vk::ColorComponentFlags::RGBA);
-    let factors = match d.blend {
-        ColorBlend::Off => None,
-        ColorBlend::Additive => Some((vk::BlendFactor::ONE, vk::BlendFactor::ONE)),
-        ColorBlend::Over => Some((
-            vk::BlendFactor::SRC_ALPHA,
-            vk::BlendFactor::ONE_MINUS_SRC_ALPHA,
-        )),
-    };
-    if let Some((src, dst)) = factors {
-        // The target's alpha stays opaque (1 from the clear; ONE, ONE_MINUS_SRC_ALPHA keeps it).
-        blend_attachment = blend_attachment
-            .blend_enable(true)
-            .src_color_blend_factor(src)
-            .dst_color_blend_factor(dst)
-            .color_blend_op(vk::BlendOp::ADD)
-            .src_alpha_blend_factor(vk::BlendFactor::ONE)
-            .dst_alpha_blend_factor(if d.blend == ColorBlend::Over {
-                vk::BlendFactor::ONE_MINUS_SRC_ALPHA
-            } else {
-                vk::BlendFactor::ZERO
-            })
-            .alpha_blend_op(vk::BlendOp::ADD);
-    }
+    let depth = depth_stencil_state(d);
+    let blend_attachment = blend_attachment_state(d);
     let blend_attachments = vec![blend_attachment; d.color_formats.len()];
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
     let mut dyn_states = vec![
@@ -185,6 +137,66 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
     })?[0];
     ctx.set_name(p, d.name);
     Ok(p)
+}
+
+/// Reversed-z depth (GREATER; no writes from blended draws) and the stencil test of `d.stencil`.
+fn depth_stencil_state(d: &PipelineDesc) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
+    let mut depth = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(d.depth_test)
+        .depth_write_enable(d.depth_test && d.blend != ColorBlend::Over)
+        .depth_compare_op(vk::CompareOp::GREATER);
+    let stencil_op = |compare, pass, write_mask| vk::StencilOpState {
+        fail_op: vk::StencilOp::KEEP,
+        pass_op: pass,
+        depth_fail_op: vk::StencilOp::KEEP,
+        compare_op: compare,
+        compare_mask: 0xff,
+        write_mask,
+        reference: 0,
+    };
+    let stencil = match d.stencil {
+        Stencil::Off => None,
+        Stencil::Mark => Some(stencil_op(
+            vk::CompareOp::ALWAYS,
+            vk::StencilOp::REPLACE,
+            0xff,
+        )),
+        Stencil::Equal => Some(stencil_op(vk::CompareOp::EQUAL, vk::StencilOp::KEEP, 0)),
+    };
+    if let Some(op) = stencil {
+        depth = depth.stencil_test_enable(true).front(op).back(op);
+    }
+    depth
+}
+
+/// The colour blend of `d.blend`: off, additive, or over (source alpha), the target's alpha kept.
+fn blend_attachment_state(d: &PipelineDesc) -> vk::PipelineColorBlendAttachmentState {
+    let mut blend_attachment = vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA);
+    let factors = match d.blend {
+        ColorBlend::Off => None,
+        ColorBlend::Additive => Some((vk::BlendFactor::ONE, vk::BlendFactor::ONE)),
+        ColorBlend::Over => Some((
+            vk::BlendFactor::SRC_ALPHA,
+            vk::BlendFactor::ONE_MINUS_SRC_ALPHA,
+        )),
+    };
+    if let Some((src, dst)) = factors {
+        // The target's alpha stays opaque (1 from the clear; ONE, ONE_MINUS_SRC_ALPHA keeps it).
+        blend_attachment = blend_attachment
+            .blend_enable(true)
+            .src_color_blend_factor(src)
+            .dst_color_blend_factor(dst)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(if d.blend == ColorBlend::Over {
+                vk::BlendFactor::ONE_MINUS_SRC_ALPHA
+            } else {
+                vk::BlendFactor::ZERO
+            })
+            .alpha_blend_op(vk::BlendOp::ADD);
+    }
+    blend_attachment
 }
 
 /// Creates a pipeline layout with set layouts and one immediate (push-constant) range.
