@@ -299,6 +299,16 @@ fn at_defaults(r: &StabilityReport) -> impl Iterator<Item = &AngleRow> {
 /// Judges the report against the issue's thresholds.
 pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
     let mut v = Vec::new();
+    acne_verdicts(r, &mut v);
+    contact_verdicts(r, &mut v);
+    motion_verdicts(r, &mut v);
+    precision_verdicts(r, &mut v);
+    degenerate_verdicts(r, &mut v);
+    v
+}
+
+/// No acne on planar and curved receivers at the defaults.
+fn acne_verdicts(r: &StabilityReport, v: &mut Vec<Verdict>) {
     let worst = |from: f32, curved: bool| {
         at_defaults(r)
             .filter(|a| a.elevation_deg >= from)
@@ -338,6 +348,10 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
             pass: (judged > 0).then(|| w.is_none_or(|x| x.0 == 0)),
         });
     }
+}
+
+/// The contact gap at the thin wall's base.
+fn contact_verdicts(r: &StabilityReport, v: &mut Vec<Verdict>) {
     let gaps: Vec<&ContactRow> = r
         .contact
         .iter()
@@ -362,6 +376,10 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
             pass: Some(worst.is_some_and(|(g, _)| g <= CONTACT_BOUND_TEXELS)),
         });
     }
+}
+
+/// Shimmer and flicker for a camera and casters in motion.
+fn motion_verdicts(r: &StabilityReport, v: &mut Vec<Verdict>) {
     // Judged: what a camera in motion gets (held across frames, as the viewer renders); the
     // fits made afresh every frame are reported beside them.
     let judged: Vec<&ShimmerSeries> = r.shimmer.iter().filter(|s| s.snapped && s.held).collect();
@@ -412,6 +430,10 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
             });
         }
     }
+}
+
+/// Far from the origin as near it.
+fn precision_verdicts(r: &StabilityReport, v: &mut Vec<Verdict>) {
     if let (Some(o), Some(far)) = (
         r.precision.first(),
         r.precision
@@ -445,6 +467,10 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
             pass: Some(far.ratio_to_origin <= FAR_RATIO_BOUND),
         });
     }
+}
+
+/// Degenerate views and input.
+fn degenerate_verdicts(r: &StabilityReport, v: &mut Vec<Verdict>) {
     let failed: Vec<&str> = r
         .degenerate
         .iter()
@@ -466,7 +492,6 @@ pub fn verdicts(r: &StabilityReport) -> Vec<Verdict> {
         },
         pass: Some(failed.is_empty()),
     });
-    v
 }
 
 /// Writes `stability.json`, the charts (`light-angle`, `bias`, `shimmer`, `motion`, `precision`, as SVG and
@@ -535,8 +560,20 @@ fn worst_by_elevation(r: &StabilityReport, f: impl Fn(&AngleRow) -> f64) -> Vec<
 
 /// The charts, by file stem.
 pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
-    const FLOOR: f64 = 1e-6;
     let mut out = Vec::new();
+    light_angle_chart(r, &mut out);
+    bias_chart(r, &mut out);
+    shimmer_chart(r, &mut out);
+    motion_chart(r, &mut out);
+    precision_charts(r, &mut out);
+    out
+}
+
+/// Where log charts draw 0.
+const FLOOR: f64 = 1e-6;
+
+/// Errors against sun elevation.
+fn light_angle_chart(r: &StabilityReport, out: &mut Vec<(&'static str, LineChart)>) {
     let series = |label: &str, f: &dyn Fn(&AngleRow) -> f64| Series {
         label: label.into(),
         points: worst_by_elevation(r, f),
@@ -562,6 +599,10 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
             marks: Vec::new(),
         },
     ));
+}
+
+/// Acne against peter-panning across the bias.
+fn bias_chart(r: &StabilityReport, out: &mut Vec<(&'static str, LineChart)>) {
     let (bias_elevations, _) = super::light::bias_sweep(r.quick);
     let mut bias = Vec::new();
     let mut marks = Vec::new();
@@ -606,6 +647,10 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
             marks,
         },
     ));
+}
+
+/// Shimmer along the flythrough.
+fn shimmer_chart(r: &StabilityReport, out: &mut Vec<(&'static str, LineChart)>) {
     out.push((
         "shimmer",
         LineChart {
@@ -629,6 +674,10 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
             marks: Vec::new(),
         },
     ));
+}
+
+/// Flicker in motion, per probe.
+fn motion_chart(r: &StabilityReport, out: &mut Vec<(&'static str, LineChart)>) {
     out.push((
         "motion",
         LineChart {
@@ -655,6 +704,10 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
             marks: Vec::new(),
         },
     ));
+}
+
+/// Errors far from the origin and across scales.
+fn precision_charts(r: &StabilityReport, out: &mut Vec<(&'static str, LineChart)>) {
     let offset_x = |p: &PrecisionRow| p.offset.max(1.0);
     let moved: Vec<&PrecisionRow> = r.precision.iter().filter(|p| p.scale == 1.0).collect();
     let scaled: Vec<&PrecisionRow> = r.precision.iter().filter(|p| p.offset == 0.0).collect();
@@ -725,11 +778,25 @@ pub fn charts(r: &StabilityReport) -> Vec<(&'static str, LineChart)> {
             marks: Vec::new(),
         },
     ));
-    out
 }
 
 /// The Markdown summary.
 pub fn markdown(r: &StabilityReport) -> String {
+    [
+        summary_md(r),
+        light_angle_md(r),
+        bias_md(r),
+        shimmer_md(r),
+        motion_md(r),
+        precision_md(r),
+        degenerate_md(r),
+        runtime_md(r),
+    ]
+    .concat()
+}
+
+/// The title, the run, the verdicts and what the terms mean.
+fn summary_md(r: &StabilityReport) -> String {
     let mut m = String::new();
     let total = r
         .seconds
@@ -764,6 +831,12 @@ pub fn markdown(r: &StabilityReport) -> String {
          False light: lit where the exact answer is shadow (leaks, peter-panning). Fractions are \
          of the pixels where the GPU and the ray-cast reference see the same surface.\n"
     );
+    m
+}
+
+/// Acne, false light and misclassification by sun elevation.
+fn light_angle_md(r: &StabilityReport) -> String {
+    let mut m = String::new();
     let _ = writeln!(
         m,
         "## Light angle (defaults, worst azimuth)\n\n![light angle](light-angle.png)\n"
@@ -805,6 +878,12 @@ pub fn markdown(r: &StabilityReport) -> String {
             low.join("; ")
         );
     }
+    m
+}
+
+/// The bias trade-off and the contact gap at the thin wall's base.
+fn bias_md(r: &StabilityReport) -> String {
+    let mut m = String::new();
     let _ = writeln!(m, "\n## Bias trade-off\n\n![bias](bias.png)\n");
     let mut t = Table::new(&[
         "sun",
@@ -836,6 +915,12 @@ pub fn markdown(r: &StabilityReport) -> String {
         }
         m += &t.render(true);
     }
+    m
+}
+
+/// Shimmer along the flythrough, per method.
+fn shimmer_md(r: &StabilityReport) -> String {
+    let mut m = String::new();
     let _ = writeln!(
         m,
         "\n## Shimmer along the flythrough ({} frames)\n\n![shimmer](shimmer.png)\n",
@@ -855,6 +940,12 @@ pub fn markdown(r: &StabilityReport) -> String {
         t.row(row);
     }
     m += &t.render(true);
+    m
+}
+
+/// Flicker in motion, per probe.
+fn motion_md(r: &StabilityReport) -> String {
+    let mut m = String::new();
     let _ = writeln!(
         m,
         "\n## Flicker in motion ({} frames, a still camera)\n\n![motion](motion.png)\n",
@@ -874,6 +965,12 @@ pub fn markdown(r: &StabilityReport) -> String {
         t.row(row);
     }
     m += &t.render(true);
+    m
+}
+
+/// Precision far from the origin.
+fn precision_md(r: &StabilityReport) -> String {
+    let mut m = String::new();
     let _ = writeln!(
         m,
         "\n## Precision\n\n![precision](precision.png) ![scale](scale.png)\n"
@@ -915,6 +1012,12 @@ pub fn markdown(r: &StabilityReport) -> String {
          (each object placed to within the world step). The camera-depth columns compare umbra's reversed-z float buffer with a standard-z float \
          buffer at the same view distance (analytic: umbra has no standard-z path).\n"
     );
+    m
+}
+
+/// The degenerate views and inputs.
+fn degenerate_md(r: &StabilityReport) -> String {
+    let mut m = String::new();
     let _ = writeln!(m, "## Degenerate views and input\n");
     let _ = writeln!(
         m,
@@ -951,6 +1054,12 @@ pub fn markdown(r: &StabilityReport) -> String {
         ]);
     }
     m += &t.render(true);
+    m
+}
+
+/// Where the time went.
+fn runtime_md(r: &StabilityReport) -> String {
+    let mut m = String::new();
     let _ = writeln!(m, "\n## Runtime\n");
     for (name, s) in &r.seconds {
         let _ = writeln!(m, "- {name}: {s:.1} s");
