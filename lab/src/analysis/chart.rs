@@ -108,17 +108,9 @@ fn y_of(r: &Row) -> f64 {
     r.misclassified.max(ZERO_ERROR_FLOOR)
 }
 
-fn draw<DB: DrawingBackend>(
-    root: DrawingArea<DB, Shift>,
-    rows: &[Row],
-    title: &str,
-) -> Result<(), String>
-where
-    DB::ErrorType: 'static,
-{
-    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
-    root.fill(&WHITE).map_err(e)?;
-    let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.gpu_ms, y_of(r))).collect();
+/// The axes' ranges for `pts` on log scales: GPU time widened by 15 % each way, the error
+/// halved and doubled (at most 1); defaults where no value is finite and positive.
+fn log_ranges(pts: &[(f64, f64)]) -> ((f64, f64), (f64, f64)) {
     let finite = |v: f64| v.is_finite() && v > 0.0;
     let xs: Vec<f64> = pts.iter().map(|p| p.0).filter(|v| finite(*v)).collect();
     let ys: Vec<f64> = pts.iter().map(|p| p.1).filter(|v| finite(*v)).collect();
@@ -140,6 +132,21 @@ where
     } else {
         (1e-6, 1.0)
     };
+    ((x0, x1), (y0, y1))
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    rows: &[Row],
+    title: &str,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.gpu_ms, y_of(r))).collect();
+    let ((x0, x1), (y0, y1)) = log_ranges(&pts);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(14)
@@ -168,7 +175,67 @@ where
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(e)?;
-    // Points: colour = fitting method, shape = filter; empty series carry the legend.
+    draw_points(&mut chart, rows)?;
+    // The front: a staircase through its points, each labelled.
+    let front = pareto_front(&pts);
+    let mut stair = Vec::new();
+    for (k, &i) in front.iter().enumerate() {
+        if k > 0 {
+            stair.push((pts[i].0, pts[front[k - 1]].1));
+        }
+        stair.push(pts[i]);
+    }
+    chart
+        .draw_series(LineSeries::new(stair, BLACK.stroke_width(1)))
+        .map_err(e)?
+        .label("Pareto front")
+        .legend(|(x, y)| PathElement::new(vec![(x - 8, y), (x + 8, y)], BLACK));
+    // Every front point ringed; labels to the right, only where they do not overlap the previous
+    // label.
+    let mut labelled: Vec<(usize, (i32, i32))> = Vec::new();
+    for &i in &front {
+        let at = chart.backend_coord(&pts[i]);
+        if labelled
+            .last()
+            .is_none_or(|(_, p)| (p.1 - at.1).abs() >= 16 || (p.0 - at.0).abs() >= 260)
+        {
+            labelled.push((i, at));
+        }
+    }
+    chart
+        .draw_series(
+            front
+                .iter()
+                .map(|&i| Circle::new(pts[i], 7, BLACK.stroke_width(1))),
+        )
+        .map_err(e)?;
+    chart
+        .draw_series(labelled.iter().map(|&(i, _)| {
+            EmptyElement::at(pts[i])
+                + Text::new(short_label(&rows[i]), (10, -7), ("sans-serif", 13))
+        }))
+        .map_err(e)?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// Every row as a point (colour = fitting method, shape = filter), with the legend's entries
+/// (empty series carry them).
+fn draw_points<'a, DB, CT>(chart: &mut ChartContext<'a, DB, CT>, rows: &[Row]) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     for (method, color) in METHODS {
         let of = |f: &str| -> Vec<(f64, f64)> {
             rows.iter()
@@ -232,54 +299,6 @@ where
                 }
             });
     }
-    // The front: a staircase through its points, each labelled.
-    let front = pareto_front(&pts);
-    let mut stair = Vec::new();
-    for (k, &i) in front.iter().enumerate() {
-        if k > 0 {
-            stair.push((pts[i].0, pts[front[k - 1]].1));
-        }
-        stair.push(pts[i]);
-    }
-    chart
-        .draw_series(LineSeries::new(stair, BLACK.stroke_width(1)))
-        .map_err(e)?
-        .label("Pareto front")
-        .legend(|(x, y)| PathElement::new(vec![(x - 8, y), (x + 8, y)], BLACK));
-    // Every front point ringed; labels to the right, only where they do not overlap the previous
-    // label.
-    let mut labelled: Vec<(usize, (i32, i32))> = Vec::new();
-    for &i in &front {
-        let at = chart.backend_coord(&pts[i]);
-        if labelled
-            .last()
-            .is_none_or(|(_, p)| (p.1 - at.1).abs() >= 16 || (p.0 - at.0).abs() >= 260)
-        {
-            labelled.push((i, at));
-        }
-    }
-    chart
-        .draw_series(
-            front
-                .iter()
-                .map(|&i| Circle::new(pts[i], 7, BLACK.stroke_width(1))),
-        )
-        .map_err(e)?;
-    chart
-        .draw_series(labelled.iter().map(|&(i, _)| {
-            EmptyElement::at(pts[i])
-                + Text::new(short_label(&rows[i]), (10, -7), ("sans-serif", 13))
-        }))
-        .map_err(e)?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(e)?;
-    root.present().map_err(e)?;
     Ok(())
 }
 
