@@ -238,16 +238,9 @@ struct Shader<'a> {
 /// constants, bindings, immediate size and entry points.
 fn reflect(shader: &Shader) -> Result<String, String> {
     let Shader {
-        file,
-        stem,
-        module,
-        info,
-        overrides,
-        requires,
-        ..
+        file, module, info, ..
     } = *shader;
-    let canonical = &shader.canonical;
-    let variants = canonical.len();
+    let stem = shader.stem;
     let mut layouter = naga::proc::Layouter::default();
     layouter
         .update(module.to_ctx())
@@ -261,6 +254,33 @@ fn reflect(shader: &Shader) -> Result<String, String> {
         "    /// SPIR-V of every override combination, indexed by the bit mask of `OVERRIDES`."
     )
     .unwrap();
+    variants_code(shader, &mut code);
+    constants_code(module, &mut code);
+    bindings_code(module, info, &layouter, &mut code);
+    for ep in &module.entry_points {
+        writeln!(code, "    /// Entry point `{}`.", ep.name).unwrap();
+        writeln!(
+            code,
+            "    pub const ENTRY_{}: &std::ffi::CStr = c\"{}\";",
+            ep.name.to_uppercase(),
+            ep.name
+        )
+        .unwrap();
+    }
+    writeln!(code, "}}").unwrap();
+    Ok(code)
+}
+
+/// The SPIR-V variants, the override list, each override's bit and each override's dependants.
+fn variants_code(shader: &Shader, code: &mut String) {
+    let Shader {
+        stem,
+        overrides,
+        requires,
+        ..
+    } = *shader;
+    let canonical = &shader.canonical;
+    let variants = canonical.len();
     let list: Vec<String> = (0..variants)
         .map(|m| {
             let m = canonical[m];
@@ -313,6 +333,10 @@ fn reflect(shader: &Shader) -> Result<String, String> {
             .unwrap();
         }
     }
+}
+
+/// The shader's named scalar constants as Rust constants.
+fn constants_code(module: &naga::Module, code: &mut String) {
     for (_, c) in module.constants.iter() {
         let Some(name) = &c.name else { continue };
         let value = match module.global_expressions[c.init] {
@@ -327,6 +351,15 @@ fn reflect(shader: &Shader) -> Result<String, String> {
         )
         .unwrap();
     }
+}
+
+/// Every resource binding (group, binding, kind, size, stages) and the immediate block's size.
+fn bindings_code(
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    layouter: &naga::proc::Layouter,
+    code: &mut String,
+) {
     let mut bindings = Vec::new();
     let mut immediate_size = 0u32;
     for (handle, var) in module.global_variables.iter() {
@@ -389,16 +422,4 @@ fn reflect(shader: &Shader) -> Result<String, String> {
         "    pub const IMMEDIATE_SIZE: u32 = {immediate_size};"
     )
     .unwrap();
-    for ep in &module.entry_points {
-        writeln!(code, "    /// Entry point `{}`.", ep.name).unwrap();
-        writeln!(
-            code,
-            "    pub const ENTRY_{}: &std::ffi::CStr = c\"{}\";",
-            ep.name.to_uppercase(),
-            ep.name
-        )
-        .unwrap();
-    }
-    writeln!(code, "}}").unwrap();
-    Ok(code)
 }

@@ -320,7 +320,8 @@ impl App {
         })
     }
 
-    fn redraw(&mut self, el: &ActiveEventLoop) -> anyhow::Result<()> {
+    /// Runs the input script's next step when it is due (one every `SCRIPT_STEP_FRAMES` frames).
+    fn script_step(&mut self, el: &ActiveEventLoop) -> anyhow::Result<()> {
         // Input script (automation): one step every few frames.
         let step = {
             let Some(s) = self.state.as_mut() else {
@@ -359,6 +360,11 @@ impl App {
                 ScriptStep::Click(x, y) => self.pick(x, y),
             }
         }
+        Ok(())
+    }
+
+    fn redraw(&mut self, el: &ActiveEventLoop) -> anyhow::Result<()> {
+        self.script_step(el)?;
         let Some(s) = self.state.as_mut() else {
             return Ok(());
         };
@@ -424,51 +430,11 @@ impl App {
             s.cpu_ms.push(cpu);
             s.frame_ms.push(dt as f64 * 1e3);
             if let Some(img) = screenshot {
-                let path = if final_frame {
-                    opts.screenshot
-                        .clone()
-                        .unwrap_or_else(|| PathBuf::from("screenshot.png"))
-                } else {
-                    s.screenshot_count += 1;
-                    PathBuf::from(format!("umbra-screenshot-{}.png", s.screenshot_count))
-                };
-                img.save(&path)
-                    .with_context(|| format!("writing {}", path.display()))?;
-                println!(
-                    "screenshot: {} ({}x{})",
-                    path.display(),
-                    img.width(),
-                    img.height()
-                );
+                save_screenshot(s, opts, &img, final_frame)?;
                 s.want_screenshot = false;
             }
         }
-        if s.last_title.elapsed().as_secs_f64() >= 0.25 && !s.cpu_ms.is_empty() {
-            let n = s.cpu_ms.len() as f64;
-            let cpu = s.cpu_ms.iter().sum::<f64>() / n;
-            let frame = s.frame_ms.iter().sum::<f64>() / n;
-            let gpu = match s.renderer.gpu_times() {
-                Some((a, b)) => format!("GPU {:.1} ms (shadow {a:.1} + camera {b:.1})", a + b),
-                None => "GPU n/a".into(),
-            };
-            let anim = if s.player.has_animations() {
-                format!(" | {}", s.player.label().trim_start_matches("animation: "))
-            } else {
-                String::new()
-            };
-            let title = format!(
-                "umbra — {} — {:.1} fps | {gpu} | CPU {cpu:.1} ms | {} tris | map {}²{anim}",
-                opts.scene.name,
-                1000.0 / frame.max(1e-3),
-                s.renderer.triangles(),
-                s.view.shadow.map_size
-            );
-            s.window.set_title(&title);
-            log::info!("{title}");
-            s.cpu_ms.clear();
-            s.frame_ms.clear();
-            s.last_title = Instant::now();
-        }
+        update_title(s, opts);
         if final_frame && s.drawn >= opts.frames.unwrap_or(0) {
             el.exit();
         }
@@ -701,6 +667,64 @@ impl ApplicationHandler for App {
                 s.window.request_redraw();
             }
         }
+    }
+}
+
+/// Saves a screenshot: the `--screenshot` path on the final frame of a `--frames` run, else a
+/// numbered file in the working folder.
+fn save_screenshot(
+    s: &mut State,
+    opts: &ViewerOptions,
+    img: &image::RgbaImage,
+    final_frame: bool,
+) -> anyhow::Result<()> {
+    let path = if final_frame {
+        opts.screenshot
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("screenshot.png"))
+    } else {
+        s.screenshot_count += 1;
+        PathBuf::from(format!("umbra-screenshot-{}.png", s.screenshot_count))
+    };
+    img.save(&path)
+        .with_context(|| format!("writing {}", path.display()))?;
+    println!(
+        "screenshot: {} ({}x{})",
+        path.display(),
+        img.width(),
+        img.height()
+    );
+    Ok(())
+}
+
+/// Puts the frame rate, GPU and CPU times, triangles, map size and animation in the window's
+/// title (and the log), four times a second.
+fn update_title(s: &mut State, opts: &ViewerOptions) {
+    if s.last_title.elapsed().as_secs_f64() >= 0.25 && !s.cpu_ms.is_empty() {
+        let n = s.cpu_ms.len() as f64;
+        let cpu = s.cpu_ms.iter().sum::<f64>() / n;
+        let frame = s.frame_ms.iter().sum::<f64>() / n;
+        let gpu = match s.renderer.gpu_times() {
+            Some((a, b)) => format!("GPU {:.1} ms (shadow {a:.1} + camera {b:.1})", a + b),
+            None => "GPU n/a".into(),
+        };
+        let anim = if s.player.has_animations() {
+            format!(" | {}", s.player.label().trim_start_matches("animation: "))
+        } else {
+            String::new()
+        };
+        let title = format!(
+            "umbra — {} — {:.1} fps | {gpu} | CPU {cpu:.1} ms | {} tris | map {}²{anim}",
+            opts.scene.name,
+            1000.0 / frame.max(1e-3),
+            s.renderer.triangles(),
+            s.view.shadow.map_size
+        );
+        s.window.set_title(&title);
+        log::info!("{title}");
+        s.cpu_ms.clear();
+        s.frame_ms.clear();
+        s.last_title = Instant::now();
     }
 }
 
