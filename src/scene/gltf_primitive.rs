@@ -90,16 +90,7 @@ pub(super) fn read_primitive(
     if prim.attributes().any(|(_, a)| a.count() != n) {
         return Err(corrupt(path, format!("{label}: attribute counts differ")));
     }
-    let raw_indices: Vec<u32> = match reader.read_indices() {
-        Some(i) => i.into_u32().collect(),
-        None => (0..n as u32).collect(),
-    };
-    if let Some(bad) = raw_indices.iter().find(|&&i| i as usize >= n) {
-        return Err(corrupt(
-            path,
-            format!("{label}: index {bad} out of range (vertex count {n})"),
-        ));
-    }
+    let raw_indices = read_indices(path, &reader, &site)?;
     let Some(indices) = triangle_list(prim.mode(), &raw_indices) else {
         scene.warn(
             "MESH_UNSUPPORTED_MODE",
@@ -400,4 +391,28 @@ fn stored_tangents(
         );
     }
     tangents
+}
+
+/// The primitive's indices (0..n without an index accessor), each checked against the vertex
+/// count.
+fn read_indices<'a, 's, F>(
+    path: &Path,
+    reader: &gltf::mesh::Reader<'a, 's, F>,
+    site: &Site,
+) -> Result<Vec<u32>, LoadError>
+where
+    F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+{
+    let (label, n) = (site.label, site.n);
+    let raw_indices: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..n as u32).collect(),
+    };
+    if let Some(bad) = raw_indices.iter().find(|&&i| i as usize >= n) {
+        return Err(corrupt(
+            path,
+            format!("{label}: index {bad} out of range (vertex count {n})"),
+        ));
+    }
+    Ok(raw_indices)
 }
