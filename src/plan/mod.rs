@@ -2,19 +2,28 @@
 //! immutable [`FramePlan`] (the lights, every shadow view with its casters, the camera, metering
 //! and exposure, the frame's uniform block). The passes in [`crate::render`] record what a plan
 //! says; the ray-cast reference reads the same plan.
+//!
+//! In one direction: `settings`, `input`, `camera` → `views` (shadow views) → `lights`
+//! (shading lights, metering, their uniforms) → `frame` (the plan) ; `casters` and `uniforms`
+//! are the data the plan carries.
 
+pub(crate) mod camera;
 pub(crate) mod casters;
 pub(crate) mod frame;
+pub(crate) mod input;
+pub(crate) mod lights;
 pub(crate) mod settings;
 pub(crate) mod uniforms;
+pub(crate) mod views;
 
+pub use camera::{camera_projection, fitting_frustum};
 pub use casters::{flat_hides_nothing, CasterPlan, Viewpoint};
-pub use frame::{
-    camera_projection, effective_lights, exposure_scale, lookup_reach, metered_illuminance,
-    soft_size, FramePlan, ScenePlanner, ShadowView, CLEAR_COLOR,
-};
+pub use frame::{plan_frame, FramePlan, ScenePlanner, CLEAR_COLOR};
+pub use input::{PlanScene, PlanTarget};
+pub use lights::{effective_lights, exposure_scale, metered_illuminance};
 pub use settings::{
     Exposure, HeldLight, Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings,
     Tonemap, View, ViewMode, AUTO_AMBIENT, MAX_CASCADES, UNIT_AMBIENT,
 };
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
+pub use views::{lookup_reach, soft_size, ShadowView};

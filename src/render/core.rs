@@ -12,8 +12,8 @@ use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::scene as sh;
 use crate::math::shadow_fit::spot_near;
-use crate::plan::frame::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::settings::{SceneOptions, ShadowSettings, View, ViewMode};
+use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
 use crate::scene::{Light, Scene};
 use ash::vk;
@@ -154,7 +154,7 @@ impl FrameCore {
                         &sv.light_clip_from_world,
                         plan.light_source(sv.light),
                         sv.res,
-                        crate::plan::frame::lookup_reach(view.shadow.pcf, plan.soft),
+                        crate::plan::lookup_reach(view.shadow.pcf, plan.soft),
                         view.mode == ViewMode::ShadowMap,
                     )
                 })

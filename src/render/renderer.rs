@@ -5,8 +5,8 @@ use super::targets::{Attachment, MsaaTargets};
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
-use crate::plan::frame::FramePlan;
 use crate::plan::settings::{SceneOptions, View};
+use crate::plan::FramePlan;
 use crate::scene::Scene;
 use ash::vk;
 use glam::Mat4;
@@ -297,7 +297,7 @@ impl Renderer {
                 let aspect = width as f32 / height.max(1) as f32;
                 let seen = visible_depths(
                     f.depth.as_deref().unwrap_or(&[]),
-                    &crate::plan::frame::camera_projection(&view.camera, aspect),
+                    &crate::plan::camera_projection(&view.camera, aspect),
                 );
                 self.seen_depths = Some((key.0, key.1, key.2, seen));
                 seen

@@ -28,7 +28,7 @@ fn inside_xy(b: &Aabb, clip: &Mat4) -> bool {
 /// How `view` of `scene` is exposed: the exposure mode, what auto exposure metered (lux, as
 /// luminance), the resolved EV100 and linear scale, the ambient and the tone curve.
 pub fn exposure_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
-    let planner = crate::plan::frame::ScenePlanner::new(scene);
+    let planner = crate::plan::ScenePlanner::new(scene);
     let plan = planner.plan(view, w, h);
     let mode = match view.exposure {
         crate::plan::settings::Exposure::Auto => "auto".to_string(),
@@ -48,7 +48,7 @@ pub fn exposure_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
 
 /// The shadow plan of `view` at `w`×`h` (the CPU side of a frame; no GPU needed).
 pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
-    let planner = crate::plan::frame::ScenePlanner::new(scene);
+    let planner = crate::plan::ScenePlanner::new(scene);
     let draws = planner.receivers();
     let plan = planner.plan(view, w, h);
     let Some(li) = plan.shadow_light.filter(|_| plan.shadows_on) else {

@@ -269,10 +269,8 @@ impl WindowRenderer {
                 self.depth_reads[f].0.as_ref().expect("buffer").raw,
             );
             let aspect = extent.width as f32 / extent.height.max(1) as f32;
-            self.depth_reads[f].1 = Some((
-                crate::plan::frame::camera_projection(&view.camera, aspect),
-                pixels,
-            ));
+            self.depth_reads[f].1 =
+                Some((crate::plan::camera_projection(&view.camera, aspect), pixels));
         }
         if want_copy {
             color.transition(d, cmd, Access::TransferSrc);

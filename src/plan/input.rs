@@ -1,0 +1,28 @@
+//! What a frame is planned against (the scene's lights, bounds and draw boxes) and for (the image).
+
+use crate::math::Aabb;
+use crate::scene::Light;
+
+/// What a frame is planned against: the scene's lights, its bounds, and each draw's world box
+/// (may be empty), which bound the depths cascades are split over.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanScene<'a> {
+    /// The scene's lights (the default sun is added when there are none).
+    pub lights: &'a [Light],
+    /// The scene's bounds.
+    pub bounds: &'a Aabb,
+    /// The draws' world boxes.
+    pub receivers: &'a [Aabb],
+}
+
+/// The image a frame is planned for.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanTarget {
+    /// Width over height.
+    pub aspect: f32,
+    /// The image height in pixels: the pixel footprint the automatic cascade count compares
+    /// texels with.
+    pub height_px: u32,
+    /// The device filters depth comparisons in hardware (the shader variant's HW_COMPARE).
+    pub hw_compare: bool,
+}
