@@ -66,6 +66,17 @@ pub struct FramePlan {
 }
 
 impl FramePlan {
+    /// The plan with each shadow view's casters (`casters[i]` for `shadow_views[i]`, from the
+    /// renderer's scene), their lookup rectangles packed into the uniform block: the one place
+    /// a plan is completed, before anything is recorded.
+    pub fn with_casters(mut self, casters: Vec<CasterPlan>) -> FramePlan {
+        for (c, cp) in casters.iter().enumerate() {
+            self.uniform.views[c].rect = cp.lookup;
+        }
+        self.casters = casters;
+        self
+    }
+
     /// The eye and the unit forward direction the cascades were split from (the fitting camera's,
     /// the view's unless shadows are fitted to another camera).
     pub fn split_eye_forward(&self) -> (Vec3, Vec3) {
@@ -199,11 +210,12 @@ impl ScenePlanner {
 
     /// The plan the renderer makes for `view` at `w`×`h`.
     pub fn plan(&self, view: &View, w: u32, h: u32) -> FramePlan {
-        let mut plan = plan_frame(
+        plan_frame(
             &PlanScene {
                 lights: &self.lights,
                 bounds: &self.bounds,
                 receivers: &self.receivers,
+                origin: self.origin,
             },
             &view.rebased(self.origin),
             &PlanTarget {
@@ -211,9 +223,7 @@ impl ScenePlanner {
                 height_px: h,
                 hw_compare: false,
             },
-        );
-        plan.origin = self.origin;
-        plan
+        )
     }
 }
 
@@ -292,7 +302,7 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         unshadowed,
         clip_from_world,
         casters: Vec::new(),
-        origin: Vec3::ZERO,
+        origin: scene.origin,
         exposure,
         tonemap: view.tonemap,
         ambient,
@@ -381,6 +391,7 @@ mod tests {
                 lights: &[sun],
                 bounds: &room,
                 receivers: &boxes,
+                origin: Vec3::ZERO,
             },
             &v,
             &PlanTarget {
@@ -405,6 +416,7 @@ mod tests {
                 lights: &s.lights,
                 bounds: &s.bounds(),
                 receivers: &[],
+                origin: Vec3::ZERO,
             },
             &v,
             &PlanTarget {
@@ -424,6 +436,7 @@ mod tests {
                 lights: &s.lights,
                 bounds: &s.bounds(),
                 receivers: &[],
+                origin: Vec3::ZERO,
             },
             &v,
             &PlanTarget {
@@ -445,6 +458,7 @@ mod tests {
                 lights: &s.lights,
                 bounds: &s.bounds(),
                 receivers: &[],
+                origin: Vec3::ZERO,
             },
             &v,
             &PlanTarget {
@@ -467,6 +481,7 @@ mod tests {
                 lights: &s.lights,
                 bounds: &s.bounds(),
                 receivers: &[],
+                origin: Vec3::ZERO,
             },
             &v,
             &PlanTarget {
@@ -492,6 +507,7 @@ mod tests {
                     lights: &sun,
                     bounds: &s.bounds(),
                     receivers: &[],
+                    origin: Vec3::ZERO,
                 },
                 v,
                 &PlanTarget {
@@ -566,6 +582,7 @@ mod tests {
                 lights: &lights,
                 bounds: &s.bounds(),
                 receivers: &[],
+                origin: Vec3::ZERO,
             },
             &v,
             &PlanTarget {
@@ -596,6 +613,7 @@ mod tests {
                 lights: &lights,
                 bounds: &s.bounds(),
                 receivers: &[],
+                origin: Vec3::ZERO,
             },
             &v,
             &PlanTarget {
@@ -618,6 +636,7 @@ mod tests {
                 lights: &lights,
                 bounds: &s.bounds(),
                 receivers: &[],
+                origin: Vec3::ZERO,
             },
             &v,
             &PlanTarget {

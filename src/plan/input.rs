@@ -13,6 +13,9 @@ pub struct PlanScene<'a> {
     pub bounds: &'a Aabb,
     /// The draws' world boxes.
     pub receivers: &'a [Aabb],
+    /// What the lights, bounds and boxes are relative to (world = given + origin); the plan's
+    /// [`super::FramePlan::origin`].
+    pub origin: glam::Vec3,
 }
 
 /// The image a frame is planned for.

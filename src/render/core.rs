@@ -124,11 +124,12 @@ impl FrameCore {
         let hw = self.shadow.hardware_filtering(view.shadow.format);
         let mut v = view.rebased(self.origin);
         v.shadow.map_size = map_size;
-        let mut plan = plan_frame(
+        let plan = plan_frame(
             &PlanScene {
                 lights: &self.lights,
                 bounds: &self.gpu.bounds,
                 receivers: &self.receiver_bounds,
+                origin: self.origin,
             },
             &v,
             &PlanTarget {
@@ -137,16 +138,14 @@ impl FrameCore {
                 hw_compare: hw,
             },
         );
-        plan.origin = self.origin;
         let layers = plan.shadow_views.len().max(1) as u32;
         self.shadow
             .ensure_map(map_size, view.shadow.format, layers)?;
         self.shadow.ensure_masked(&self.gpu, view.shadow.format)?;
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         self.camera.bind_shadow_map(slot, map_view, hw);
-        if plan.shadows_on {
-            plan.casters = plan
-                .shadow_views
+        let casters = if plan.shadows_on {
+            plan.shadow_views
                 .iter()
                 .map(|sv| {
                     plan_casters(
@@ -158,11 +157,11 @@ impl FrameCore {
                         view.mode == ViewMode::ShadowMap,
                     )
                 })
-                .collect();
-        }
-        for (c, cp) in plan.casters.iter().enumerate() {
-            plan.uniform.views[c].rect = cp.lookup;
-        }
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let plan = plan.with_casters(casters);
         self.camera.write_frame(slot, &plan.uniform)?;
         let extent = vk::Extent2D { width, height };
         let cull = camera_cull(view, &plan, extent, self.receiver_split);
