@@ -47,8 +47,6 @@ pub struct FramePlan {
     pub unshadowed: Vec<usize>,
     /// The camera's world → clip.
     pub clip_from_world: Mat4,
-    /// The shadow pass's casters and area per shadow view (set by `FrameCore::prepare`).
-    pub casters: Vec<CasterPlan>,
     /// The linear scale applied to the lit image before tone mapping (`View::exposure`
     /// resolved: auto exposure metered from this frame's lights).
     pub exposure: f32,
@@ -70,10 +68,10 @@ impl FramePlan {
     /// renderer's scene), their lookup rectangles packed into the uniform block: the one place
     /// a plan is completed, before anything is recorded.
     pub fn with_casters(mut self, casters: Vec<CasterPlan>) -> FramePlan {
-        for (c, cp) in casters.iter().enumerate() {
+        for (c, (view, cp)) in self.shadow_views.iter_mut().zip(casters).enumerate() {
             self.uniform.views[c].rect = cp.lookup;
+            view.casters = cp;
         }
-        self.casters = casters;
         self
     }
 
@@ -301,7 +299,6 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         shadow_views: views,
         unshadowed,
         clip_from_world,
-        casters: Vec::new(),
         origin: scene.origin,
         exposure,
         tonemap: view.tonemap,

@@ -2,6 +2,7 @@
 //! frustum, a point light's six cube faces, and their uniforms.
 
 use super::camera::fitting_frustum;
+use super::casters::CasterPlan;
 use super::input::{PlanScene, PlanTarget};
 use super::settings::{HeldLight, Pcf, ShadowFit, ShadowSettings, View, MAX_CASCADES};
 use super::uniforms::{ShadowViewUniform, MAX_SHADOW_VIEWS};
@@ -21,8 +22,9 @@ pub const CASCADE_SPLIT_LAMBDA: f32 = 0.9;
 pub const CASCADE_BLEND: f32 = 0.1;
 
 /// One shadow view (one layer of the shadow map): a cascade or the single map of a directional
-/// light, a spot light's frustum, or one cube face of a point light.
-#[derive(Clone, Copy, Debug)]
+/// light, a spot light's frustum, or one cube face of a point light, with the casters the shadow
+/// pass draws into it.
+#[derive(Clone, Debug)]
 pub struct ShadowView {
     /// World → light clip.
     pub light_clip_from_world: Mat4,
@@ -39,6 +41,9 @@ pub struct ShadowView {
     pub res: u32,
     /// For cascades: the view depths (near, far) their light's cascades were split over.
     pub depth_range: Option<(f32, f32)>,
+    /// The casters the shadow pass draws into this view and the texels they touch (none until
+    /// the renderer plans them: [`super::FramePlan::with_casters`]).
+    pub casters: CasterPlan,
 }
 
 impl ShadowView {
@@ -52,6 +57,7 @@ impl ShadowView {
             light: 0,
             res: 0,
             depth_range: None,
+            casters: CasterPlan::default(),
         }
     }
 }

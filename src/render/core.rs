@@ -217,8 +217,7 @@ impl FrameCore {
         let views: Vec<_> = plan
             .shadow_views
             .iter()
-            .map(|v| v.light_clip_from_world)
-            .zip(&plan.casters)
+            .map(|v| (v.light_clip_from_world, &v.casters))
             .collect();
         // How far from a point or spot light its projection's near plane reaches (near
         // distance × √(1 + 2·tan²) for the widest point face, tan ≤ 4/3).
@@ -331,7 +330,7 @@ fn camera_cull(
 ) -> CameraCull {
     let aspect = extent.width as f32 / extent.height.max(1) as f32;
     let t = (view.camera.fov_y * 0.5).tan();
-    let single_view = plan.shadow_views.len() == 1 && plan.casters.len() == 1;
+    let single_view = plan.shadow_views.len() == 1;
     let bits = plan.shader_variant;
     let shadow_reach = (receiver_split
         && view.mode == ViewMode::Lit
@@ -347,7 +346,7 @@ fn camera_cull(
             };
             ShadowReach::new(
                 &sv.light_clip_from_world,
-                plan.casters[0].lookup,
+                sv.casters.lookup,
                 sv.res as f32,
                 view.shadow.normal_offset.abs() + view.shadow.constant_bias.abs(),
                 sv.texel_world,
