@@ -231,14 +231,14 @@ pub struct SceneOptions {
     /// every start), blits on GPUs.
     pub cpu_mips: Option<bool>,
     /// Shade draws of triangles smaller than llvmpipe's 4×4 shading block deferred
-    /// (`crate::render::deferred`: a G-buffer, then each covered pixel shaded once). `None`: on
+    /// (`crate::render::passes::deferred`: a G-buffer, then each covered pixel shaded once). `None`: on
     /// CPU devices at one sample per pixel, off on GPUs (which shade 2×2 quads in hardware).
     pub deferred: Option<bool>,
     /// Draw small receivers (a ground) without the shadow lookup where no caster can shadow them
-    /// (`crate::render::receivers`: the same image; llvmpipe runs the lookup even where a
+    /// (`crate::render::passes::receivers`: the same image; llvmpipe runs the lookup even where a
     /// branch skips it). `None`: on for CPU devices, off on GPUs (whose branches skip it).
     pub receiver_split: Option<bool>,
-    /// Reuse shadow-map layers across frames (`crate::render::shadow_cache`): a layer whose
+    /// Reuse shadow-map layers across frames (`crate::render::passes::shadow_cache`): a layer whose
     /// light matrix, area and static casters are those of the last frame is not redrawn, and
     /// only moving casters (animated or deforming) are drawn over a cached copy of the static
     /// ones. The same image to the bit. Off by default (each `render` then measures the whole

@@ -2,12 +2,7 @@
 //! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
 //! record exactly the same commands, so the window and the capture give the same pixels.
 
-use super::camera_pass::{CameraPass, CameraTargets, Resolve};
-use super::cull::CameraCull;
 use super::gpu_scene::GpuScene;
-use super::receivers::ShadowReach;
-use super::shadow_pass::{plan_casters, ShadowPass};
-use super::targets::{Attachment, MsaaTargets};
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::scene as sh;
@@ -15,6 +10,11 @@ use crate::math::shadow_fit::spot_near;
 use crate::plan::settings::{SceneOptions, ShadowSettings, View, ViewMode};
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
+use crate::render::passes::camera_pass::{CameraPass, CameraTargets, Resolve};
+use crate::render::passes::cull::CameraCull;
+use crate::render::passes::receivers::ShadowReach;
+use crate::render::passes::shadow_pass::{plan_casters, ShadowPass};
+use crate::render::targets::{Attachment, MsaaTargets};
 use crate::scene::{Light, Scene};
 use ash::vk;
 use std::sync::Arc;
@@ -321,7 +321,7 @@ impl FrameCore {
 /// The debug entry `mode` draws the scene with (`None`: the lit image, or the shadow map drawn
 /// full-screen).
 /// What the camera pass culls and draws with for `view` planned as `plan` at `extent`; with
-/// `receiver_split`, the reach of a single shadow view (`crate::render::receivers`).
+/// `receiver_split`, the reach of a single shadow view (`crate::render::passes::receivers`).
 fn camera_cull(
     view: &View,
     plan: &FramePlan,
@@ -366,8 +366,8 @@ fn camera_cull(
     }
 }
 
-fn is_debug_view(mode: ViewMode) -> Option<super::cull::Entry> {
-    use super::cull::Entry;
+fn is_debug_view(mode: ViewMode) -> Option<crate::render::passes::cull::Entry> {
+    use crate::render::passes::cull::Entry;
     match mode {
         ViewMode::Lit | ViewMode::ShadowMap => None,
         ViewMode::Overdraw => Some(Entry::Overdraw),
@@ -413,9 +413,9 @@ pub struct PassCounts {
     pub casters: usize,
     /// Draws in the camera pass.
     pub camera_draws: usize,
-    /// Of those, draws shaded deferred (`crate::render::deferred`).
+    /// Of those, draws shaded deferred (`crate::render::passes::deferred`).
     pub deferred_draws: usize,
-    /// Draws drawn, wholly or in part, without the shadow lookup (`crate::render::receivers`).
+    /// Draws drawn, wholly or in part, without the shadow lookup (`crate::render::passes::receivers`).
     pub unshadowed_draws: usize,
 }
 

@@ -1,22 +1,16 @@
-//! Rendering: one module per pass, the targets they draw into, the scene's GPU copy, and the
-//! offscreen and window renderers; the passes record what a [`crate::plan::FramePlan`] says. Passes,
-//! pipelines and uniform layouts are internal; the public types are re-exported here.
+//! Rendering, in rooms by job: the passes (`passes/`), the images they draw into (`targets/`),
+//! pipelines and samplers, the scene's GPU copy (`gpu_scene`), the frame scheduler (`core`:
+//! prepare, then record) and the offscreen and window renderers. The passes record what a
+//! [`crate::plan::FramePlan`] says. Passes, pipelines and uniform layouts are internal; the
+//! public types are re-exported here.
 
-pub(crate) mod camera_pass;
 pub(crate) mod core;
-pub(crate) mod cull;
-pub(crate) mod deferred;
 pub(crate) mod gpu_scene;
+pub(crate) mod passes;
 pub(crate) mod pipeline;
-pub(crate) mod receivers;
 pub(crate) mod renderer;
 pub mod report;
 pub(crate) mod samplers;
-pub(crate) mod screen;
-pub(crate) mod shadow_cache;
-pub(crate) mod shadow_pass;
-#[cfg(feature = "viewer")]
-pub(crate) mod swapchain;
 pub(crate) mod targets;
 #[cfg(feature = "viewer")]
 pub(crate) mod window;

@@ -1,12 +1,12 @@
 //! The offscreen renderer: the shared frame core into an image, read back to RGBA8.
 
 use super::core::{FrameCore, Targets};
-use super::targets::{Attachment, MsaaTargets};
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
 use crate::plan::settings::{SceneOptions, View};
 use crate::plan::FramePlan;
+use crate::render::targets::{Attachment, MsaaTargets};
 use crate::scene::Scene;
 use ash::vk;
 use glam::Mat4;

@@ -6,12 +6,12 @@ use super::core::{FrameCore, Targets};
 use super::renderer::{
     copy_to_buffer, rgba_from_readback, transfer_to_host_barrier, visible_depths,
 };
-use super::swapchain::Swapchain;
-use super::targets::{Attachment, MsaaTargets};
 use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
 use crate::plan::settings::{SceneOptions, ShadowHold, View};
+use crate::render::targets::swapchain::Swapchain;
+use crate::render::targets::{Attachment, MsaaTargets};
 use crate::scene::Scene;
 use ash::vk;
 use gpu_allocator::MemoryLocation;

@@ -1,8 +1,8 @@
 //! What the camera pass is told per frame: which draws it records and with which fragment
 //! entry point.
 
-use super::gpu_scene::AlphaDraw;
-use super::receivers::ShadowReach;
+use crate::render::gpu_scene::AlphaDraw;
+use crate::render::passes::receivers::ShadowReach;
 use glam::{Mat4, Vec3};
 
 /// What the camera pass needs per frame to do only the work the frame needs: the camera's world →
@@ -20,7 +20,7 @@ pub struct CameraCull {
     /// The (instance, primitive) drawn tinted (`View::highlight`).
     pub highlight: Option<(usize, usize)>,
     /// Where the frame's single shadow view can shadow anything, when small receivers are
-    /// drawn unshadowed beyond it (`crate::render::receivers`).
+    /// drawn unshadowed beyond it (`crate::render::passes::receivers`).
     pub shadow_reach: Option<ShadowReach>,
 }
 

@@ -13,13 +13,13 @@
 //! On by default on CPU devices at one sample per pixel (`SceneOptions::deferred`); GPUs shade
 //! 2×2 quads in hardware and keep the forward pass.
 
-use super::cull::CameraCull;
-use super::gpu_scene::{AlphaDraw, Draw};
-use super::screen::{pixels_per_triangle, screen_rect, PixelRect};
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{allocate_sets, scene as sh, ReflectedBinding};
 use crate::gpu::Image;
+use crate::render::gpu_scene::{AlphaDraw, Draw};
+use crate::render::passes::cull::CameraCull;
+use crate::render::passes::screen::{pixels_per_triangle, screen_rect, PixelRect};
 use ash::vk;
 use glam::Mat4;
 use std::collections::{HashMap, HashSet};
@@ -391,7 +391,7 @@ mod tests {
         assert_eq!(sources, [(3, 0), (5, 0)]);
         assert_eq!(p.forward[0].source, (3, 1));
         c.highlight = None;
-        c.debug_view = Some(crate::render::cull::Entry::Debug);
+        c.debug_view = Some(crate::render::passes::cull::Entry::Debug);
         assert!(plan(draws.iter().collect(), &c, extent, true)
             .deferred
             .is_empty());

@@ -14,10 +14,10 @@
 //! Only frames with one shadow view use it (a single map of a directional light or a spot
 //! light's; cascades and cube faces keep the shadowed shader everywhere).
 
-use super::gpu_scene::Draw;
-use super::screen::{points_rect, screen_rect, PixelRect};
 use crate::gpu::shaders::scene as sh;
 use crate::math::Aabb;
+use crate::render::gpu_scene::Draw;
+use crate::render::passes::screen::{points_rect, screen_rect, PixelRect};
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 

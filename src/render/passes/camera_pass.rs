@@ -1,14 +1,6 @@
 //! The camera pass: Blinn-Phong, normal mapping, shadow-map reprojection (scene.wgsl), plus the
 //! full-screen shadow-map debug view. One frame-uniform slot per frame in flight.
 
-use super::cull::{CameraCull, Entry};
-use super::deferred::{self, DeferPlan, GBuffer, GBUFFER_FORMAT, GBUFFER_TARGETS};
-use super::gpu_scene::{vertex_layout, AlphaDraw, Draw, GpuScene};
-use super::pipeline::{
-    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
-    Stencil,
-};
-use super::receivers::{self, Split};
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::resources::has_stencil;
@@ -18,6 +10,14 @@ use crate::gpu::shaders::{
 use crate::gpu::Buffer;
 use crate::plan::uniforms::FrameUniform;
 use crate::plan::{flat_hides_nothing, Viewpoint};
+use crate::render::gpu_scene::{vertex_layout, AlphaDraw, Draw, GpuScene};
+use crate::render::passes::cull::{CameraCull, Entry};
+use crate::render::passes::deferred::{self, DeferPlan, GBuffer, GBUFFER_FORMAT, GBUFFER_TARGETS};
+use crate::render::passes::receivers::{self, Split};
+use crate::render::pipeline::{
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
+    Stencil,
+};
 use ash::vk;
 use glam::Vec3;
 use gpu_allocator::MemoryLocation;
@@ -48,7 +48,7 @@ pub struct CameraPass {
     pub depth_format: vk::Format,
     /// Samples per pixel of the colour and depth attachments (MSAA; 1 = off).
     samples: u32,
-    /// Whether micro-triangle draws are shaded deferred (`crate::render::deferred`).
+    /// Whether micro-triangle draws are shaded deferred (`crate::render::passes::deferred`).
     deferred: bool,
     gbuffer_layout: vk::DescriptorSetLayout,
     /// The G-buffer targets, at the last deferring frame's size.

@@ -1,10 +1,13 @@
-//! The images a pass renders into: an attachment that remembers its last access, and the
-//! multisampled targets of a camera pass.
+//! The images a pass renders into: an attachment that remembers its last access, the
+//! multisampled targets of a camera pass, and the window's swapchain.
 
-use super::camera_pass::DEPTH_FORMAT;
+#[cfg(feature = "viewer")]
+pub(crate) mod swapchain;
+
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::Image;
+use crate::render::passes::camera_pass::DEPTH_FORMAT;
 use ash::vk;
 use std::sync::Arc;
 

@@ -1,7 +1,7 @@
 //! Screen rectangles of draws and points: where a draw lands in pixels, and how large its
 //! triangles are there.
 
-use super::gpu_scene::Draw;
+use crate::render::gpu_scene::Draw;
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3};
 

@@ -1,13 +1,6 @@
 //! The light-space depth pass: position-only stream, depth clamp on, reversed-z (clear 0, GREATER),
 //! depth bias pushing casters away from the light (negative factors under reversed-z).
 
-use super::gpu_scene::{vertex_layout, GpuScene};
-use super::pipeline::{
-    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
-    Stencil,
-};
-use super::shadow_cache::{split_moving, LayerKey, LayerWork, ShadowCache};
-use super::targets::Attachment;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{create_module, shadow as sh};
@@ -16,6 +9,13 @@ use crate::math::Aabb;
 use crate::plan::settings::{ShadowFormat, ShadowSettings};
 use crate::plan::uniforms::ShadowImmediates;
 use crate::plan::{flat_hides_nothing, CasterPlan, Viewpoint};
+use crate::render::gpu_scene::{vertex_layout, GpuScene};
+use crate::render::passes::shadow_cache::{split_moving, LayerKey, LayerWork, ShadowCache};
+use crate::render::pipeline::{
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
+    Stencil,
+};
+use crate::render::targets::Attachment;
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use std::sync::Arc;

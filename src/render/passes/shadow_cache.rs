@@ -13,8 +13,8 @@
 //! A depth buffer keeps the nearest depth of everything drawn into it, whatever the order, so
 //! the map is the same to the bit as the uncached pass's (`tests/shadow_cache.rs`).
 
-use super::gpu_scene::GpuScene;
 use crate::plan::{CasterPlan, Viewpoint};
+use crate::render::gpu_scene::GpuScene;
 use ash::vk;
 use glam::Mat4;
 
