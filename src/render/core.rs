@@ -10,7 +10,7 @@ use crate::math::shadow_fit::spot_near;
 use crate::plan::settings::{SceneOptions, ShadowSettings, View, ViewMode};
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
-use crate::render::passes::camera_pass::{CameraPass, CameraTargets, Resolve};
+use crate::render::passes::camera_pass::{CameraFrame, CameraPass, CameraTargets, Resolve};
 use crate::render::passes::cull::CameraCull;
 use crate::render::passes::receivers::ShadowReach;
 use crate::render::passes::shadow_pass::{plan_casters, ShadowPass};
@@ -165,10 +165,13 @@ impl FrameCore {
         self.camera.write_frame(slot, &plan.uniform)?;
         let extent = vk::Extent2D { width, height };
         let cull = camera_cull(view, &plan, extent, self.receiver_split);
-        self.camera.ensure_pipelines(&self.gpu, &cull, extent)?;
+        let camera =
+            self.camera
+                .plan_frame(&self.gpu, cull, extent, view.mode == ViewMode::ShadowMap);
+        self.camera.ensure_pipelines(&self.gpu, &camera, extent)?;
         Ok(Prepared {
             plan,
-            cull,
+            camera,
             extent,
             slot,
             shadow: view.shadow,
@@ -187,7 +190,7 @@ impl FrameCore {
     ) -> PassCounts {
         let Prepared {
             plan,
-            cull,
+            camera,
             extent,
             slot,
             ..
@@ -265,14 +268,7 @@ impl FrameCore {
                 CLEAR_COLOR
             },
         };
-        let counts = self.camera.record(
-            cmd,
-            slot,
-            &self.gpu,
-            &targets,
-            frame.mode == ViewMode::ShadowMap,
-            cull,
-        );
+        let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
         unsafe {
             if timestamps {
                 d.cmd_write_timestamp2(
@@ -380,8 +376,8 @@ fn is_debug_view(mode: ViewMode) -> Option<crate::render::passes::cull::Entry> {
 pub struct Prepared {
     /// The frame's plan (returned to the caller with the image).
     pub plan: FramePlan,
-    /// The camera pass's culling and variant inputs.
-    cull: CameraCull,
+    /// What the camera pass draws: its culling inputs, deferred split and receiver splits.
+    camera: CameraFrame,
     /// The image size.
     extent: vk::Extent2D,
     /// The uniform and timestamp slot the frame was prepared in.

@@ -10,7 +10,7 @@ use crate::gpu::shaders::{
 use crate::gpu::Buffer;
 use crate::plan::uniforms::FrameUniform;
 use crate::plan::{flat_hides_nothing, Viewpoint};
-use crate::render::gpu_scene::{vertex_layout, AlphaDraw, Draw, GpuScene};
+use crate::render::gpu_scene::{vertex_layout, AlphaDraw, GpuScene};
 use crate::render::passes::cull::{CameraCull, Entry};
 use crate::render::passes::deferred::{self, DeferPlan, GBuffer, GBUFFER_FORMAT, GBUFFER_TARGETS};
 use crate::render::passes::receivers::{self, Split};
@@ -171,23 +171,23 @@ impl CameraPass {
     pub fn ensure_pipelines(
         &mut self,
         scene: &GpuScene,
-        cull: &CameraCull,
+        frame: &CameraFrame,
         extent: vk::Extent2D,
     ) -> Result<(), GpuError> {
+        let cull = &frame.cull;
         let (frame_bits, debug_view) = (cull.frame_bits, cull.debug_view);
         let mut keys: Vec<(usize, Entry)> = scene
             .pipeline_keys
             .iter()
             .map(|&(bits, alpha)| (bits | frame_bits, Entry::of(alpha, debug_view)))
             .collect();
-        let defer = deferred::plan(draw_order(scene, cull), cull, extent, self.deferred);
+        let defer = &frame.defer;
         // The unshadowed variants of receivers drawn (partly) beyond the casters' reach.
-        if let Some(reach) = &cull.shadow_reach {
-            for dr in &defer.forward {
-                if receivers::split(reach, dr, &cull.clip_from_world, extent) != Split::Shadowed {
-                    let bits = receivers::unshadowed(dr.material_bits | frame_bits);
-                    keys.push((bits, Entry::of(dr.alpha, debug_view)));
-                }
+        for (&i, split) in defer.forward.iter().zip(&frame.splits) {
+            if *split != Split::Shadowed {
+                let dr = &scene.draws[i];
+                let bits = receivers::unshadowed(dr.material_bits | frame_bits);
+                keys.push((bits, Entry::of(dr.alpha, debug_view)));
             }
         }
         if !defer.deferred.is_empty() {
@@ -329,9 +329,9 @@ impl CameraPass {
         slot: usize,
         scene: &GpuScene,
         targets: &CameraTargets,
-        shadow_map_view: bool,
-        cull: &CameraCull,
+        frame: &CameraFrame,
     ) -> CameraCounts {
+        let (cull, shadow_map_view, plan) = (&frame.cull, frame.shadow_map_view, &frame.defer);
         let CameraTargets {
             color,
             depth,
@@ -343,20 +343,13 @@ impl CameraPass {
         let d = &ctx.device;
         ctx.begin_label(cmd, "camera pass");
         let stencil = has_stencil(self.depth_format);
-        let order = if shadow_map_view {
-            Vec::new()
-        } else {
-            draw_order(scene, cull)
-        };
-        // The split `ensure_pipelines` made this frame's pipelines and G-buffer for.
-        let plan = deferred::plan(order, cull, extent, self.deferred);
         let deferring = !plan.deferred.is_empty();
         let frame_set = self.slots[slot].set;
         let mut drawn = 0;
         let mut unshadowed = 0;
         let mut deferred_draws = 0;
         if deferring {
-            deferred_draws = self.record_gbuffer(cmd, scene, targets, frame_set, &plan, cull.eye);
+            deferred_draws = self.record_gbuffer(cmd, scene, targets, frame_set, plan, cull.eye);
         }
         let mut color_att = vk::RenderingAttachmentInfo::default()
             .image_view(color)
@@ -404,10 +397,10 @@ impl CameraPass {
                 d.cmd_draw(cmd, 3, 1, 0, 0);
             }
             if deferring {
-                self.record_resolve(cmd, scene, &plan, cull.frame_bits, extent);
+                self.record_resolve(cmd, scene, plan, cull.frame_bits, extent);
             }
             if !plan.forward.is_empty() {
-                let (n, u) = self.record_forward(cmd, scene, &plan.forward, cull, extent);
+                let (n, u) = self.record_forward(cmd, scene, frame, extent);
                 drawn += n;
                 unshadowed += u;
             }
@@ -428,24 +421,22 @@ impl CameraPass {
         &self,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-        forward: &[&Draw],
-        cull: &CameraCull,
+        frame: &CameraFrame,
         extent: vk::Extent2D,
     ) -> (usize, usize) {
+        let cull = &frame.cull;
         let d = &self.ctx.device;
         let (mut drawn, mut unshadowed) = (0, 0);
         unsafe {
             bind_geometry(d, cmd, scene);
             let mut bound_material = usize::MAX;
             let mut bound_pipeline = vk::Pipeline::null();
-            for &dr in forward {
+            for (&i, split) in frame.defer.forward.iter().zip(&frame.splits) {
+                let dr = &scene.draws[i];
                 let entry = Entry::of(dr.alpha, cull.debug_view);
                 let bits = dr.material_bits | cull.frame_bits;
-                let split = cull.shadow_reach.as_ref().map_or(Split::Shadowed, |r| {
-                    receivers::split(r, dr, &cull.clip_from_world, extent)
-                });
-                unshadowed += usize::from(split != Split::Shadowed);
-                let pieces = pieces(bits, split);
+                unshadowed += usize::from(*split != Split::Shadowed);
+                let pieces = pieces(bits, split.clone());
                 drawn += 1;
                 if dr.material != bound_material {
                     d.cmd_bind_descriptor_sets(
@@ -533,7 +524,8 @@ impl CameraPass {
         self.begin_rendering(cmd, &rendering, extent, frame_set);
         unsafe { d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline) };
         bind_geometry(d, cmd, scene);
-        for &(dr, mark) in &plan.deferred {
+        for &(i, mark) in &plan.deferred {
+            let dr = &scene.draws[i];
             unsafe { d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, mark) };
             scene.record_draw(
                 cmd,
@@ -655,14 +647,15 @@ fn bind_geometry(d: &ash::Device, cmd: vk::CommandBuffer, scene: &GpuScene) {
 /// shading; flat draws that hide nothing from the eye, such as the ground, after the others),
 /// then the alpha-masked ones, then the blended ones back to front (farthest bounds centre
 /// first: each is blended over everything behind it).
-fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
-    let mut v: Vec<((AlphaDraw, bool), f32, &Draw)> = scene
+fn draw_order(scene: &GpuScene, cull: &CameraCull) -> Vec<usize> {
+    let mut v: Vec<((AlphaDraw, bool), f32, usize)> = scene
         .draws
         .iter()
-        .filter(|dr| {
+        .enumerate()
+        .filter(|(_, dr)| {
             !scene.frustum_culling || !dr.world_bounds.outside_clip_volume(&cull.clip_from_world)
         })
-        .map(|dr| {
+        .map(|(i, dr)| {
             let nearest = cull.eye.0.clamp(dr.world_bounds.min, dr.world_bounds.max);
             // A ground plane's nearest point is right under the eye, but it hides nothing: drawn
             // last, its fragments behind everything else fail the early depth test.
@@ -674,11 +667,59 @@ fn draw_order<'a>(scene: &'a GpuScene, cull: &CameraCull) -> Vec<&'a Draw> {
                 AlphaDraw::Blended => -dr.world_bounds.center().distance_squared(cull.eye.0),
                 _ => nearest.distance_squared(cull.eye.0),
             };
-            (key, distance, dr)
+            (key, distance, i)
         })
         .collect();
     v.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    v.into_iter().map(|(_, _, dr)| dr).collect()
+    v.into_iter().map(|(_, _, i)| i).collect()
+}
+
+/// What the camera pass records in one frame, decided before recording: its culling inputs, the
+/// draws in order split between the G-buffer and the forward pass, and for each forward draw
+/// whether it needs the shadow lookup everywhere, nowhere or in part (`receivers::split`).
+pub struct CameraFrame {
+    /// The culling and variant inputs.
+    pub cull: CameraCull,
+    /// Draw the shadow map full-screen instead of the scene (the map debug view).
+    pub shadow_map_view: bool,
+    /// Deferred and forward draws.
+    pub defer: DeferPlan,
+    /// Per forward draw (`defer.forward`), its receiver split.
+    pub splits: Vec<Split>,
+}
+
+impl CameraPass {
+    /// Decides what the camera pass draws for `cull` at `extent`: the draw order, the deferred
+    /// split (`deferred::plan`) and each forward draw's receiver split.
+    pub fn plan_frame(
+        &self,
+        scene: &GpuScene,
+        cull: CameraCull,
+        extent: vk::Extent2D,
+        shadow_map_view: bool,
+    ) -> CameraFrame {
+        let order = if shadow_map_view {
+            Vec::new()
+        } else {
+            draw_order(scene, &cull)
+        };
+        let defer = deferred::plan(order, &scene.draws, &cull, extent, self.deferred);
+        let splits = defer
+            .forward
+            .iter()
+            .map(|&i| {
+                cull.shadow_reach.as_ref().map_or(Split::Shadowed, |r| {
+                    receivers::split(r, &scene.draws[i], &cull.clip_from_world, extent)
+                })
+            })
+            .collect();
+        CameraFrame {
+            cull,
+            shadow_map_view,
+            defer,
+            splits,
+        }
+    }
 }
 
 /// Draws one camera pass recorded.

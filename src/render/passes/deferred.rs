@@ -111,14 +111,16 @@ pub struct Resolved {
     pub rect: PixelRect,
 }
 
-/// How a frame's draws split between the G-buffer and the forward pass.
-pub struct DeferPlan<'a> {
+/// How a frame's draws split between the G-buffer and the forward pass (draws as indices into
+/// `GpuScene::draws`).
+#[derive(Clone, Debug, Default)]
+pub struct DeferPlan {
     /// Draws into the G-buffer, each with its material's stencil mark, in the given order.
-    pub deferred: Vec<(&'a Draw, u32)>,
+    pub deferred: Vec<(usize, u32)>,
     /// The materials to resolve.
     pub resolved: Vec<Resolved>,
     /// The rest, drawn forward after the resolve, in the given order.
-    pub forward: Vec<&'a Draw>,
+    pub forward: Vec<usize>,
 }
 
 /// Splits `order` (the camera pass's draw order) for `cull`'s frame at `extent`; with `enabled`
@@ -126,18 +128,20 @@ pub struct DeferPlan<'a> {
 /// all, everything is forward. The viewer's highlighted draw stays forward (its tint is a
 /// forward-shader immediate), and past 255 candidate materials those covering the fewest
 /// pixels too (`keep_largest_materials`).
-pub fn plan<'a>(
-    order: Vec<&'a Draw>,
+pub fn plan(
+    order: Vec<usize>,
+    draws: &[Draw],
     cull: &CameraCull,
     extent: vk::Extent2D,
     enabled: bool,
-) -> DeferPlan<'a> {
+) -> DeferPlan {
+    let refs: Vec<&Draw> = order.iter().map(|&i| &draws[i]).collect();
     let mut p = DeferPlan {
         deferred: Vec::new(),
         resolved: Vec::new(),
         forward: Vec::new(),
     };
-    let mut micro: Vec<Option<(PixelRect, f32)>> = order
+    let mut micro: Vec<Option<(PixelRect, f32)>> = refs
         .iter()
         .map(|dr| {
             (enabled && cull.debug_view.is_none() && cull.highlight != Some(dr.source))
@@ -145,17 +149,17 @@ pub fn plan<'a>(
                 .flatten()
         })
         .collect();
-    keep_largest_materials(&order, &mut micro);
-    let candidates: u32 = order
+    keep_largest_materials(&refs, &mut micro);
+    let candidates: u32 = refs
         .iter()
         .zip(&micro)
         .filter(|(_, m)| m.is_some())
         .map(|(dr, _)| dr.index_count / 3)
         .sum();
     let worth_a_pass = candidates >= DEFER_MIN_FRAME_TRIANGLES;
-    for (dr, micro) in order.into_iter().zip(micro) {
+    for ((&i, dr), micro) in order.iter().zip(refs).zip(micro) {
         let Some((rect, _)) = micro.filter(|_| worth_a_pass) else {
-            p.forward.push(dr);
+            p.forward.push(i);
             continue;
         };
         let known = p.resolved.iter().position(|r| r.material == dr.material);
@@ -176,7 +180,7 @@ pub fn plan<'a>(
                 mark
             }
         };
-        p.deferred.push((dr, mark));
+        p.deferred.push((i, mark));
     }
     p
 }
@@ -370,8 +374,12 @@ mod tests {
                 ..draw(8, 1000, 0.01, Vec3::new(2.0, 0.0, -10.0))
             },
         ];
-        let p = plan(draws.iter().collect(), &c, extent, true);
-        let marks: Vec<(usize, u32)> = p.deferred.iter().map(|(d, m)| (d.material, *m)).collect();
+        let p = plan((0..draws.len()).collect(), &draws, &c, extent, true);
+        let marks: Vec<(usize, u32)> = p
+            .deferred
+            .iter()
+            .map(|&(d, m)| (draws[d].material, m))
+            .collect();
         assert_eq!(marks, [(3, 1), (3, 1), (5, 2)]);
         assert_eq!(p.resolved.len(), 2);
         // Material 3's rectangle covers both of its draws' boxes.
@@ -379,20 +387,21 @@ mod tests {
         let a = screen_rect(&draws[0], &c.clip_from_world, extent).unwrap();
         let b = screen_rect(&draws[1], &c.clip_from_world, extent).unwrap();
         assert_eq!(r, a.union(b));
-        let forward: Vec<usize> = p.forward.iter().map(|d| d.material).collect();
+        let forward: Vec<usize> = p.forward.iter().map(|&d| draws[d].material).collect();
         assert_eq!(forward, [6, 7, 8]);
         // Off, in a debug view, or for the highlighted draw: forward.
-        assert!(plan(draws.iter().collect(), &c, extent, false)
+        assert!(plan((0..draws.len()).collect(), &draws, &c, extent, false)
             .deferred
             .is_empty());
         c.highlight = Some((3, 1));
-        let p = plan(draws.iter().collect(), &c, extent, true);
-        let sources: Vec<(usize, usize)> = p.deferred.iter().map(|(d, _)| d.source).collect();
+        let p = plan((0..draws.len()).collect(), &draws, &c, extent, true);
+        let sources: Vec<(usize, usize)> =
+            p.deferred.iter().map(|&(d, _)| draws[d].source).collect();
         assert_eq!(sources, [(3, 0), (5, 0)]);
-        assert_eq!(p.forward[0].source, (3, 1));
+        assert_eq!(draws[p.forward[0]].source, (3, 1));
         c.highlight = None;
         c.debug_view = Some(crate::render::passes::cull::Entry::Debug);
-        assert!(plan(draws.iter().collect(), &c, extent, true)
+        assert!(plan((0..draws.len()).collect(), &draws, &c, extent, true)
             .deferred
             .is_empty());
     }
@@ -408,12 +417,12 @@ mod tests {
             draw(3, 2000, 0.01, Vec3::new(1.0, 0.0, -10.0)),
             draw(4, 2000, 0.01, Vec3::new(0.0, 1.0, -10.0)),
         ];
-        let p = plan(draws[..3].iter().collect(), &c, extent, true);
+        let p = plan((0..3).collect(), &draws, &c, extent, true);
         assert!(p.deferred.is_empty() && p.resolved.is_empty());
-        let forward: Vec<usize> = p.forward.iter().map(|d| d.material).collect();
+        let forward: Vec<usize> = p.forward.iter().map(|&d| draws[d].material).collect();
         assert_eq!(forward, [1, 2, 3]);
-        let p = plan(draws.iter().collect(), &c, extent, true);
-        let deferred: Vec<usize> = p.deferred.iter().map(|(d, _)| d.material).collect();
+        let p = plan((0..draws.len()).collect(), &draws, &c, extent, true);
+        let deferred: Vec<usize> = p.deferred.iter().map(|&(d, _)| draws[d].material).collect();
         assert_eq!(deferred, [1, 3, 4]);
         assert_eq!(p.forward.len(), 1);
     }
@@ -433,13 +442,13 @@ mod tests {
                 draw(i, 1000, area, Vec3::new(0.0, 0.0, -10.0))
             })
             .collect();
-        let p = plan(draws.iter().collect(), &c, extent, true);
+        let p = plan((0..draws.len()).collect(), &draws, &c, extent, true);
         assert_eq!(p.resolved.len(), MAX_MARKS);
-        let deferred: Vec<usize> = p.deferred.iter().map(|(d, _)| d.material).collect();
+        let deferred: Vec<usize> = p.deferred.iter().map(|&(d, _)| draws[d].material).collect();
         let mut expected: Vec<usize> = (0..254).collect();
         expected.push(299);
         assert_eq!(deferred, expected);
-        let forward: Vec<usize> = p.forward.iter().map(|d| d.material).collect();
+        let forward: Vec<usize> = p.forward.iter().map(|&d| draws[d].material).collect();
         assert_eq!(forward, (254..299).collect::<Vec<_>>());
     }
 }
