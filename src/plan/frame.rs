@@ -348,6 +348,29 @@ fn frame_variant_bits(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `plan_frame` at the world origin with software depth comparison.
+    fn plan_at(
+        lights: &[Light],
+        bounds: &Aabb,
+        receivers: &[Aabb],
+        view: &View,
+        aspect: f32,
+        height_px: u32,
+    ) -> FramePlan {
+        let scene = PlanScene {
+            lights,
+            bounds,
+            receivers,
+            origin: Vec3::ZERO,
+        };
+        let target = PlanTarget {
+            aspect,
+            height_px,
+            hw_compare: false,
+        };
+        plan_frame(&scene, view, &target)
+    }
     use crate::plan::lights::*;
     use crate::plan::settings::AUTO_AMBIENT;
     use crate::scene::Camera;
@@ -383,20 +406,7 @@ mod tests {
             0.8,
             0.1,
         ));
-        let p = plan_frame(
-            &PlanScene {
-                lights: &[sun],
-                bounds: &room,
-                receivers: &boxes,
-                origin: Vec3::ZERO,
-            },
-            &v,
-            &PlanTarget {
-                aspect: 1.5,
-                height_px: 100,
-                hw_compare: false,
-            },
-        );
+        let p = plan_at(&[sun], &room, &boxes, &v, 1.5, 100);
         assert!((p.ambient - Vec3::splat(AUTO_AMBIENT * 3.0)).length() < 1e-5);
         let k = crate::math::tonemap::KEY_VALUE;
         assert!((p.exposure - k / (3.0 * (1.0 + AUTO_AMBIENT))).abs() < 1e-5);
@@ -408,40 +418,14 @@ mod tests {
         let mut s = demo_scene();
         s.lights.clear();
         let mut v = View::new(s.default_camera(1.5));
-        let p = plan_frame(
-            &PlanScene {
-                lights: &s.lights,
-                bounds: &s.bounds(),
-                receivers: &[],
-                origin: Vec3::ZERO,
-            },
-            &v,
-            &PlanTarget {
-                aspect: 1.5,
-                height_px: 720,
-                hw_compare: false,
-            },
-        );
+        let p = plan_at(&s.lights, &s.bounds(), &[], &v, 1.5, 720);
         // The compact demo keeps one map by default (automatic cascade count).
         assert_eq!(p.shadow_views.len(), 1);
         assert_eq!(p.lights.len(), 1);
         assert_eq!(p.shadow_light, Some(0));
         assert!(p.texel_world() > 0.0);
         v.sun_direction = Some(Vec3::new(0.0, -1.0, 0.0));
-        let p = plan_frame(
-            &PlanScene {
-                lights: &s.lights,
-                bounds: &s.bounds(),
-                receivers: &[],
-                origin: Vec3::ZERO,
-            },
-            &v,
-            &PlanTarget {
-                aspect: 1.5,
-                height_px: 720,
-                hw_compare: false,
-            },
-        );
+        let p = plan_at(&s.lights, &s.bounds(), &[], &v, 1.5, 720);
         assert_eq!(p.lights[0].direction, Vec3::NEG_Y);
         assert_eq!(p.uniform.modes[3], 1);
         // One light, shadows on, PCF 2×2 by hand (hw_compare false).
@@ -450,20 +434,7 @@ mod tests {
         assert_eq!(p.shader_variant, want);
         // Cascades: four views, nearest first, each ending where the next blends in.
         v.shadow.cascades = 4;
-        let p = plan_frame(
-            &PlanScene {
-                lights: &s.lights,
-                bounds: &s.bounds(),
-                receivers: &[],
-                origin: Vec3::ZERO,
-            },
-            &v,
-            &PlanTarget {
-                aspect: 1.5,
-                height_px: 720,
-                hw_compare: false,
-            },
-        );
+        let p = plan_at(&s.lights, &s.bounds(), &[], &v, 1.5, 720);
         assert_eq!(p.shader_variant, want | sh::BIT_MANY_VIEWS);
         assert_eq!(p.shadow_views.len(), 4);
         for w in p.shadow_views.windows(2) {
@@ -473,20 +444,7 @@ mod tests {
         assert!(p.shadow_views[3].far.is_infinite());
         // Without shadows the filter, comparison and cascade bits mean nothing: one shader.
         v.shadow.enabled = false;
-        let p = plan_frame(
-            &PlanScene {
-                lights: &s.lights,
-                bounds: &s.bounds(),
-                receivers: &[],
-                origin: Vec3::ZERO,
-            },
-            &v,
-            &PlanTarget {
-                aspect: 1.5,
-                height_px: 720,
-                hw_compare: false,
-            },
-        );
+        let p = plan_at(&s.lights, &s.bounds(), &[], &v, 1.5, 720);
         assert_eq!(p.shader_variant, sh::BIT_SINGLE_LIGHT);
     }
     #[test]
@@ -498,22 +456,7 @@ mod tests {
         let at = |k: f32| Camera::look_at(c + (eye - c) * k, c, cam.fov_y, cam.near);
         let mut v = View::new(cam);
         v.shadow.cascades = 4;
-        let plan = |v: &View| {
-            plan_frame(
-                &PlanScene {
-                    lights: &sun,
-                    bounds: &s.bounds(),
-                    receivers: &[],
-                    origin: Vec3::ZERO,
-                },
-                v,
-                &PlanTarget {
-                    aspect: 1.5,
-                    height_px: 720,
-                    hw_compare: false,
-                },
-            )
-        };
+        let plan = |v: &View| plan_at(&sun, &s.bounds(), &[], v, 1.5, 720);
         let range = |p: &FramePlan| p.primary_views()[0].depth_range.unwrap();
         let splits = |p: &FramePlan| p.primary_views().iter().map(|v| v.far).collect::<Vec<_>>();
         let first = plan(&v);
@@ -574,20 +517,7 @@ mod tests {
         let lights = vec![sun, point(-2.0), dark, spot, point(2.0), point(4.0)];
         let mut v = View::new(s.default_camera(1.5));
         v.shadow.cascades = 4;
-        let p = plan_frame(
-            &PlanScene {
-                lights: &lights,
-                bounds: &s.bounds(),
-                receivers: &[],
-                origin: Vec3::ZERO,
-            },
-            &v,
-            &PlanTarget {
-                aspect: 1.5,
-                height_px: 720,
-                hw_compare: false,
-            },
-        );
+        let p = plan_at(&lights, &s.bounds(), &[], &v, 1.5, 720);
         // Sun 4 cascades, point 6 faces, spot 1: 11 of 16; the next two point lights need 6
         // each, more than the 5 left, and the light that casts none gets none.
         let per_light: Vec<usize> = (0..lights.len()).map(|i| p.light_views(i).len()).collect();
@@ -605,20 +535,7 @@ mod tests {
         // The shown light: the first shadowed one, or the one asked for if it has views.
         assert_eq!(p.shadow_light, Some(0));
         v.shown_light = Some(3);
-        let p = plan_frame(
-            &PlanScene {
-                lights: &lights,
-                bounds: &s.bounds(),
-                receivers: &[],
-                origin: Vec3::ZERO,
-            },
-            &v,
-            &PlanTarget {
-                aspect: 1.5,
-                height_px: 720,
-                hw_compare: false,
-            },
-        );
+        let p = plan_at(&lights, &s.bounds(), &[], &v, 1.5, 720);
         assert_eq!(
             (
                 p.shadow_light,
@@ -628,20 +545,7 @@ mod tests {
             (Some(3), 10.0, 1.0)
         );
         v.shown_light = Some(4);
-        let p = plan_frame(
-            &PlanScene {
-                lights: &lights,
-                bounds: &s.bounds(),
-                receivers: &[],
-                origin: Vec3::ZERO,
-            },
-            &v,
-            &PlanTarget {
-                aspect: 1.5,
-                height_px: 720,
-                hw_compare: false,
-            },
-        );
+        let p = plan_at(&lights, &s.bounds(), &[], &v, 1.5, 720);
         assert_eq!(p.shadow_light, Some(0));
         // A point light's faces look along ±x, ±y, ±z: each face's centre direction lands in the
         // middle of its own layer.
