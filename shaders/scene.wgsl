@@ -119,7 +119,7 @@ fn vs_main(v: VsIn) -> VsOut {
 // - fs_debug, the shadow-visibility and normals views, for every material.
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    return vec4<f32>(highlight(display(shade(in, front_facing, base_color(in.uv, in.color)).color)), 1.0);
+    return vec4<f32>(highlight(display_surface(shade(in, front_facing, base_color(in.uv, in.color)).color)), 1.0);
 }
 
 @fragment
@@ -178,7 +178,7 @@ fn fs_resolve(full: FullscreenOut) -> @location(0) vec4<f32> {
         t.mr = textureSampleGrad(metal_rough_tex, metal_rough_sampler, slot_uv(2u, in.uv), slot_grad(2u, dx), slot_grad(2u, dy));
         t.emissive = textureSampleGrad(emissive_tex, emissive_sampler, slot_uv(3u, in.uv), slot_grad(3u, dx), slot_grad(3u, dy)).rgb;
     }
-    return vec4<f32>(display(shade_texels(in, front_facing, base, t).color), 1.0);
+    return vec4<f32>(display_surface(shade_texels(in, front_facing, base, t).color), 1.0);
 }
 
 // Blended materials: the lit colour with the base colour's alpha, blended over what lies behind
@@ -187,7 +187,7 @@ fn fs_resolve(full: FullscreenOut) -> @location(0) vec4<f32> {
 @fragment
 fn fs_blend(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let base = base_color(in.uv, in.color);
-    return vec4<f32>(highlight(display(shade(in, front_facing, base).color)), clamp(base.a, 0.0, 1.0));
+    return vec4<f32>(highlight(display_surface(shade(in, front_facing, base).color)), clamp(base.a, 0.0, 1.0));
 }
 
 @fragment
@@ -196,7 +196,7 @@ fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(
     if base.a < material.extra.x {
         discard;
     }
-    return vec4<f32>(highlight(display(shade(in, front_facing, base).color)), 1.0);
+    return vec4<f32>(highlight(display_surface(shade(in, front_facing, base).color)), 1.0);
 }
 
 // A colour ramp of rising brightness: dark blue, teal, yellow, white over t in [0, 1].
@@ -258,8 +258,10 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
         return vec4<f32>(srgb_to_linear(vec3<f32>(clamp(v, 0.0, 1.0))), 1.0);
     }
     if mode == VIEW_DEPTH {
-        // Linear view depth (1 / w of the fragment), white at the eye, black at the scene's far end.
-        let d = 1.0 / max(in.clip.w, 1e-30);
+        // Linear view depth (1 / w of the fragment; under an orthographic camera, where w is 1,
+        // the distance along the view), white at the eye, black at the scene's far end.
+        let along = dot(in.world_position - frame.camera_position.xyz, frame.eye_forward.xyz);
+        let d = select(1.0 / max(in.clip.w, 1e-30), along, frame.eye_forward.w > 0.5);
         return vec4<f32>(srgb_to_linear(vec3<f32>(1.0 - clamp(d / frame.shadow.z, 0.0, 1.0))), 1.0);
     }
     if mode == VIEW_TEXEL_DENSITY {
@@ -316,6 +318,17 @@ fn vs_fullscreen(@builtin(vertex_index) index: u32) -> FullscreenOut {
     out.clip = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 0.0, 1.0);
     out.uv = uv;
     return out;
+}
+
+// The background where no surface was drawn (depth still 0): the ambient hemisphere seen along
+// the pixel's view direction, exposed and tone-mapped (the reference's background too).
+@fragment
+fn fs_sky(full: FullscreenOut) -> @location(0) vec4<f32> {
+    let ndc = vec2<f32>(full.uv.x * 2.0 - 1.0, 1.0 - full.uv.y * 2.0);
+    let near = frame.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
+    let mid = frame.world_from_clip * vec4<f32>(ndc, 0.5, 1.0);
+    let dir = normalize(mid.xyz / mid.w - near.xyz / near.w);
+    return vec4<f32>(display(ambient_at(dir)), 1.0);
 }
 
 // The shadow map itself: grey = stored depth (reversed-z: white is nearest the light), row 0 on top.

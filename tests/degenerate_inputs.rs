@@ -49,13 +49,18 @@ fn write_gltf(
 }
 
 fn render_clean(scene: &umbra::scene::Scene) -> image::RgbaImage {
+    render_clean_with_plan(scene).0
+}
+
+/// `render_clean`, with the plan the frame was drawn with.
+fn render_clean_with_plan(scene: &umbra::scene::Scene) -> (image::RgbaImage, umbra::FramePlan) {
     let ctx = context();
     let mut r = Renderer::new(&ctx, scene).unwrap();
     let f = r
         .render(&View::new(scene.default_camera(1.0)), 64, 64)
         .unwrap();
     assert_validation_clean(&ctx);
-    f.image
+    (f.image, f.plan)
 }
 
 #[test]
@@ -153,10 +158,17 @@ fn a_scene_without_instances_renders_the_background() {
         .warnings
         .iter()
         .any(|w| w.message.contains("no mesh instances") && w.code == "SCENE_EMPTY"));
-    let img = render_clean(&s);
-    let first = *img.get_pixel(0, 0);
-    assert!(
-        img.pixels().all(|p| *p == first),
-        "nothing but the clear colour"
-    );
+    let (img, plan) = render_clean_with_plan(&s);
+    // Nothing but the sky: each pixel the hemisphere seen along its direction (within a level
+    // of the CPU's evaluation), darker below the horizon than above.
+    let want = plan.background_image(img.width(), img.height());
+    let worst = img
+        .pixels()
+        .zip(want.pixels())
+        .flat_map(|(a, b)| (0..3).map(move |k| (a[k] as i32 - b[k] as i32).abs()))
+        .max()
+        .unwrap();
+    assert!(worst <= 1, "the background differs by {worst} levels");
+    let (top, bottom) = (img.get_pixel(32, 0), img.get_pixel(32, img.height() - 1));
+    assert_ne!(top, bottom, "a gradient, not one colour");
 }

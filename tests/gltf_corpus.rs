@@ -60,9 +60,8 @@ fn see(ctx: &std::sync::Arc<umbra::gpu::Context>, scene: &Scene, name: &str) -> 
         let mut r = Renderer::new(ctx, s).unwrap_or_else(|e| panic!("{name}: {e}"));
         r.set_read_depth(true);
         let mut view = View::new(camera);
-        // A sun from the left, shadows falling to the right of the model as the camera sees it
-        // (the default sun throws them behind the model, where the model hides them).
-        view.sun_direction = Some(glam::Vec3::new(0.7, -1.0, -0.2));
+        // The default sun: from the upper left in front of the model, its shadow falling
+        // behind it to the right.
         let lit = r.render(&view, W, H).unwrap();
         view.mode = ViewMode::Shadow;
         let vis = r.render(&view, W, H).unwrap();
@@ -111,11 +110,12 @@ fn every_model_draws_itself_and_casts_a_shadow() {
             "{name}: {} model px, {} shadow px",
             seen.model_pixels, seen.shadow_pixels
         ));
-        // Measured (160×120): the smallest model covers 1,181 px (Fox; generated: 1,809) and the
-        // smallest shadow 118 px (strips_and_fans); the bounds sit at about 3/4 of that.
-        if seen.model_pixels < 900 || seen.shadow_pixels < 80 {
+        // Measured (160×120, the default front view and sun): the smallest model covers 1,174
+        // px (hierarchy; real: Fox 1,253) and the smallest shadow 162 px (strips_and_fans: its
+        // wall hides most of it); the bounds sit at about 3/4 of that.
+        if seen.model_pixels < 900 || seen.shadow_pixels < 120 {
             failures.push(format!(
-                "{}: {} model px (need 900), {} shadow px (need 80)",
+                "{}: {} model px (need 900), {} shadow px (need 120)",
                 path.display(),
                 seen.model_pixels,
                 seen.shadow_pixels

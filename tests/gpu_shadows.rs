@@ -237,7 +237,7 @@ fn huge_tiny_and_far_scenes_match_geometry() {
         let target = m.transform_point3(
             local_cam.position() + local_cam.world_from_view.transform_vector3(-Vec3::Z),
         );
-        let cam = Camera::look_at(eye, target, local_cam.fov_y, 0.1 * scale);
+        let cam = Camera::look_at(eye, target, local_cam.fov_y().unwrap(), 0.1 * scale);
         let f = r.render(&shadow_view(cam), W, H).unwrap();
         let (j, diff) = judge(&f, &light, EDGE_TEXELS * f.plan.texel_world() / scale);
         save(&diff, &format!("placed_{scale}_{}_diff.png", offset.x));

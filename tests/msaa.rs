@@ -164,9 +164,11 @@ fn msaa_error_on_edges_falls_with_sample_count() {
                     sum += d as f64;
                     worst = worst.max(d);
                 } else if let Some(one) = one_sample.as_ref().filter(|_| flat[i]) {
-                    // Away from edges MSAA shades as one sample does.
+                    // Away from edges MSAA shades as one sample does (within rounding: on a
+                    // face's inner diagonal each triangle shades its samples at its own
+                    // centroid, which moves the specular term by a level or two).
                     let q = one.get_pixel(x, y).0;
-                    off_edge += (0..3).any(|k| p[k].abs_diff(q[k]) > 1) as usize;
+                    off_edge += (0..3).any(|k| p[k].abs_diff(q[k]) > 2) as usize;
                 }
             }
         }
@@ -174,7 +176,7 @@ fn msaa_error_on_edges_falls_with_sample_count() {
         eprintln!(
             "{n} sample(s): edge pixels {edges}, mean error against 16× supersampling \
              {mean:.2} levels (worst {worst:.0}); {off_edge} of {} flat pixels differ from 1 \
-             sample by more than 1 level",
+             sample by more than 2 levels",
             flat.iter().filter(|&&f| f).count()
         );
         if n == 1 {
@@ -193,8 +195,8 @@ fn msaa_error_on_edges_falls_with_sample_count() {
     }
     let (_, e1, _) = results[0];
     let (n, en, _) = *results.last().unwrap();
-    // Measured on lavapipe (1 and 4 samples): 30.79 and 10.17 levels (0.33×); 0 flat pixels
-    // changed.
+    // Measured on lavapipe (1 and 4 samples): 29.97 and 9.56 levels (0.32×); 0 flat pixels
+    // changed by more than 2 levels (3, on a box face's inner diagonal, by 2).
     assert!(
         en < 0.4 * e1,
         "{n} samples: {en:.2} levels against {e1:.2} at 1"

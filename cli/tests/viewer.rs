@@ -428,7 +428,7 @@ fn a_click_picks_the_node_mesh_and_triangle_under_it() {
 
 #[test]
 fn the_viewer_plays_and_steps_animations_like_the_offscreen_render() {
-    // The skinned bar: started paused at 0.2 s and stepped 6 frames of 1/30 s with `O` it
+    // The skinned bar: started paused at 0.2 s and stepped 6 frames of 1/30 s with `I` it
     // stands at 0.4 s; the offscreen render at --time 0.4 must show the same pose. Then `R`
     // (next: all animations, from 0 playing) and `space` (pause) on the same run leave no
     // validation message.
@@ -457,7 +457,7 @@ fn the_viewer_plays_and_steps_animations_like_the_offscreen_render() {
     ];
     args.extend([
         "--script",
-        "key:o*6",
+        "key:i*6",
         "--screenshot",
         shot.to_str().unwrap(),
     ]);

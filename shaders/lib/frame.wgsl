@@ -60,8 +60,10 @@ struct Frame {
     world_from_clip: mat4x4<f32>,
     // xyz: camera position in world
     camera_position: vec4<f32>,
-    // rgb: ambient intensity Ia
-    ambient: vec4<f32>,
+    // rgb: ambient Ia of a surface facing up (the sky)
+    ambient_sky: vec4<f32>,
+    // rgb: ambient Ia of a surface facing down (the ground); between, mixed by the normal's y
+    ambient_ground: vec4<f32>,
     // x: shadow-map size in texels, y: normal-offset bias in texels,
     // z: view depth that the depth view draws black (the scene's far end), w: 1 if shadows on
     shadow: vec4<f32>,
@@ -72,11 +74,14 @@ struct Frame {
     bias: vec4<f32>,
     // xyz: the shadow-fitting camera's forward (view depth = dot(p - shadow_light.xyz, forward))
     camera_forward: vec4<f32>,
+    // xyz: the view camera's forward; w: 1 for an orthographic camera (seen along xyz everywhere)
+    eye_forward: vec4<f32>,
     // x: view mode, y: PCF kernel width in bilinear taps (0 = single nearest compare),
     // z: 1 if hardware linear comparison filtering is used, w: number of lights
     modes: vec4<u32>,
     // x: exposure (linear scale before tone mapping), y: tone-mapping operator (0 none, 1 Khronos
-    // PBR Neutral, 2 ACES Hill)
+    // PBR Neutral, 2 ACES Hill), z: the scale of unlit colours, w: 1 when unlit colours are shown
+    // as authored (times z, no tone curve), 0 when exposed and tone-mapped like lit ones
     output: vec4<f32>,
     lights: array<Light, 8>,
     // Layer i of the shadow map belongs to view i.

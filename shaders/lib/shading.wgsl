@@ -16,6 +16,12 @@ fn base_color(uv: vec4<f32>, color: vec4<f32>) -> vec4<f32> {
     return base;
 }
 
+// The ambient hemisphere's Ia for unit normal (or view direction) `n`: the ground's facing
+// down, the sky's facing up, mixed by the up component (src/plan/settings.rs `Ambient::at`).
+fn ambient_at(n: vec3<f32>) -> vec3<f32> {
+    return mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, clamp(0.5 + 0.5 * n.y, 0.0, 1.0));
+}
+
 struct Shaded {
     color: vec3<f32>,
     // The shading normal (after normal mapping, facing the viewer).
@@ -82,10 +88,11 @@ fn shade_texels(in: VsOut, front_facing: bool, base: vec4<f32>, texels: Texels) 
     }
 
     let p = in.world_position;
-    let v = normalize(frame.camera_position.xyz - p);
+    // Towards the eye, or against the viewing direction under an orthographic camera.
+    let v = select(normalize(frame.camera_position.xyz - p), -frame.eye_forward.xyz, frame.eye_forward.w > 0.5);
     // Occlusion (mr.r) scales the ambient term only: 1 + strength * (occlusion - 1).
     let occlusion = 1.0 + material.params.z * (mr.r - 1.0);
-    var color = ka * frame.ambient.rgb * occlusion + emissive;
+    var color = ka * ambient_at(n) * occlusion + emissive;
     var shadow_term = 1.0;
     var cascade = -1;
     // One light: a constant trip count the driver unrolls (a uniform count costs a real loop).

@@ -14,6 +14,15 @@ fn display(c: vec3<f32>) -> vec3<f32> {
     return clamp(x, vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
+// The displayed colour of a surface of the draw's material: an unlit one as authored at the
+// automatic exposure (output.w = 1: times output.z, clamped; no tone curve), else `display`.
+fn display_surface(c: vec3<f32>) -> vec3<f32> {
+    if material.params.w > 0.5 && frame.output.w > 0.5 {
+        return clamp(c * frame.output.z, vec3<f32>(0.0), vec3<f32>(1.0));
+    }
+    return display(c);
+}
+
 // Khronos PBR Neutral.
 fn pbr_neutral(c_in: vec3<f32>) -> vec3<f32> {
     let start = 0.76;

@@ -228,7 +228,6 @@ pub struct Context {
     /// The graphics queue (also used for transfers).
     pub(crate) queue: vk::Queue,
     /// Its family index.
-    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
     pub(crate) queue_family: u32,
     /// Device properties.
     pub(crate) properties: vk::PhysicalDeviceProperties,
@@ -254,6 +253,20 @@ pub struct Context {
     pub(crate) device: DeviceOwner,
     /// The instance (and loader).
     pub(crate) instance: InstanceOwner,
+}
+
+/// The raw Vulkan objects of a [`Context`] ([`Context::raw`]).
+pub struct RawVulkan<'a> {
+    /// The instance.
+    pub instance: &'a ash::Instance,
+    /// The physical device.
+    pub physical: vk::PhysicalDevice,
+    /// The logical device.
+    pub device: &'a ash::Device,
+    /// The graphics queue every frame is submitted to.
+    pub queue: vk::Queue,
+    /// Its family index.
+    pub queue_family: u32,
 }
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -356,6 +369,19 @@ impl Context {
             device,
             instance,
         }))
+    }
+
+    /// The raw Vulkan objects, for a front end that records its own drawing into a window's
+    /// frames (an on-screen panel: `render::Overlay`). Objects it makes from them must be
+    /// destroyed before the context.
+    pub fn raw(&self) -> RawVulkan<'_> {
+        RawVulkan {
+            instance: &self.instance,
+            physical: self.physical,
+            device: &self.device,
+            queue: self.queue,
+            queue_family: self.queue_family,
+        }
     }
 
     /// The memory allocator.

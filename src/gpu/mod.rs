@@ -9,5 +9,5 @@ pub mod pipeline_cache;
 pub(crate) mod resources;
 pub(crate) mod shaders;
 
-pub use context::{Context, ContextDesc, GpuError, Validation, ValidationLog};
+pub use context::{Context, ContextDesc, GpuError, RawVulkan, Validation, ValidationLog};
 pub(crate) use resources::{Buffer, Image};

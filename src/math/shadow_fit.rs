@@ -15,13 +15,18 @@ use super::projection::{orthographic_reversed, perspective_infinite_reversed};
 use super::Aabb;
 use glam::{Mat4, Vec3, Vec4};
 
-/// A camera frustum to fit against.
+/// A camera frustum to fit against: at view depth d it spans ±h(d) vertically and ±h(d)·aspect
+/// horizontally, with h(d) = `half_height` + `tan_half`·d (a perspective camera: `half_height`
+/// 0, `tan_half` = tan(fov_y / 2); an orthographic one: `tan_half` 0, `half_height` its ymag).
 #[derive(Clone, Copy, Debug)]
 pub struct CameraFrustum {
     /// World → view (right-handed, looking down −Z).
     pub view_from_world: Mat4,
-    /// Vertical field of view in radians.
-    pub fov_y: f32,
+    /// Growth of the half-height with depth (tan of half the vertical field of view; 0 for a
+    /// parallel projection).
+    pub tan_half: f32,
+    /// Half-height at depth 0 (an orthographic camera's ymag; 0 for a perspective one).
+    pub half_height: f32,
     /// Width / height.
     pub aspect: f32,
     /// Near distance.
@@ -31,18 +36,41 @@ pub struct CameraFrustum {
 }
 
 impl CameraFrustum {
+    /// A perspective frustum (`fov_y` in radians).
+    pub fn perspective(
+        view_from_world: Mat4,
+        fov_y: f32,
+        aspect: f32,
+        near: f32,
+        far: f32,
+    ) -> Self {
+        Self {
+            view_from_world,
+            tan_half: (fov_y * 0.5).tan(),
+            half_height: 0.0,
+            aspect,
+            near,
+            far,
+        }
+    }
+
+    /// Half the height of the frustum's cross-section at view depth `d`.
+    pub fn half_height_at(&self, d: f32) -> f32 {
+        self.half_height + self.tan_half * d
+    }
+
     /// The 8 corners in world space: near plane first (−−, +−, −+, ++ in x/y), then far.
     pub fn corners(&self) -> [Vec3; 8] {
         let world_from_view = self.view_from_world.inverse();
-        let ty = (self.fov_y * 0.5).tan();
-        let tx = ty * self.aspect;
         let mut out = [Vec3::ZERO; 8];
         for (i, d) in [self.near, self.far].into_iter().enumerate() {
+            let ty = self.half_height_at(d);
+            let tx = ty * self.aspect;
             for (j, (sx, sy)) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
                 .into_iter()
                 .enumerate()
             {
-                let p = Vec3::new(sx * tx * d, sy * ty * d, -d);
+                let p = Vec3::new(sx * tx, sy * ty, -d);
                 out[i * 4 + j] = world_from_view.transform_point3(p);
             }
         }
@@ -273,16 +301,24 @@ pub fn quantize_extent(x: f32, per_octave: u32) -> f32 {
     (steps / k).exp2()
 }
 
-/// The bounding sphere of a frustum slice: its centre's view depth and its radius. Both depend
-/// only on the slice's near and far distances, field of view and aspect, not on where the camera
-/// is or where it looks.
-pub fn slice_sphere(near: f32, far: f32, fov_y: f32, aspect: f32) -> (f32, f32) {
-    // Half-diagonal of the slice's cross-section per unit depth.
-    let k2 = (fov_y * 0.5).tan().powi(2) * (1.0 + aspect * aspect);
+/// The bounding sphere of the slice of `frustum` between its `near` and `far`: its centre's view
+/// depth and its radius. Both depend only on the slice's near and far distances and the
+/// frustum's shape (field of view or orthographic size, aspect), not on where the camera is or
+/// where it looks.
+pub fn slice_sphere(frustum: &CameraFrustum) -> (f32, f32) {
+    let (near, far) = (frustum.near, frustum.far);
+    // Squared half-diagonals of the near and far cross-sections.
+    let s2 = 1.0 + frustum.aspect * frustum.aspect;
+    let hn2 = frustum.half_height_at(near).powi(2) * s2;
+    let hf2 = frustum.half_height_at(far).powi(2) * s2;
     // Equidistant from the near and far corners, or on the far plane when that is nearer.
-    let z = (0.5 * (near + far) * (1.0 + k2)).clamp(near, far);
-    let r = ((z - near).powi(2) + near * near * k2)
-        .max((far - z).powi(2) + far * far * k2)
+    let z = if far > near {
+        ((far * far - near * near + hf2 - hn2) / (2.0 * (far - near))).clamp(near, far)
+    } else {
+        near
+    };
+    let r = ((z - near).powi(2) + hn2)
+        .max((far - z).powi(2) + hf2)
         .sqrt();
     (z, r)
 }
@@ -299,7 +335,7 @@ fn sphere_square(
     scene_l: &Aabb,
     min_extent: f32,
 ) -> (f32, f32, f32) {
-    let (z, r) = slice_sphere(c.near, c.far, c.fov_y, c.aspect);
+    let (z, r) = slice_sphere(c);
     let world_from_view = c.view_from_world.inverse();
     let centre = view.transform_point3(world_from_view.transform_point3(Vec3::new(0.0, 0.0, -z)));
     let (sw, sh) = (scene_l.max.x - scene_l.min.x, scene_l.max.y - scene_l.min.y);
@@ -471,13 +507,13 @@ mod tests {
     use super::*;
 
     fn camera(eye: Vec3, target: Vec3) -> CameraFrustum {
-        CameraFrustum {
-            view_from_world: Mat4::look_at_rh(eye, target, Vec3::Y),
-            fov_y: 0.8,
-            aspect: 16.0 / 9.0,
-            near: 0.1,
-            far: 60.0,
-        }
+        CameraFrustum::perspective(
+            Mat4::look_at_rh(eye, target, Vec3::Y),
+            0.8,
+            16.0 / 9.0,
+            0.1,
+            60.0,
+        )
     }
 
     fn scene() -> Aabb {
@@ -608,15 +644,20 @@ mod tests {
 
     #[test]
     fn slice_sphere_holds_the_slice_tightly() {
-        for (near, far, fov) in [(0.1f32, 4.0f32, 0.8f32), (1.0, 1.5, 1.2), (0.5, 100.0, 0.3)] {
-            let c = CameraFrustum {
-                view_from_world: Mat4::IDENTITY,
-                fov_y: fov,
-                aspect: 16.0 / 9.0,
-                near,
-                far,
-            };
-            let (z, r) = slice_sphere(near, far, fov, 16.0 / 9.0);
+        let perspective = [(0.1f32, 4.0f32, 0.8f32), (1.0, 1.5, 1.2), (0.5, 100.0, 0.3)].map(
+            |(near, far, fov)| {
+                CameraFrustum::perspective(Mat4::IDENTITY, fov, 16.0 / 9.0, near, far)
+            },
+        );
+        // Parallel projections: a deep box and a shallow one.
+        let orthographic =
+            [(0.1f32, 40.0f32, 2.0f32), (3.0, 3.5, 10.0)].map(|(near, far, h)| CameraFrustum {
+                tan_half: 0.0,
+                half_height: h,
+                ..CameraFrustum::perspective(Mat4::IDENTITY, 1.0, 4.0 / 3.0, near, far)
+            });
+        for c in perspective.into_iter().chain(orthographic) {
+            let (z, r) = slice_sphere(&c);
             let centre = Vec3::new(0.0, 0.0, -z);
             let d: Vec<f32> = c.corners().iter().map(|p| p.distance(centre)).collect();
             let widest = d.iter().copied().fold(0.0, f32::max);

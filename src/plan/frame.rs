@@ -5,7 +5,7 @@ use super::camera::camera_projection;
 use super::casters::{CasterPlan, Viewpoint};
 use super::input::{PlanScene, PlanTarget};
 use super::lights::{effective_lights, light_uniforms, metering};
-use super::settings::{HeldLight, Pcf, ShadowHold, Tonemap, View};
+use super::settings::{Ambient, Background, Exposure, HeldLight, Pcf, ShadowHold, Tonemap, View};
 use super::uniforms::{FrameUniform, MAX_LIGHTS};
 use super::views::{far_view_depth, shadow_views, view_uniforms, ShadowView};
 use crate::math::Aabb;
@@ -29,6 +29,8 @@ pub struct FramePlan {
     pub shadow_map_size: u32,
     /// The camera's world position.
     pub camera_position: Vec3,
+    /// Whether the camera projects in parallel (every pixel seen along its forward direction).
+    pub orthographic: bool,
     /// The scene shader's variant bits this frame sets (one light, shadows sampled, comparison
     /// path, PCF kernel); each draw adds its material's bits.
     pub(crate) shader_variant: usize,
@@ -52,8 +54,16 @@ pub struct FramePlan {
     pub exposure: f32,
     /// The tone-mapping curve of the lit image.
     pub tonemap: Tonemap,
-    /// The ambient intensity Ia this frame is shaded with (`View::ambient` resolved).
-    pub ambient: Vec3,
+    /// The ambient Ia this frame is shaded with (`View::ambient` resolved: the sky and ground
+    /// hemisphere, or a flat one).
+    pub ambient: Ambient,
+    /// What the lit image shows where nothing is drawn.
+    pub background: Background,
+    /// How unlit (KHR_materials_unlit) colours are shown: `Some(k)`, as authored × k, clamped,
+    /// with no tone curve (the automatic exposure: k = 2^compensation, so an authored texel is
+    /// the displayed one whatever lights the scene); `None`, exposed and tone-mapped like lit
+    /// colours (an exposure was given).
+    pub unlit_scale: Option<f32>,
     /// What auto exposure metered for this frame ([`metered_illuminance`] with `ambient`), used
     /// or not.
     pub metered_lux: f32,
@@ -125,6 +135,51 @@ impl FramePlan {
     /// `display`; blended layers are composited after it, as on the GPU).
     pub fn display(&self, rgb: Vec3) -> Vec3 {
         self.tonemap.apply(rgb * self.exposure)
+    }
+
+    /// The display value of a surface's colour (`display_surface`): an unlit material's as
+    /// authored at the automatic exposure ([`FramePlan::unlit_scale`]), else [`Self::display`].
+    pub fn display_surface(&self, rgb: Vec3, unlit: bool) -> Vec3 {
+        match self.unlit_scale {
+            Some(k) if unlit => (rgb * k).clamp(Vec3::ZERO, Vec3::ONE),
+            _ => self.display(rgb),
+        }
+    }
+
+    /// The unit direction the camera looks along at image position (`x`, `y`) (pixel units,
+    /// centres at +0.5) of a `w`×`h` image: from the near plane's point there to the point at
+    /// half the depth range, as the sky pass computes it (from the eye through the pixel for a
+    /// perspective camera; the camera's forward for an orthographic one).
+    pub fn view_direction(&self, x: f32, y: f32, w: u32, h: u32) -> Vec3 {
+        let ndc = crate::math::projection::pixel_to_ndc(x, y, w, h);
+        let inv = self.uniform.world_from_clip;
+        let at = |depth: f32| {
+            let p = inv * Vec4::new(ndc.x, ndc.y, depth, 1.0);
+            p.truncate() / p.w
+        };
+        (at(0.5) - at(1.0)).normalize_or(Vec3::NEG_Z)
+    }
+
+    /// The lit image's background alone at `w`×`h` (what a frame with nothing drawn shows):
+    /// [`Self::background_along`] each pixel's [`Self::view_direction`], sRGB-encoded.
+    pub fn background_image(&self, w: u32, h: u32) -> image::RgbaImage {
+        let byte = |c: f32| {
+            (crate::math::tonemap::linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0).round() as u8
+        };
+        image::RgbaImage::from_fn(w, h, |x, y| {
+            let c =
+                self.background_along(self.view_direction(x as f32 + 0.5, y as f32 + 0.5, w, h));
+            image::Rgba([byte(c.x), byte(c.y), byte(c.z), 255])
+        })
+    }
+
+    /// The lit image's background seen along unit direction `dir` (the sky pass's `fs_sky`):
+    /// the ambient hemisphere exposed and tone-mapped, or the flat colour.
+    pub fn background_along(&self, dir: Vec3) -> Vec3 {
+        match self.background {
+            Background::Sky => self.display(self.ambient.at(dir)),
+            Background::Color(c) => c,
+        }
     }
 
     /// Whether light `i` is shadowed by the map this frame (shadows on and it has views).
@@ -244,11 +299,14 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         .or_else(|| views.first().map(|v| v.light));
     let shadows_on = view.shadow.enabled && shadow_light.is_some();
     let (ambient, metered_lux, exposure) = metering(&lights, scene, view);
+    let unlit_scale = (view.exposure == Exposure::Auto)
+        .then(|| view.exposure_compensation.clamp(-64.0, 64.0).exp2());
     let u = FrameUniform {
         clip_from_world,
         world_from_clip: clip_from_world.as_dmat4().inverse().as_mat4(),
         camera_position: view.camera.position().extend(1.0),
-        ambient: ambient.extend(0.0),
+        ambient_sky: ambient.sky.extend(0.0),
+        ambient_ground: ambient.ground.extend(0.0),
         shadow: Vec4::new(
             size as f32,
             view.shadow.normal_offset,
@@ -268,13 +326,26 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
             .transform_vector3(Vec3::NEG_Z))
         .normalize_or(Vec3::NEG_Z)
         .extend(0.0),
+        eye_forward: view
+            .camera
+            .forward()
+            .extend(if view.camera.is_orthographic() {
+                1.0
+            } else {
+                0.0
+            }),
         modes: [
             view.mode.shader_value(),
             view.shadow.pcf.taps(),
             hw_compare as u32,
             lights.len() as u32,
         ],
-        output: Vec4::new(exposure, view.tonemap.shader_value(), 0.0, 0.0),
+        output: Vec4::new(
+            exposure,
+            view.tonemap.shader_value(),
+            unlit_scale.unwrap_or(1.0),
+            if unlit_scale.is_some() { 1.0 } else { 0.0 },
+        ),
         lights: light_uniforms(&lights, &views, view),
         views: view_uniforms(&views),
     };
@@ -286,6 +357,7 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         soft,
         shadow_map_size: size,
         camera_position: view.camera.position(),
+        orthographic: view.camera.is_orthographic(),
         shader_variant: frame_variant_bits(
             lights.len(),
             shadows_on,
@@ -303,6 +375,8 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         exposure,
         tonemap: view.tonemap,
         ambient,
+        background: view.background,
+        unlit_scale,
         metered_lux,
     }
 }
@@ -372,7 +446,7 @@ mod tests {
         plan_frame(&scene, view, &target)
     }
     use crate::plan::lights::*;
-    use crate::plan::settings::AUTO_AMBIENT;
+    use crate::plan::settings::{AUTO_GROUND, AUTO_SKY, GROUND_TINT, SKY_TINT};
     use crate::scene::Camera;
 
     #[test]
@@ -398,7 +472,8 @@ mod tests {
             .collect();
         let e = metered_illuminance(&[lamp], Vec3::splat(0.5), &boxes, &room);
         assert!((e - (25.0 + 0.5)).abs() < 1e-3, "{e}");
-        // A sun meters its intensity wherever the receivers are; the default ambient is 7 % of it.
+        // A sun meters its intensity wherever the receivers are; the default sky is a fifth of
+        // it, the ground 6 %, and exposure meters the sun plus their mean.
         let sun = Light::sun(Vec3::NEG_Y, 3.0);
         let v = View::new(crate::scene::Camera::look_at(
             Vec3::new(0.0, 2.0, 8.0),
@@ -407,9 +482,32 @@ mod tests {
             0.1,
         ));
         let p = plan_at(&[sun], &room, &boxes, &v, 1.5, 100);
-        assert!((p.ambient - Vec3::splat(AUTO_AMBIENT * 3.0)).length() < 1e-5);
+        assert!((p.ambient.sky - SKY_TINT * (AUTO_SKY * 3.0)).length() < 1e-5);
+        assert!((p.ambient.ground - GROUND_TINT * (AUTO_GROUND * 3.0)).length() < 1e-5);
         let k = crate::math::tonemap::KEY_VALUE;
-        assert!((p.exposure - k / (3.0 * (1.0 + AUTO_AMBIENT))).abs() < 1e-5);
+        let mean = 0.5 * (AUTO_SKY * luminance(SKY_TINT) + AUTO_GROUND * luminance(GROUND_TINT));
+        assert!((p.exposure - k / (3.0 * (1.0 + mean))).abs() < 1e-5);
+        // A flat ambient is what it says from every direction.
+        let mut flat = v.clone();
+        flat.ambient = Some(Vec3::splat(0.25));
+        let p = plan_at(&[sun], &room, &boxes, &flat, 1.5, 100);
+        assert_eq!(p.ambient.at(Vec3::X), Vec3::splat(0.25));
+    }
+
+    #[test]
+    fn the_hemisphere_mixes_ground_to_sky_by_the_up_component() {
+        // The tints keep the luminance the shares give.
+        assert!((luminance(SKY_TINT) - 1.0).abs() < 1e-3);
+        assert!((luminance(GROUND_TINT) - 1.0).abs() < 1e-3);
+        let a = Ambient {
+            sky: Vec3::new(1.0, 2.0, 3.0),
+            ground: Vec3::new(0.5, 0.0, 1.0),
+        };
+        assert_eq!(a.at(Vec3::Y), a.sky);
+        assert_eq!(a.at(Vec3::NEG_Y), a.ground);
+        assert_eq!(a.at(Vec3::Z), a.mean());
+        let tilted = Vec3::new(0.0, 0.5, 0.75f32.sqrt());
+        assert!((a.at(tilted) - (a.ground * 0.25 + a.sky * 0.75)).length() < 1e-6);
     }
     use crate::scene::demo::demo_scene;
 
@@ -453,7 +551,8 @@ mod tests {
         let sun = [Light::sun(Vec3::new(0.3, -1.0, 0.2), 1.0)];
         let cam = s.default_camera(1.5);
         let (c, eye) = (s.bounds().center(), cam.position());
-        let at = |k: f32| Camera::look_at(c + (eye - c) * k, c, cam.fov_y, cam.near);
+        let fov = cam.fov_y().unwrap();
+        let at = |k: f32| Camera::look_at(c + (eye - c) * k, c, fov, cam.near);
         let mut v = View::new(cam);
         v.shadow.cascades = 4;
         let plan = |v: &View| plan_at(&sun, &s.bounds(), &[], v, 1.5, 720);

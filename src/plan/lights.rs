@@ -1,7 +1,7 @@
 //! The lights a frame is shaded with, what auto exposure meters from them, and their uniforms.
 
 use super::input::PlanScene;
-use super::settings::{Exposure, View, AUTO_AMBIENT, UNIT_AMBIENT};
+use super::settings::{Ambient, Exposure, View, UNIT_AMBIENT};
 use super::uniforms::{LightUniform, MAX_LIGHTS};
 use super::views::{soft_size, ShadowView};
 use crate::gpu::shaders::scene as sh;
@@ -9,11 +9,14 @@ use crate::math::Aabb;
 use crate::scene::{Light, LightKind};
 use glam::{Vec3, Vec4};
 
-/// Elevation of the default sun used when a scene has no light (degrees).
-pub const DEFAULT_SUN_ELEVATION_DEG: f32 = 50.0;
+/// Elevation of the default sun used when a scene has no light (degrees): a key light from the
+/// viewer's upper left, in front of the model (the default view looks from +Z), so the model's
+/// shadow falls behind it to the right, on the model and on a ground beside it.
+pub const DEFAULT_SUN_ELEVATION_DEG: f32 = 35.0;
 
-/// Azimuth of the default sun (degrees).
-pub const DEFAULT_SUN_AZIMUTH_DEG: f32 = 35.0;
+/// Azimuth of the default sun around +Y from +Z (degrees; negative towards −X, the default
+/// view's left).
+pub const DEFAULT_SUN_AZIMUTH_DEG: f32 = -60.0;
 
 /// Intensity of the default sun.
 pub const DEFAULT_SUN_INTENSITY: f32 = 1.7;
@@ -57,19 +60,17 @@ pub fn effective_lights(scene_lights: &[Light], view: &View) -> Vec<Light> {
     lights
 }
 
-/// The ambient Ia (the view's, else a share of the metered direct light), the metered
-/// illuminance, and the exposure scale. Metered once: the default ambient follows the direct
-/// part, auto exposure the sum.
-pub(super) fn metering(lights: &[Light], scene: &PlanScene, view: &View) -> (Vec3, f32, f32) {
+/// The ambient Ia (the view's flat one, else the sky and ground hemisphere sized by the metered
+/// direct light), the metered illuminance, and the exposure scale. Metered once: the default
+/// ambient follows the direct part, auto exposure the sum (the ambient's mean over directions).
+pub(super) fn metering(lights: &[Light], scene: &PlanScene, view: &View) -> (Ambient, f32, f32) {
     let direct = metered_illuminance(lights, Vec3::ZERO, scene.receivers, scene.bounds);
-    let ambient = view.ambient.unwrap_or_else(|| {
-        Vec3::splat(if direct.is_finite() && direct > 0.0 {
-            AUTO_AMBIENT * direct
-        } else {
-            UNIT_AMBIENT
-        })
-    });
-    let metered_lux = direct + luminance(ambient.max(Vec3::ZERO));
+    let ambient = match view.ambient {
+        Some(a) => Ambient::flat(a),
+        None if direct.is_finite() && direct > 0.0 => Ambient::metered(direct),
+        None => Ambient::flat(Vec3::splat(UNIT_AMBIENT)),
+    };
+    let metered_lux = direct + luminance(ambient.mean().max(Vec3::ZERO));
     let exposure = exposure_scale(view.exposure, metered_lux)
         * view.exposure_compensation.clamp(-64.0, 64.0).exp2();
     (ambient, metered_lux, exposure)

@@ -22,8 +22,9 @@ pub use frame::{plan_frame, FramePlan, ScenePlanner, CLEAR_COLOR};
 pub use input::{PlanScene, PlanTarget};
 pub use lights::{effective_lights, exposure_scale, metered_illuminance};
 pub use settings::{
-    Exposure, HeldLight, Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings,
-    Tonemap, View, ViewMode, AUTO_AMBIENT, MAX_CASCADES, UNIT_AMBIENT,
+    Ambient, Background, Exposure, HeldLight, Pcf, SceneOptions, ShadowFit, ShadowFormat,
+    ShadowHold, ShadowSettings, Tonemap, View, ViewMode, AUTO_GROUND, AUTO_SKY, GROUND_TINT,
+    MAX_CASCADES, SKY_TINT, UNIT_AMBIENT,
 };
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
 pub use views::{lookup_reach, soft_size, ShadowView};

@@ -322,13 +322,78 @@ impl SceneOptions {
     }
 }
 
-/// The default ambient as a fraction of the metered direct illuminance (the demo's 0.12 under
-/// its sun of 1.7).
-pub const AUTO_AMBIENT: f32 = 0.07;
+/// The default sky ambient as a fraction of the metered direct illuminance: what an up-facing
+/// surface in shadow receives (0.34 under the demo's sun of 1.7). A clear sky gives a horizontal
+/// surface 10–25 % of the sun's illuminance; a fifth keeps shadows readable without washing out
+/// the key light.
+pub const AUTO_SKY: f32 = 0.2;
+
+/// The default ground (bounce) ambient as a fraction of the metered direct illuminance: what a
+/// down-facing surface receives (a ground of albedo ~0.3 under the sky and sun).
+pub const AUTO_GROUND: f32 = 0.06;
+
+/// The default sky's colour, of luminance 1 (a pale blue).
+pub const SKY_TINT: Vec3 = Vec3::new(0.89, 1.012, 1.2);
+
+/// The default ground's colour, of luminance 1 (a warm grey).
+pub const GROUND_TINT: Vec3 = Vec3::new(1.114, 0.985, 0.816);
 
 /// The ambient umbra used before it followed the lights (`View::raw_output`), and where nothing
 /// lights the scene.
 pub const UNIT_AMBIENT: f32 = 0.12;
+
+/// The ambient light Ia of Blinn-Phong's ka·Ia: a hemisphere, `sky` from above and `ground`
+/// from below, blended by the normal's up (+Y) component, Ia(n) = mix(ground, sky, ½ + ½·n_y)
+/// (three.js' hemisphere light); `sky` = `ground` is a flat ambient. The background of the lit
+/// image is the same function of the view direction ([`Background::Sky`]).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Ambient {
+    /// Ia of a surface facing straight up (rgb, in the lights' units).
+    pub sky: Vec3,
+    /// Ia of a surface facing straight down.
+    pub ground: Vec3,
+}
+
+impl Ambient {
+    /// The same Ia from every direction.
+    pub fn flat(ia: Vec3) -> Self {
+        Self {
+            sky: ia,
+            ground: ia,
+        }
+    }
+
+    /// The default hemisphere for a metered direct illuminance `direct` ([`AUTO_SKY`],
+    /// [`AUTO_GROUND`], tinted by [`SKY_TINT`] and [`GROUND_TINT`]).
+    pub fn metered(direct: f32) -> Self {
+        Self {
+            sky: SKY_TINT * (AUTO_SKY * direct),
+            ground: GROUND_TINT * (AUTO_GROUND * direct),
+        }
+    }
+
+    /// Ia for a surface of unit normal `n` (or, for the background, seen along direction `n`).
+    pub fn at(&self, n: Vec3) -> Vec3 {
+        let up = (0.5 + 0.5 * n.y).clamp(0.0, 1.0);
+        self.ground.lerp(self.sky, up)
+    }
+
+    /// Ia averaged over directions (what a vertical surface receives).
+    pub fn mean(&self) -> Vec3 {
+        0.5 * (self.sky + self.ground)
+    }
+}
+
+/// What the lit image shows where no surface is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum Background {
+    /// The ambient hemisphere seen along each pixel's view direction
+    /// ([`Ambient::at`]), exposed and tone-mapped like the surfaces it lights: a sky gradient.
+    #[default]
+    Sky,
+    /// A flat linear colour (written as it is: not exposed).
+    Color(Vec3),
+}
 
 /// How bright the scene is drawn: the linear scale applied before tone mapping.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -363,10 +428,14 @@ pub struct View {
     pub mode: ViewMode,
     /// Shadow settings.
     pub shadow: ShadowSettings,
-    /// Ambient intensity Ia, in the lights' units. `None` (the default): [`AUTO_AMBIENT`] of
-    /// the direct illuminance auto exposure meters (`frame::metered_illuminance`), so the fill
-    /// follows the lights whatever their units (0.12 under the default sun of 1.7).
+    /// A flat ambient Ia (the same from every direction), in the lights' units. `None` (the
+    /// default): the sky and ground hemisphere [`Ambient::metered`] from the direct illuminance
+    /// auto exposure meters (`frame::metered_illuminance`), so the fill follows the lights
+    /// whatever their units (sky 0.34, ground 0.10 under the demo's sun of 1.7).
     pub ambient: Option<Vec3>,
+    /// What the lit image shows where nothing is drawn (debug views always clear to
+    /// [`crate::plan::CLEAR_COLOR`]).
+    pub background: Background,
     /// Exposure before tone mapping (the lit image; debug views are not exposed).
     pub exposure: Exposure,
     /// Exposure compensation in stops on top of `exposure` (+1 doubles the scale; the viewer's
@@ -435,13 +504,15 @@ impl View {
     }
 
     /// The same view with its lit image's raw values: exposure 1, no tone curve (values
-    /// clamped to [0, 1]) and, unless set, an ambient of [`UNIT_AMBIENT`], as umbra drew before
-    /// exposure existed; for tests that check levels.
+    /// clamped to [0, 1]), unless set a flat ambient of [`UNIT_AMBIENT`], and the clear colour
+    /// behind, as umbra drew before exposure and the sky existed; for tests that check levels.
     pub fn raw_output(mut self) -> Self {
         self.exposure = Exposure::Scale(1.0);
         self.exposure_compensation = 0.0;
         self.ambient = self.ambient.or(Some(Vec3::splat(UNIT_AMBIENT)));
         self.tonemap = Tonemap::None;
+        let c = super::frame::CLEAR_COLOR;
+        self.background = Background::Color(Vec3::new(c[0], c[1], c[2]));
         self
     }
 
@@ -455,6 +526,7 @@ impl View {
             mode: ViewMode::Lit,
             shadow: ShadowSettings::default(),
             ambient: None,
+            background: Background::Sky,
             exposure: Exposure::Auto,
             exposure_compensation: 0.0,
             tonemap: Tonemap::Neutral,

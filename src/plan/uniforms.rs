@@ -64,8 +64,10 @@ pub struct FrameUniform {
     pub world_from_clip: Mat4,
     /// Camera position.
     pub camera_position: Vec4,
-    /// Ambient intensity Ia.
-    pub ambient: Vec4,
+    /// Ambient Ia of a surface facing up (the sky of `Ambient`).
+    pub ambient_sky: Vec4,
+    /// Ambient Ia of a surface facing down (the ground of `Ambient`).
+    pub ambient_ground: Vec4,
     /// x map size, y normal offset (texels), z the depth view's far end, w enabled.
     pub shadow: Vec4,
     /// w: index of the light whose visibility the shadow view shows (`MAX_LIGHTS + 1` when
@@ -76,9 +78,14 @@ pub struct FrameUniform {
     pub bias: Vec4,
     /// xyz: the shadow-fitting camera's forward direction.
     pub camera_forward: Vec4,
+    /// xyz: the view camera's forward direction; w: 1 for an orthographic camera (every
+    /// fragment is seen along xyz).
+    pub eye_forward: Vec4,
     /// x view mode, y PCF taps per side (0 = nearest), z hardware compare, w light count.
     pub modes: [u32; 4],
-    /// x exposure (linear scale), y tone-mapping operator (`Tonemap::shader_value`).
+    /// x exposure (linear scale), y tone-mapping operator (`Tonemap::shader_value`), z the scale
+    /// of unlit colours and w 1 when they are shown as authored (× z, no tone curve; the
+    /// automatic exposure), 0 when exposed and tone-mapped like lit ones.
     pub output: Vec4,
     /// Lights.
     pub lights: [LightUniform; MAX_LIGHTS],

@@ -15,7 +15,8 @@ use crate::math::Aabb;
 use crate::scene::{Camera, Light, LightKind};
 use glam::{Mat4, Vec4};
 
-/// Weight of logarithmic against uniform cascade splits (`cascade_splits`).
+/// Weight of logarithmic against uniform cascade splits (`cascade_splits`) under a perspective
+/// camera (an orthographic one splits evenly).
 pub const CASCADE_SPLIT_LAMBDA: f32 = 0.9;
 
 /// The last fraction of each cascade (but the last) over which lookups move to the next one.
@@ -86,7 +87,13 @@ pub(super) fn cascade_views(
     n: usize,
     fit: impl Fn(usize, Option<CameraFrustum>) -> DirectionalFit,
 ) -> Vec<ShadowView> {
-    let splits = cascade_splits(range.0, range.1, n, CASCADE_SPLIT_LAMBDA);
+    // A parallel projection's pixels are the same size at every depth: even splits.
+    let lambda = if frustum.tan_half > 0.0 {
+        CASCADE_SPLIT_LAMBDA
+    } else {
+        0.0
+    };
+    let splits = cascade_splits(range.0, range.1, n, lambda);
     (0..n)
         .map(|c| {
             let near = match c {
@@ -356,7 +363,9 @@ pub(super) fn directional_views(
             let n = match view.shadow.cascades {
                 0 => {
                     let f = fit(Some(frustum));
-                    let pixel = 2.0 * near * (fit_cam.fov_y * 0.5).tan() / height_px.max(1) as f32;
+                    // A pixel's footprint at the nearest receiver (the same at every depth for
+                    // an orthographic camera).
+                    let pixel = 2.0 * fit_cam.half_extent_at(near, 1.0).y / height_px.max(1) as f32;
                     single = Some(f);
                     auto_cascades(f.texel_world / pixel.max(f32::MIN_POSITIVE))
                 }

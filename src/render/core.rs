@@ -7,7 +7,7 @@ use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::scene as sh;
 use crate::math::shadow_fit::spot_near;
-use crate::plan::settings::{SceneOptions, ShadowSettings, View, ViewMode};
+use crate::plan::settings::{Background, SceneOptions, ShadowSettings, View, ViewMode};
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
 use crate::render::passes::camera_pass::{CameraFrame, CameraPass, CameraTargets, Resolve};
@@ -165,9 +165,14 @@ impl FrameCore {
         self.camera.write_frame(slot, &plan.uniform)?;
         let extent = vk::Extent2D { width, height };
         let cull = camera_cull(view, &plan, extent, self.receiver_split);
-        let camera =
-            self.camera
-                .plan_frame(&self.gpu, cull, extent, view.mode == ViewMode::ShadowMap);
+        let sky = view.mode == ViewMode::Lit && plan.background == Background::Sky;
+        let camera = self.camera.plan_frame(
+            &self.gpu,
+            cull,
+            extent,
+            view.mode == ViewMode::ShadowMap,
+            sky,
+        );
         self.camera.ensure_pipelines(&self.gpu, &camera, extent)?;
         Ok(Prepared {
             plan,
@@ -262,10 +267,10 @@ impl FrameCore {
             depth: draw_depth,
             resolve,
             extent,
-            clear: if frame.mode == ViewMode::Overdraw {
-                [0.0, 0.0, 0.0, 1.0]
-            } else {
-                CLEAR_COLOR
+            clear: match (frame.mode, plan.background) {
+                (ViewMode::Overdraw, _) => [0.0, 0.0, 0.0, 1.0],
+                (ViewMode::Lit, Background::Color(c)) => c.extend(1.0).to_array(),
+                _ => CLEAR_COLOR,
             },
         };
         let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
@@ -325,7 +330,8 @@ fn camera_cull(
     receiver_split: bool,
 ) -> CameraCull {
     let aspect = extent.width as f32 / extent.height.max(1) as f32;
-    let t = (view.camera.fov_y * 0.5).tan();
+    let cam = &view.camera;
+    let half = cam.half_extent_at(cam.near, aspect);
     let single_view = plan.shadow_views.len() == 1;
     let bits = plan.shader_variant;
     let shadow_reach = (receiver_split
@@ -354,8 +360,13 @@ fn camera_cull(
         clip_from_world: plan.clip_from_world,
         eye: (
             plan.camera_position,
-            view.camera.near * (1.0 + t * t * (1.0 + aspect * aspect)).sqrt(),
+            (cam.near * cam.near + half.length_squared()).sqrt(),
         ),
+        viewpoint: if cam.is_orthographic() {
+            Viewpoint::Along(cam.forward())
+        } else {
+            Viewpoint::Eye(plan.camera_position)
+        },
         frame_bits: plan.shader_variant,
         debug_view: is_debug_view(view.mode),
         highlight: view.highlight,

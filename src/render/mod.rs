@@ -16,10 +16,10 @@ pub(crate) mod targets;
 pub(crate) mod window;
 
 pub use crate::plan::{
-    effective_lights, metered_illuminance, Exposure, FramePlan, HeldLight, Pcf, SceneOptions,
-    ScenePlanner, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings, ShadowView, Tonemap, View,
-    ViewMode, AUTO_AMBIENT, MAX_CASCADES, MAX_LIGHTS, MAX_SHADOW_VIEWS, UNIT_AMBIENT,
+    effective_lights, metered_illuminance, Ambient, Background, Exposure, FramePlan, HeldLight,
+    Pcf, SceneOptions, ScenePlanner, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings,
+    ShadowView, Tonemap, View, ViewMode, MAX_CASCADES, MAX_LIGHTS, MAX_SHADOW_VIEWS, UNIT_AMBIENT,
 };
 pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 #[cfg(feature = "viewer")]
-pub use window::{surface_extensions, DrawResult, WindowRenderer};
+pub use window::{surface_extensions, Capture, DrawResult, FrameSummary, Overlay, WindowRenderer};

@@ -29,8 +29,8 @@ pub struct PipelineDesc<'a> {
     pub depth_clamp: bool,
     /// Enable (dynamic) depth bias.
     pub depth_bias: bool,
-    /// Depth test and write (off for full-screen passes).
-    pub depth_test: bool,
+    /// Depth test and write.
+    pub depth: Depth,
     /// Colour blending.
     pub blend: ColorBlend,
     /// Samples per pixel of the attachments (1, or the MSAA count).
@@ -46,6 +46,18 @@ pub enum Stencil {
     Mark,
     /// Passes only where the stored value equals the reference; writes nothing.
     Equal,
+}
+
+/// What a pipeline does with the depth aspect (reversed-z: larger is nearer, cleared to 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Depth {
+    /// No test, no write (full-screen passes, the overdraw view).
+    Off,
+    /// GREATER, writing (no writes with [`ColorBlend::Over`]).
+    Test,
+    /// Passes only where the depth is still the clear value 0 (a full-screen triangle at depth
+    /// 0 with GREATER_OR_EQUAL): the background where no surface was drawn; writes nothing.
+    Empty,
 }
 
 /// How a pipeline's colour output combines with the attachment.
@@ -139,12 +151,18 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
     Ok(p)
 }
 
-/// Reversed-z depth (GREATER; no writes from blended draws) and the stencil test of `d.stencil`.
+/// Reversed-z depth (`d.depth`; no writes from blended draws) and the stencil test of
+/// `d.stencil`.
 fn depth_stencil_state(d: &PipelineDesc) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
+    let (test, write, op) = match d.depth {
+        Depth::Off => (false, false, vk::CompareOp::ALWAYS),
+        Depth::Test => (true, d.blend != ColorBlend::Over, vk::CompareOp::GREATER),
+        Depth::Empty => (true, false, vk::CompareOp::GREATER_OR_EQUAL),
+    };
     let mut depth = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(d.depth_test)
-        .depth_write_enable(d.depth_test && d.blend != ColorBlend::Over)
-        .depth_compare_op(vk::CompareOp::GREATER);
+        .depth_test_enable(test)
+        .depth_write_enable(write)
+        .depth_compare_op(op);
     let stencil_op = |compare, pass, write_mask| vk::StencilOpState {
         fail_op: vk::StencilOp::KEEP,
         pass_op: pass,

@@ -80,9 +80,14 @@ pub struct Renderer {
     seen_depths: Option<SeenDepths>,
 }
 
-/// A camera (view matrix, field of view, image size) and the (nearest, farthest) view depth it
-/// saw (None: nothing drawn).
-type SeenDepths = (Mat4, f32, (u32, u32), Option<(f32, f32)>);
+/// A camera (view matrix, projection, image size) and the (nearest, farthest) view depth it saw
+/// (None: nothing drawn).
+type SeenDepths = (
+    Mat4,
+    crate::scene::Projection,
+    (u32, u32),
+    Option<(f32, f32)>,
+);
 
 /// Copies a whole single-level image aspect into a tightly packed buffer.
 pub fn copy_to_buffer(
@@ -276,7 +281,7 @@ impl Renderer {
         }
         let key = (
             view.camera.view_from_world(),
-            view.camera.fov_y,
+            view.camera.projection,
             (width, height),
         );
         let known = self

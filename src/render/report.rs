@@ -41,7 +41,8 @@ pub fn exposure_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
         "ev100": crate::math::tonemap::ev100_from_exposure(plan.exposure),
         "scale": plan.exposure,
         "compensation_ev": view.exposure_compensation,
-        "ambient": plan.ambient.to_array(),
+        "ambient": plan.ambient.sky.to_array(),
+        "ambient_ground": plan.ambient.ground.to_array(),
         "tonemap": format!("{:?}", view.tonemap),
     })
 }

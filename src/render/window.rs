@@ -40,14 +40,49 @@ struct FrameSync {
     acquired: vk::Semaphore,
 }
 
+/// Drawing recorded over a window's frame after the scene (an on-screen panel): called inside a
+/// rendering of the swapchain image (its colour loaded and stored, no depth attachment, the
+/// viewport and scissor left to the overlay), in the frame's command buffer. What it draws from
+/// must stay alive until that frame completes (`WindowRenderer::draw_with` waits for a frame
+/// slot's previous use before recording into it again).
+pub trait Overlay {
+    /// Records the overlay into `cmd` for an image of `extent`.
+    fn record(&mut self, cmd: vk::CommandBuffer, extent: vk::Extent2D);
+}
+
+/// What a frame's screenshot holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Capture {
+    /// No screenshot.
+    None,
+    /// The scene as rendered, without the overlay.
+    Scene,
+    /// What is on screen, the overlay included.
+    Screen,
+}
+
+/// What one drawn frame did: its draws and shadow views, for a front end's statistics.
+#[derive(Clone, Debug, Default)]
+pub struct FrameSummary {
+    /// Casters drawn into the shadow map.
+    pub casters: usize,
+    /// Draws in the camera pass (after culling).
+    pub draws: usize,
+    /// Of those, draws shaded deferred.
+    pub deferred: usize,
+    /// Per shadow view: its light, its side in texels and the world size of a texel
+    /// (directional) or of a texel per unit distance (spot, point face).
+    pub shadow_views: Vec<(usize, u32, f32)>,
+}
+
 /// What `draw` did.
 pub enum DrawResult {
     /// Nothing drawn: the window is 0×0 or the swapchain was out of date (recreated).
     Skipped,
     /// A frame was submitted and presented.
     Drawn {
-        /// Casters drawn into the shadow map.
-        casters: usize,
+        /// What was drawn.
+        summary: FrameSummary,
         /// The presented pixels, when a screenshot was asked for.
         screenshot: Option<image::RgbaImage>,
     },
@@ -146,6 +181,31 @@ impl WindowRenderer {
         self.core.set_pose(scene)
     }
 
+    /// Replaces the scene (a file opened or reloaded) keeping the window's swapchain: waits for
+    /// the frames in flight, then uploads `scene` with `options` as [`Self::new`] does.
+    pub fn set_scene(&mut self, scene: &Scene, options: &SceneOptions) -> Result<(), GpuError> {
+        let ctx = self.core.ctx.clone();
+        unsafe { ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
+        self.core = FrameCore::new(
+            &ctx,
+            scene,
+            options,
+            self.swapchain.format,
+            FRAMES_IN_FLIGHT,
+        )?;
+        // The depth format and sample count may differ; nothing read back belongs to it.
+        self.depth = None;
+        self.msaa = None;
+        self.last_gpu = None;
+        self.seen_depths = None;
+        self.held = None;
+        self.last_shot = None;
+        for slot in &mut self.depth_reads {
+            slot.1 = None;
+        }
+        self.ensure_depth()
+    }
+
     /// The triangles drawn per frame.
     pub fn triangles(&self) -> usize {
         self.core.gpu.triangles
@@ -208,6 +268,23 @@ impl WindowRenderer {
     /// back and fits the cascades of a later frame (the latest completed: one or two frames
     /// behind a moving camera).
     pub fn draw(&mut self, view: &View, screenshot: bool) -> Result<DrawResult, GpuError> {
+        let capture = if screenshot {
+            Capture::Scene
+        } else {
+            Capture::None
+        };
+        self.draw_with(view, capture, None)
+    }
+
+    /// [`Self::draw`] with an `overlay` recorded over the scene, and a screenshot (`capture`) of
+    /// the scene alone or of the screen.
+    pub fn draw_with(
+        &mut self,
+        view: &View,
+        capture: Capture,
+        overlay: Option<&mut dyn Overlay>,
+    ) -> Result<DrawResult, GpuError> {
+        let screenshot = capture != Capture::None;
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
         let f = self.frame;
@@ -245,19 +322,27 @@ impl WindowRenderer {
             state: Access::Acquired,
         };
         ctx.begin_one_time(cmd)?;
-        let casters = self
-            .core
-            .record(
-                cmd,
-                &prepared,
-                Targets {
-                    color: &mut color,
-                    depth,
-                    msaa: self.msaa.as_mut(),
-                    resolve_depth: fit,
-                },
-            )
-            .casters;
+        let counts = self.core.record(
+            cmd,
+            &prepared,
+            Targets {
+                color: &mut color,
+                depth,
+                msaa: self.msaa.as_mut(),
+                resolve_depth: fit,
+            },
+        );
+        let summary = FrameSummary {
+            casters: counts.casters,
+            draws: counts.camera_draws,
+            deferred: counts.deferred_draws,
+            shadow_views: prepared
+                .plan
+                .shadow_views
+                .iter()
+                .map(|v| (v.light, v.res, v.texel_world))
+                .collect(),
+        };
         if fit {
             depth.transition(d, cmd, Access::TransferSrc);
             copy_to_buffer(
@@ -272,7 +357,8 @@ impl WindowRenderer {
             self.depth_reads[f].1 =
                 Some((crate::plan::camera_projection(&view.camera, aspect), pixels));
         }
-        if want_copy {
+        let shot_buffer = self.screenshot.as_ref().map(|b| b.raw);
+        let copy = |color: &mut Attachment| {
             color.transition(d, cmd, Access::TransferSrc);
             copy_to_buffer(
                 d,
@@ -280,8 +366,17 @@ impl WindowRenderer {
                 color.image,
                 vk::ImageAspectFlags::COLOR,
                 extent,
-                self.screenshot.as_ref().expect("buffer").raw,
+                shot_buffer.expect("buffer"),
             );
+        };
+        if want_copy && (capture == Capture::Scene || overlay.is_none()) {
+            copy(&mut color);
+        }
+        if let Some(o) = overlay {
+            record_overlay(d, cmd, &mut color, extent, o);
+            if want_copy && capture == Capture::Screen {
+                copy(&mut color);
+            }
         }
         if fit || want_copy {
             transfer_to_host_barrier(d, cmd);
@@ -303,7 +398,7 @@ impl WindowRenderer {
             self.resize(w, h)?;
         }
         Ok(DrawResult::Drawn {
-            casters,
+            summary,
             screenshot: shot,
         })
     }
@@ -420,6 +515,32 @@ impl WindowRenderer {
             .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
         Ok(rgba_from_readback(bytes, extent.width, extent.height, bgra))
     }
+}
+
+/// Records `overlay` into a rendering of `color` (loaded and stored, after the scene's writes).
+fn record_overlay(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    color: &mut Attachment,
+    extent: vk::Extent2D,
+    overlay: &mut dyn Overlay,
+) {
+    color.transition(d, cmd, Access::ColorAttachment);
+    let attachments = [vk::RenderingAttachmentInfo::default()
+        .image_view(color.view)
+        .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::LOAD)
+        .store_op(vk::AttachmentStoreOp::STORE)];
+    let rendering = vk::RenderingInfo::default()
+        .render_area(vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent,
+        })
+        .layer_count(1)
+        .color_attachments(&attachments);
+    unsafe { d.cmd_begin_rendering(cmd, &rendering) };
+    overlay.record(cmd, extent);
+    unsafe { d.cmd_end_rendering(cmd) };
 }
 
 impl Drop for WindowRenderer {

@@ -2,7 +2,7 @@
 //! from it (each node's parent, the nodes lights and cameras hang on).
 
 use super::load_error::{corrupt, LoadError};
-use super::{Camera, Instance, Light, LightKind, Scene};
+use super::{Camera, Instance, Light, LightKind, Projection, Scene};
 use glam::{Mat4, Vec3};
 use std::path::Path;
 
@@ -69,9 +69,8 @@ pub(super) fn walk_nodes(
             });
         }
         if let Some(c) = node.camera() {
-            if add_camera(scene, &c, world) {
-                camera_nodes.push(node.index());
-            }
+            add_camera(scene, &c, world);
+            camera_nodes.push(node.index());
         }
         if let Some(l) = node.light() {
             light_nodes.push(node.index());
@@ -89,32 +88,64 @@ pub(super) fn walk_nodes(
     })
 }
 
-/// Adds camera `c` at `world` (scale removed); false (with a warning) for an orthographic one.
-fn add_camera(scene: &mut Scene, c: &gltf::Camera, world: Mat4) -> bool {
-    match c.projection() {
-        gltf::camera::Projection::Perspective(p) => {
-            // Remove scale from the camera transform.
-            let (_, rot, pos) = world.to_scale_rotation_translation();
-            scene.cameras.push(Camera {
-                world_from_view: Mat4::from_rotation_translation(rot, pos),
+/// Adds camera `c` at `world` (scale removed), perspective or orthographic; parameters out of
+/// range are repaired with a `CAMERA_INVALID` warning.
+fn add_camera(scene: &mut Scene, c: &gltf::Camera, world: Mat4) {
+    let (_, rot, pos) = world.to_scale_rotation_translation();
+    let world_from_view = Mat4::from_rotation_translation(rot, pos);
+    let pointer = format!("/cameras/{}", c.index());
+    let mut repairs = Vec::new();
+    let camera = match c.projection() {
+        gltf::camera::Projection::Perspective(p) => Camera {
+            world_from_view,
+            projection: Projection::Perspective {
                 fov_y: p.yfov().clamp(0.01, 3.1),
-                near: p.znear().max(1e-6),
-                far: p.zfar(),
-            });
-            true
-        }
-        gltf::camera::Projection::Orthographic(_) => {
-            scene.warn(
-                "CAMERA_ORTHOGRAPHIC",
-                format!("/cameras/{}", c.index()),
-                format!(
-                    "camera {} is orthographic; not supported, skipped",
-                    c.index()
-                ),
+            },
+            near: p.znear().max(1e-6),
+            far: p.zfar(),
+        },
+        gltf::camera::Projection::Orthographic(o) => {
+            let mag = |m: f32, name: &str, repairs: &mut Vec<String>| {
+                if m.is_finite() && m != 0.0 {
+                    m.abs()
+                } else {
+                    repairs.push(format!("{name} {m} read as 1"));
+                    1.0
+                }
+            };
+            let (xmag, ymag) = (
+                mag(o.xmag(), "xmag", &mut repairs),
+                mag(o.ymag(), "ymag", &mut repairs),
             );
-            false
+            let near = if o.znear().is_finite() {
+                o.znear().max(0.0)
+            } else {
+                0.0
+            };
+            let far = Some(o.zfar()).filter(|f| f.is_finite() && *f > near);
+            if far.is_none() {
+                repairs.push(format!(
+                    "zfar {} is not beyond znear {near}: seen {} units deep",
+                    o.zfar(),
+                    Camera::ORTHO_DEFAULT_DEPTH * ymag
+                ));
+            }
+            Camera {
+                world_from_view,
+                projection: Projection::Orthographic { xmag, ymag },
+                near,
+                far,
+            }
         }
+    };
+    if !repairs.is_empty() {
+        scene.warn(
+            "CAMERA_INVALID",
+            pointer,
+            format!("camera {}: {}", c.index(), repairs.join("; ")),
+        );
     }
+    scene.cameras.push(camera);
 }
 
 /// Adds light `l` at `world`: position, the direction it shines (its −Z), and the size an

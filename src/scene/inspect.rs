@@ -311,6 +311,7 @@ fn tree_lists(doc: &Value, seen: &[bool]) -> (Vec<Value>, Vec<Value>, Vec<Value>
         .map(|(i, c)| {
             let t = c["type"].as_str().unwrap_or("");
             json!({"index": i, "name": c["name"], "type": t, "yfov": c[t]["yfov"],
+                   "xmag": c[t]["xmag"], "ymag": c[t]["ymag"],
                    "znear": c[t]["znear"], "zfar": c[t]["zfar"], "aspect": c[t]["aspectRatio"]})
         })
         .collect();

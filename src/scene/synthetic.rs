@@ -84,6 +84,16 @@ pub fn sphere_grid(n: u32) -> Scene {
         }
     }
     s.lights.push(Light::sun(Vec3::new(0.9, -1.0, -0.25), 2.0));
+    // The peer's view: from (0.55, 0.45, 1) at the distance that fits the bounding sphere.
+    let (c, r) = s.bounds().bounding_sphere();
+    let fov = 45f32.to_radians();
+    let dist = crate::math::projection::framing_distance(r, fov, 16.0 / 9.0);
+    s.cameras.push(Camera::look_at(
+        c + Vec3::new(0.55, 0.45, 1.0).normalize() * dist,
+        c,
+        fov,
+        (dist - r).max(dist * 1e-3) * 0.5,
+    ));
     s
 }
 

@@ -1,6 +1,5 @@
 //! Scene data types.
 
-use crate::math::projection::framing_distance;
 use crate::math::Aabb;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
@@ -280,33 +279,100 @@ impl Light {
     }
 }
 
-/// A perspective camera.
+/// How a camera maps view space onto the image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Perspective with this vertical field of view (radians); the image's aspect ratio sets the
+    /// horizontal one (a glTF camera's `aspectRatio` is not used).
+    Perspective {
+        /// Vertical field of view (radians).
+        fov_y: f32,
+    },
+    /// Parallel projection (glTF's orthographic camera): the view volume spans ±`ymag`
+    /// vertically and ±`ymag` × the image's aspect ratio horizontally, so an image of the
+    /// camera's own aspect ratio (`xmag / ymag`) spans ±`xmag` exactly (as the glTF matrix does)
+    /// and other images are not stretched.
+    Orthographic {
+        /// Half the width of the view volume in an image of aspect `xmag / ymag`.
+        xmag: f32,
+        /// Half the height of the view volume.
+        ymag: f32,
+    },
+}
+
+/// A camera: perspective or orthographic.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Camera → world (the camera looks down its −Z).
     pub world_from_view: Mat4,
-    /// Vertical field of view (radians).
-    pub fov_y: f32,
+    /// Its projection.
+    pub projection: Projection,
     /// Near plane distance.
     pub near: f32,
-    /// Far plane distance; `None` for an infinite reversed-z projection.
+    /// Far plane distance; `None` for an infinite reversed-z perspective (an orthographic
+    /// camera without one reaches [`Camera::ORTHO_DEFAULT_DEPTH`] half-heights past its near
+    /// plane).
     pub far: Option<f32>,
 }
 
 impl Camera {
-    /// A camera at `eye` looking at `target` (Y up; Z up if looking straight down or up).
+    /// How deep, in half-heights (`ymag`), an orthographic camera without a far plane sees.
+    pub const ORTHO_DEFAULT_DEPTH: f32 = 1.0e4;
+
+    /// A perspective camera at `eye` looking at `target` (Y up; Z up if looking straight down or
+    /// up).
     pub fn look_at(eye: Vec3, target: Vec3, fov_y: f32, near: f32) -> Self {
-        let d = (target - eye).normalize_or_zero();
-        let up = if d.cross(Vec3::Y).length_squared() < 1e-8 {
-            Vec3::Z
-        } else {
-            Vec3::Y
-        };
         Self {
-            world_from_view: Mat4::look_at_rh(eye, target, up).inverse(),
-            fov_y,
+            world_from_view: look_at_frame(eye, target),
+            projection: Projection::Perspective { fov_y },
             near,
             far: None,
+        }
+    }
+
+    /// An orthographic camera at `eye` looking at `target` (Y up), seeing ±`ymag` vertically
+    /// from `near` to `far` in front of the eye.
+    pub fn orthographic_look_at(eye: Vec3, target: Vec3, ymag: f32, near: f32, far: f32) -> Self {
+        Self {
+            world_from_view: look_at_frame(eye, target),
+            projection: Projection::Orthographic { xmag: ymag, ymag },
+            near,
+            far: Some(far),
+        }
+    }
+
+    /// The vertical field of view of a perspective camera (None for an orthographic one).
+    pub fn fov_y(&self) -> Option<f32> {
+        match self.projection {
+            Projection::Perspective { fov_y } => Some(fov_y),
+            Projection::Orthographic { .. } => None,
+        }
+    }
+
+    /// Whether the camera projects in parallel.
+    pub fn is_orthographic(&self) -> bool {
+        matches!(self.projection, Projection::Orthographic { .. })
+    }
+
+    /// Half the width and height of what the camera sees at view depth `d` in an image of
+    /// `aspect` (width / height).
+    pub fn half_extent_at(&self, d: f32, aspect: f32) -> Vec2 {
+        let h = match self.projection {
+            Projection::Perspective { fov_y } => d * (fov_y * 0.5).tan(),
+            Projection::Orthographic { ymag, .. } => ymag,
+        };
+        Vec2::new(h * aspect, h)
+    }
+
+    /// The far plane's distance: `far`, or for an orthographic camera without one its default
+    /// depth; None for an infinite perspective.
+    pub fn far_plane(&self) -> Option<f32> {
+        match (self.far, self.projection) {
+            (Some(f), _) if f > self.near => Some(f),
+            (_, Projection::Orthographic { ymag, .. }) => {
+                Some(self.near + Self::ORTHO_DEFAULT_DEPTH * ymag.abs().max(f32::MIN_POSITIVE))
+            }
+            _ => None,
         }
     }
 
@@ -320,6 +386,13 @@ impl Camera {
         self.world_from_view.w_axis.truncate()
     }
 
+    /// The unit direction the camera looks along (its −Z in world space).
+    pub fn forward(&self) -> Vec3 {
+        self.world_from_view
+            .transform_vector3(Vec3::NEG_Z)
+            .normalize_or(Vec3::NEG_Z)
+    }
+
     /// The same camera in coordinates relative to `origin` (see [`Scene::render_origin`]).
     pub fn rebased(&self, origin: Vec3) -> Self {
         Self {
@@ -327,6 +400,18 @@ impl Camera {
             ..*self
         }
     }
+}
+
+/// Camera → world of an eye at `eye` looking at `target`, Y up (Z up when looking straight down
+/// or up).
+fn look_at_frame(eye: Vec3, target: Vec3) -> Mat4 {
+    let d = (target - eye).normalize_or_zero();
+    let up = if d.cross(Vec3::Y).length_squared() < 1e-8 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    Mat4::look_at_rh(eye, target, up).inverse()
 }
 
 /// `world_from_model` in coordinates relative to `origin`: the translation minus `origin`,
@@ -463,18 +548,12 @@ impl Scene {
         });
     }
 
-    /// A camera that frames the bounds from the front-right, above.
+    /// The camera a model without one is seen through: from the front (+Z, looking towards
+    /// −Z) [`super::framing::DEFAULT_ELEVATION_DEG`] above the horizontal, at the centre of
+    /// its bounds (`framing`, else `bounds()`), at the distance where the bounds' corners fill
+    /// [`super::framing::FILL`] of the shorter image side ([`super::framing::framed_camera`]).
     pub fn default_camera(&self, aspect: f32) -> Camera {
         let b = self.framing.unwrap_or_else(|| self.bounds());
-        let (center, radius) = b.bounding_sphere();
-        let fov_y = 45f32.to_radians();
-        let dist = framing_distance(radius, fov_y, aspect);
-        let dir = Vec3::new(0.55, 0.45, 1.0).normalize();
-        Camera::look_at(
-            center + dir * dist,
-            center,
-            fov_y,
-            (dist - radius).max(dist * 1e-3) * 0.5,
-        )
+        super::framing::framed_camera(&b, super::framing::default_direction(), aspect)
     }
 }

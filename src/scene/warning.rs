@@ -73,9 +73,10 @@ pub const FINDING_CODES: &[(&str, &str, &str)] = &[
         "a node with a non-finite transform was skipped",
     ),
     (
-        "CAMERA_ORTHOGRAPHIC",
+        "CAMERA_INVALID",
         "warning",
-        "orthographic cameras are skipped",
+        "a camera's projection is out of range (a zero or non-finite size or field of view, a far \
+         plane not beyond the near one): repaired as the message says",
     ),
     (
         "MATERIAL_ALPHA_BLEND",

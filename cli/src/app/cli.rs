@@ -1,15 +1,15 @@
 //! Argument parsing (clap) and turning arguments into a scene and a view.
 
 use super::parse::{
-    parse_ambient, parse_budget, parse_exposure, parse_fps, parse_msaa, parse_on_off, parse_size,
-    parse_time, parse_vec3,
+    parse_ambient, parse_background, parse_budget, parse_exposure, parse_fps, parse_msaa,
+    parse_on_off, parse_size, parse_time, parse_vec3,
 };
 use anyhow::{anyhow, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 use std::path::PathBuf;
 use umbra::render::{
-    Exposure, Pcf, ShadowFit, ShadowFormat, ShadowSettings, Tonemap, View, ViewMode,
+    Background, Exposure, Pcf, ShadowFit, ShadowFormat, ShadowSettings, Tonemap, View, ViewMode,
 };
 use umbra::scene::anim::Playing;
 use umbra::scene::{demo::demo_scene, load_gltf, Camera, Scene};
@@ -388,11 +388,17 @@ pub struct ViewArgs {
     /// a sunlit scene in lux), or `xS` for a linear scale S (`x1`: the shading's raw values).
     #[arg(long, default_value = "auto", value_parser = parse_exposure, allow_hyphen_values = true)]
     pub exposure: Exposure,
-    /// Ambient intensity Ia (the formula's ka·Ia term): one value for grey or R,G,B, in the
-    /// units of the scene's lights. Default: 7 % of the direct illuminance auto exposure
-    /// meters (0.12 under the default sun), so it follows the lights' units.
+    /// A flat ambient intensity Ia (the formula's ka·Ia term, the same from every direction):
+    /// one value for grey or R,G,B, in the units of the scene's lights. Default: a sky and
+    /// ground hemisphere sized by the direct illuminance auto exposure meters (sky 20 %,
+    /// ground 6 %; docs/accuracy.md), so it follows the lights' units.
     #[arg(long, value_parser = parse_ambient)]
     pub ambient: Option<Vec3>,
+    /// What the lit image shows where nothing is drawn: `sky` (the ambient hemisphere seen
+    /// along each pixel, exposed like the scene) or a display colour (#RRGGBB, or R,G,B within
+    /// 0..1).
+    #[arg(long, default_value = "sky", value_parser = parse_background)]
+    pub background: Background,
     /// Tone-mapping curve of the lit image: Khronos PBR Neutral, ACES (Hill's fit), or none
     /// (exposed values clamped).
     #[arg(long, value_enum, default_value = "neutral")]
@@ -688,6 +694,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     v.mode = a.mode;
     v.exposure = a.exposure;
     v.ambient = a.ambient;
+    v.background = a.background;
     v.tonemap = a.tonemap;
     if let Some(i) = a.shadow_light {
         let n = umbra::render::effective_lights(&scene.lights, &v).len();

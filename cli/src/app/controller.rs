@@ -1,12 +1,13 @@
 //! Camera controllers for the viewer, as pure logic (input events → camera state) so they can be
 //! unit-tested without a window: orbit (left-drag rotate, right/middle-drag pan, wheel zoom,
-//! frame the bounds) and fly (WASD + Q/E, mouse look with the left button, Shift for speed).
-//! Speeds scale with the scene's size.
+//! frame the bounds) and fly (WASD + Q/E, mouse look with the left button, Shift for speed),
+//! either through a perspective or an orthographic projection. Speeds scale with the scene's
+//! size.
 
 use glam::Vec3;
-use umbra::math::projection::framing_distance;
 use umbra::math::Aabb;
-use umbra::scene::Camera;
+use umbra::scene::framing::{fit_box, FILL, FOV_Y_DEG};
+use umbra::scene::{Camera, Projection};
 
 /// Mouse buttons the controllers use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,8 +78,12 @@ pub struct Controller {
     pub pitch: f32,
     /// Fly position.
     pub position: Vec3,
-    /// Vertical field of view.
+    /// Vertical field of view (perspective; an orthographic view spans what it spans at the
+    /// orbit distance).
     pub fov_y: f32,
+    /// Orthographic (parallel) projection: ±distance·tan(fov_y / 2) vertically, the eye drawn
+    /// back by the scene's size so nothing in front of the orbit centre is clipped.
+    pub orthographic: bool,
     /// Scene size (bounds diagonal) that scales speeds and the near plane.
     pub scale: f32,
     /// Near-plane distance of the camera this controller continues from (its own near plane
@@ -109,7 +114,8 @@ impl Controller {
             yaw: 0.5,
             pitch: 0.4,
             position: Vec3::ZERO,
-            fov_y: 45f32.to_radians(),
+            fov_y: FOV_Y_DEG.to_radians(),
+            orthographic: false,
             scale: 1.0,
             near: None,
             held: Vec::new(),
@@ -120,34 +126,54 @@ impl Controller {
         c
     }
 
-    /// A controller continuing from `camera` (orbiting the point `focus` distance ahead).
+    /// A controller continuing from `camera` (orbiting the point ahead of it level with the
+    /// bounds' centre; an orthographic camera keeps its height of view).
     pub fn from_camera(camera: &Camera, bounds: &Aabb) -> Self {
         let mut c = Self::framing(bounds);
         let eye = camera.position();
-        let forward = (camera.world_from_view.transform_vector3(-Vec3::Z)).normalize_or(-Vec3::Z);
+        let forward = camera.forward();
         let dist = if bounds.is_empty() {
             1.0
         } else {
             (bounds.center() - eye).dot(forward).max(c.scale * 0.05)
         };
-        c.target = eye + forward * dist;
-        c.distance = dist;
         c.pitch = (-forward.y).clamp(-1.0, 1.0).asin();
         c.yaw = (-forward.x).atan2(-forward.z);
-        c.position = eye;
-        c.fov_y = camera.fov_y;
         c.near = Some(camera.near).filter(|n| n.is_finite() && *n > 0.0);
+        match camera.projection {
+            Projection::Perspective { fov_y } => {
+                c.fov_y = fov_y;
+                c.orthographic = false;
+                c.target = eye + forward * dist;
+                c.distance = dist;
+                c.position = eye;
+            }
+            Projection::Orthographic { ymag, .. } => {
+                c.orthographic = true;
+                c.distance = ymag / (c.fov_y * 0.5).tan();
+                c.target = eye + forward * dist;
+                c.position = c.target - forward * c.distance;
+            }
+        }
         c
     }
 
-    /// Orbit to frame `bounds` in a view of `aspect` (the `F` key).
+    /// Orbit to frame `bounds` in a view of `aspect` from the current direction (the `F` key):
+    /// the box centred, filling the same share of the shorter side as the default view.
     pub fn frame(&mut self, bounds: &Aabb, aspect: f32) {
-        let (center, radius) = bounds.bounding_sphere();
+        let (_, radius) = bounds.bounding_sphere();
         self.scale = radius * 2.0;
         self.near = None;
-        self.target = center;
-        self.distance = framing_distance(radius, self.fov_y, aspect);
+        let f = fit_box(bounds, -self.forward(), self.fov_y, aspect, FILL);
+        self.target = f.target;
+        self.distance = (f.eye - f.target).length();
         self.mode = Mode::Orbit;
+    }
+
+    /// Switches between a perspective and an orthographic projection, keeping the size of what
+    /// is seen at the orbit centre (the `O` key).
+    pub fn toggle_projection(&mut self) {
+        self.orthographic = !self.orthographic;
     }
 
     /// Switches between orbit and fly, keeping the eye where it is (the `Tab` key).
@@ -267,7 +293,16 @@ impl Controller {
         let near = (self.scale * 1e-3)
             .min(self.near.unwrap_or(f32::INFINITY))
             .max(1e-5);
-        Camera::look_at(eye, eye + self.forward(), self.fov_y, near)
+        let forward = self.forward();
+        if self.orthographic {
+            // As tall as the perspective view at the orbit centre; drawn back so that nothing
+            // between the eye and the centre, or a scene's size behind the eye, is clipped.
+            let ymag = self.distance * (self.fov_y * 0.5).tan();
+            let back = eye - forward * self.scale;
+            let far = self.scale * 2.0 + self.distance + self.scale;
+            return Camera::orthographic_look_at(back, back + forward, ymag, near, far);
+        }
+        Camera::look_at(eye, eye + forward, self.fov_y, near)
     }
 }
 
@@ -280,11 +315,18 @@ mod tests {
     }
 
     #[test]
-    fn framing_sees_the_bounds_centre() {
+    fn framing_centres_the_bounds() {
         let c = Controller::framing(&bounds());
         let cam = c.camera();
-        let v = cam.view_from_world().transform_point3(Vec3::ZERO);
-        assert!(v.x.abs() < 1e-4 && v.y.abs() < 1e-4 && v.z < 0.0, "{v}");
+        let m = umbra::plan::camera_projection(&cam, 1.0) * cam.view_from_world();
+        let (mut lo, mut hi) = (glam::Vec2::MAX, glam::Vec2::MIN);
+        for p in bounds().corners() {
+            let q = m * p.extend(1.0);
+            lo = lo.min(q.truncate().truncate() / q.w);
+            hi = hi.max(q.truncate().truncate() / q.w);
+        }
+        let centre = (lo + hi) * 0.5;
+        assert!(centre.abs().max_element() < 1e-3, "{centre}");
         assert!(cam.position().length() > 8.66, "outside the bounds");
     }
 
@@ -297,7 +339,8 @@ mod tests {
         c.handle(Input::Cursor(200.0, 100.0));
         c.handle(Input::Release(Button::Left));
         let after = c.eye();
-        assert!((after.length() - before.length()).abs() < 1e-3);
+        let t = c.target;
+        assert!(((after - t).length() - (before - t).length()).abs() < 1e-3);
         assert!(
             (after - before).length() > 1.0,
             "dragging 100 px must rotate"
@@ -372,5 +415,61 @@ mod tests {
         let f0 = cam.world_from_view.transform_vector3(-Vec3::Z);
         let f1 = back.world_from_view.transform_vector3(-Vec3::Z);
         assert!(f0.abs_diff_eq(f1, 1e-4));
+    }
+
+    #[test]
+    fn orthographic_keeps_the_size_seen_at_the_centre_and_sees_it_all() {
+        let mut c = Controller::framing(&bounds());
+        let persp = c.camera();
+        c.toggle_projection();
+        let ortho = c.camera();
+        let Projection::Orthographic { ymag, .. } = ortho.projection else {
+            panic!("{ortho:?}");
+        };
+        // The perspective half-height at the orbit centre.
+        let want = c.distance * (persp.fov_y().unwrap() * 0.5).tan();
+        assert!((ymag - want).abs() < 1e-4, "{ymag} vs {want}");
+        assert!(ortho.forward().abs_diff_eq(persp.forward(), 1e-6));
+        // Every corner of the bounds lies between its near and far planes.
+        let view = ortho.view_from_world();
+        for p in bounds().corners() {
+            let d = -view.transform_point3(p).z;
+            assert!(d > ortho.near && d < ortho.far.unwrap(), "{p} at {d}");
+        }
+        // Back to perspective: the same camera as before.
+        c.toggle_projection();
+        assert_eq!(c.camera(), persp);
+        // From a glTF orthographic camera: the same height of view and direction.
+        let glb =
+            Camera::orthographic_look_at(Vec3::new(0.0, 2.0, 20.0), Vec3::ZERO, 3.0, 0.0, 50.0);
+        let c = Controller::from_camera(&glb, &bounds());
+        let back = c.camera();
+        assert_eq!(
+            back.projection,
+            Projection::Orthographic {
+                xmag: 3.0,
+                ymag: 3.0
+            }
+        );
+        assert!(back.forward().abs_diff_eq(glb.forward(), 1e-5));
+    }
+
+    #[test]
+    fn framing_fills_the_share_of_the_shorter_side() {
+        let b = Aabb::new(Vec3::new(-4.0, 0.0, -0.2), Vec3::new(4.0, 1.0, 0.2));
+        let mut c = Controller::framing(&b);
+        c.frame(&b, 16.0 / 9.0);
+        let cam = c.camera();
+        let m = umbra::plan::camera_projection(&cam, 16.0 / 9.0) * cam.view_from_world();
+        let (mut lo, mut hi) = (glam::Vec2::MAX, glam::Vec2::MIN);
+        for p in b.corners() {
+            let q = m * p.extend(1.0);
+            let ndc = q.truncate().truncate() / q.w;
+            lo = lo.min(ndc);
+            hi = hi.max(ndc);
+        }
+        // In pixels of a 16:9 image 9 units high: the wider side spans FILL of the height.
+        let span = (hi - lo) * 0.5 * glam::Vec2::new(16.0, 9.0);
+        assert!((span.max_element() / 9.0 - FILL).abs() < 2e-3, "{span}");
     }
 }

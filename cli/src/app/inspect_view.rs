@@ -165,12 +165,13 @@ fn exposure(r: &Value, h: &dyn Fn(&str) -> String) -> String {
     if !e.is_null() {
         out += &h("Exposure (default view)");
         out += &format!(
-            "{}: metered {} lux, EV100 {}, scale {}, ambient {}, tone curve {}\n",
+            "{}: metered {} lux, EV100 {}, scale {}, ambient sky {} ground {}, tone curve {}\n",
             cell(&e["mode"]),
             cell(&e["metered_lux"]),
             cell(&e["ev100"]),
             cell(&e["scale"]),
-            cell(&e["ambient"][0]),
+            cell(&e["ambient"][1]),
+            cell(&e["ambient_ground"][1]),
             cell(&e["tonemap"])
         );
     }
@@ -373,12 +374,22 @@ fn tree(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
             t.row(vec![
                 format!("camera {}", cell(&c["index"])),
                 cell(&c["type"]),
-                format!(
-                    "yfov {} znear {} zfar {}",
-                    cell(&c["yfov"]),
-                    cell(&c["znear"]),
-                    cell(&c["zfar"])
-                ),
+                if c["type"] == "orthographic" {
+                    format!(
+                        "xmag {} ymag {} znear {} zfar {}",
+                        cell(&c["xmag"]),
+                        cell(&c["ymag"]),
+                        cell(&c["znear"]),
+                        cell(&c["zfar"])
+                    )
+                } else {
+                    format!(
+                        "yfov {} znear {} zfar {}",
+                        cell(&c["yfov"]),
+                        cell(&c["znear"]),
+                        cell(&c["zfar"])
+                    )
+                },
             ]);
         }
         for l in arr(&st["lights"]) {

@@ -2,7 +2,7 @@
 //! message for clap on bad input.
 
 use glam::Vec3;
-use umbra::render::Exposure;
+use umbra::render::{Background, Exposure};
 
 /// A frame rate within 0.001..=10000.
 pub(crate) fn parse_fps(s: &str) -> Result<f32, String> {
@@ -72,6 +72,39 @@ pub(crate) fn parse_ambient(s: &str) -> Result<Vec3, String> {
         return Err(format!("ambient '{s}' must be finite and >= 0"));
     }
     Ok(v)
+}
+
+/// `sky`, or a display (sRGB) colour: `#RRGGBB`, or `R,G,B` / one grey value within 0..1,
+/// returned as the linear colour the background is cleared to.
+pub(crate) fn parse_background(s: &str) -> Result<Background, String> {
+    let t = s.trim();
+    if t.eq_ignore_ascii_case("sky") {
+        return Ok(Background::Sky);
+    }
+    let srgb = if let Some(hex) = t.strip_prefix('#') {
+        let byte = |i: usize| {
+            hex.get(i..i + 2)
+                .and_then(|b| u8::from_str_radix(b, 16).ok())
+                .map(|b| b as f32 / 255.0)
+        };
+        match (hex.len(), byte(0), byte(2), byte(4)) {
+            (6, Some(r), Some(g), Some(b)) => Vec3::new(r, g, b),
+            _ => return Err(format!("background '{s}' is not #RRGGBB")),
+        }
+    } else {
+        match t.parse::<f32>() {
+            Ok(g) => Vec3::splat(g),
+            Err(_) => parse_vec3(t)?,
+        }
+    };
+    if !(srgb.is_finite() && srgb.min_element() >= 0.0 && srgb.max_element() <= 1.0) {
+        return Err(format!(
+            "background '{s}' must be sky, #RRGGBB or R,G,B within 0..1"
+        ));
+    }
+    Ok(Background::Color(
+        srgb.map(umbra::math::tonemap::srgb_to_linear),
+    ))
 }
 
 /// `auto`, an EV100 number, or `x` and a linear scale.

@@ -4,14 +4,15 @@
 //!
 //! A script is a comma-separated list of steps, each optionally repeated with `*N`:
 //! `WxH` resizes the window (`0x0` simulates minimising), `key:NAME` presses and releases a key
-//! (`up down left right [ ] k + - v h f tab c p space i o z x r`, the viewer's own bindings), `wheel:N`
+//! (`up down left right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r`, the
+//! viewer's own bindings), `wheel:N`
 //! scrolls N lines (positive zooms in) and `click:X:Y` clicks (picks) at window pixel (X, Y).
 //! Example: `key:down*40,wheel:1*80,640x360*3,0x0,click:320:200`.
 
 /// Key names a script may press (each one of the viewer's bindings).
 pub const KEYS: &[&str] = &[
     "up", "down", "left", "right", "[", "]", "k", "+", "-", "v", "h", "n", "g", "j", "l", "t",
-    "comma", "period", "f", "tab", "c", "p", "space", "i", "o", "z", "x", "r",
+    "comma", "period", "f", "tab", "c", "o", "p", "space", "u", "i", "z", "x", "r",
 ];
 
 /// Most steps one script may expand to (a typo such as `*1000000000` is an error, not a hang).

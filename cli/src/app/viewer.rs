@@ -84,6 +84,7 @@ enum KeyAction {
     Frame,
     ToggleFly,
     NextCamera,
+    ToggleOrthographic,
     Screenshot,
     Anim(AnimKey),
     Quit,
@@ -115,6 +116,7 @@ fn script_key(name: &str) -> Option<KeyCode> {
         "comma" => KeyCode::Comma,
         "period" => KeyCode::Period,
         "space" => KeyCode::Space,
+        "u" => KeyCode::KeyU,
         "i" => KeyCode::KeyI,
         "o" => KeyCode::KeyO,
         "z" => KeyCode::KeyZ,
@@ -155,10 +157,11 @@ fn key_action(code: KeyCode) -> Option<KeyAction> {
         KeyCode::KeyF => Frame,
         KeyCode::Tab => ToggleFly,
         KeyCode::KeyC => NextCamera,
+        KeyCode::KeyO => ToggleOrthographic,
         KeyCode::KeyP => Screenshot,
         KeyCode::Space => Anim(AnimKey::Toggle),
-        KeyCode::KeyI => Anim(AnimKey::Step(-1)),
-        KeyCode::KeyO => Anim(AnimKey::Step(1)),
+        KeyCode::KeyU => Anim(AnimKey::Step(-1)),
+        KeyCode::KeyI => Anim(AnimKey::Step(1)),
         KeyCode::KeyZ => Anim(AnimKey::Speed(0.5)),
         KeyCode::KeyX => Anim(AnimKey::Speed(2.0)),
         KeyCode::KeyR => Anim(AnimKey::Next),
@@ -536,8 +539,28 @@ impl App {
                     s.camera_index = Some(i);
                     s.view.camera = opts.scene.cameras[i];
                     s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
-                    println!("camera: glTF camera {i}");
+                    let kind = if s.view.camera.is_orthographic() {
+                        "orthographic"
+                    } else {
+                        "perspective"
+                    };
+                    println!("camera: glTF camera {i} ({kind})");
                 }
+            }
+            KeyAction::ToggleOrthographic => {
+                if let Some(i) = s.camera_index.take() {
+                    // Continue from the glTF camera on screen.
+                    s.controller = Controller::from_camera(&opts.scene.cameras[i], &s.bounds);
+                }
+                s.controller.toggle_projection();
+                println!(
+                    "camera: {}",
+                    if s.controller.orthographic {
+                        "orthographic"
+                    } else {
+                        "perspective"
+                    }
+                );
             }
             KeyAction::Screenshot => s.want_screenshot = true,
             KeyAction::Anim(k) => {

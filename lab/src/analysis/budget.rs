@@ -174,7 +174,10 @@ pub fn features(probe: &ViewProbe, plan: &FramePlan, view: &View) -> Features {
         .z_axis
         .truncate()
         .normalize_or(Vec3::NEG_Z);
-    let pixel_angle = 2.0 * (view.camera.fov_y * 0.5).tan() / probe.height.max(1) as f32;
+    // A pixel's footprint at distance d: d × its angle, or under an orthographic camera the same
+    // at every distance.
+    let rows = probe.height.max(1) as f32;
+    let pixel_at = |d: f32| 2.0 * view.camera.half_extent_at(d, 1.0).y / rows;
     let rho = |p: &Probe| -> f64 {
         let depth = (p.position - eye).dot(forward);
         let k = views
@@ -186,7 +189,7 @@ pub fn features(probe: &ViewProbe, plan: &FramePlan, view: &View) -> Features {
             LightKind::Directional => tw,
             _ => tw * (p.position - light.position).length(),
         };
-        (texel / (p.distance * pixel_angle).max(f32::MIN_POSITIVE)) as f64
+        (texel / pixel_at(p.distance).max(f32::MIN_POSITIVE)) as f64
     };
     let at = |i: u32, j: u32| probe.probes[(j * probe.cols + i) as usize];
     let ell = std::f64::consts::FRAC_PI_4 * probe.stride as f64;

@@ -211,10 +211,11 @@ pub fn sweep_views(scene: &Scene, aspect: f32) -> Vec<(String, Camera)> {
     let framed = scene.framing.unwrap_or(b);
     let (c, r) = framed.bounding_sphere();
     let dist = (default.position() - c).length();
+    let fov = umbra::scene::framing::FOV_Y_DEG.to_radians();
     let high = Camera::look_at(
         c + Vec3::new(-0.45, 1.3, -0.6).normalize() * dist,
         c,
-        default.fov_y,
+        default.fov_y().unwrap_or(fov),
         default.near,
     );
     // Eye height: 4% of the framed model's height above the lowest point (at least 0.2% of r).

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use umbra::math::interp::perturb_normal;
 use umbra::math::projection::pixel_to_ndc;
 use umbra::math::ray::Ray;
-use umbra::plan::FramePlan;
+use umbra::plan::{Ambient, FramePlan};
 use umbra::scene::{
     blinn_phong_params, shade_blinn_phong, AlphaMode, Filter, LightKind, Sampler, Scene, Texture,
     TextureRef, BLEND_SHADOW_CUTOFF,
@@ -177,14 +177,21 @@ pub struct Pick {
     pub lights_visible: Vec<bool>,
 }
 
-/// The primary ray through image position (x, y) of the camera with clip → world `inv` at `eye`.
-fn primary_ray(inv: &glam::Mat4, eye: Vec3, x: f32, y: f32, w: u32, h: u32) -> Ray {
+/// The primary ray through image position (x, y) of `plan`'s camera (clip → world `inv`): from
+/// the eye through the pixel for a perspective camera, from the pixel on the near plane along the
+/// view for an orthographic one (parallel rays).
+fn primary_ray(plan: &FramePlan, inv: &glam::Mat4, x: f32, y: f32, w: u32, h: u32) -> Ray {
     let n = pixel_to_ndc(x, y, w, h);
-    let far = *inv * Vec4::new(n.x, n.y, 1e-3, 1.0);
-    Ray::new(
-        eye,
-        (far.truncate() / far.w - eye).normalize_or(Vec3::NEG_Z),
-    )
+    let at = |depth: f32| {
+        let p = *inv * Vec4::new(n.x, n.y, depth, 1.0);
+        p.truncate() / p.w
+    };
+    if plan.orthographic {
+        let near = at(1.0);
+        return Ray::new(near, (at(0.5) - near).normalize_or(Vec3::NEG_Z));
+    }
+    let eye = plan.camera_position;
+    Ray::new(eye, (at(1e-3) - eye).normalize_or(Vec3::NEG_Z))
 }
 
 /// Turns a hit's geometric normal towards the viewer along `dir`, as the shader does; the
@@ -462,21 +469,26 @@ impl<'a> ReferenceScene<'a> {
 
     /// The linear colour seen along `ray` beyond `t_min`: the first surface's shading, and where
     /// it is blended, that over what lies behind it (up to `MAX_BLEND_LAYERS` blended surfaces);
-    /// the clear colour where nothing is hit.
+    /// the background where nothing is hit.
     fn radiance(
         &self,
         plan: &FramePlan,
         ray: &Ray,
         t_min: f32,
-        ambient: Vec3,
+        ambient: Ambient,
         layers: u32,
     ) -> Vec3 {
-        let c = umbra::plan::CLEAR_COLOR;
         let Some(h) = self.intersect_from(ray, t_min) else {
-            return Vec3::new(c[0], c[1], c[2]);
+            return plan.background_along(ray.dir);
         };
         let (_, _, rgb) = self.shade(plan, ray, &h, ambient);
-        self.blend_behind(plan, ray, &h, plan.display(rgb), ambient, layers)
+        let rgb = plan.display_surface(rgb, self.unlit(&h));
+        self.blend_behind(plan, ray, &h, rgb, ambient, layers)
+    }
+
+    /// Whether the surface hit is unlit (KHR_materials_unlit).
+    fn unlit(&self, h: &Hit) -> bool {
+        self.material_of(h).is_some_and(|m| m.unlit)
     }
 
     /// `rgb`, the shading of hit `h`, blended over what lies behind it when its material is
@@ -487,7 +499,7 @@ impl<'a> ReferenceScene<'a> {
         ray: &Ray,
         h: &Hit,
         rgb: Vec3,
-        ambient: Vec3,
+        ambient: Ambient,
         layers: u32,
     ) -> Vec3 {
         if layers >= MAX_BLEND_LAYERS
@@ -519,7 +531,7 @@ impl<'a> ReferenceScene<'a> {
             "plan and reference share an origin"
         );
         let inv = plan.clip_from_world.inverse();
-        let ray = primary_ray(&inv, plan.camera_position, x, y, width, height);
+        let ray = primary_ray(plan, &inv, x, y, width, height);
         let h = self.intersect(&ray)?;
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
@@ -585,11 +597,10 @@ impl<'a> ReferenceScene<'a> {
             "plan and reference share an origin"
         );
         let inv = plan.clip_from_world.inverse();
-        let eye = plan.camera_position;
         pixels
             .par_iter()
             .map(|&(x, y)| {
-                let ray = primary_ray(&inv, eye, x, y, width, height);
+                let ray = primary_ray(plan, &inv, x, y, width, height);
                 let h = self.intersect(&ray)?;
                 // The same normals, flips and facing test as `shade`.
                 let (ng, mut n_geo) = self.hit_normals(&h);
@@ -612,23 +623,22 @@ impl<'a> ReferenceScene<'a> {
             .collect()
     }
 
-    /// Casts one primary ray per pixel centre of `plan`'s camera and shades the hits.
+    /// Casts one primary ray per pixel centre of `plan`'s camera and shades the hits; the
+    /// background where nothing is hit is `plan`'s ([`FramePlan::background_along`]).
     pub fn render(
         &self,
         plan: &FramePlan,
         width: u32,
         height: u32,
-        ambient: Vec3,
+        ambient: Ambient,
     ) -> ReferenceFrame {
         debug_assert_eq!(
             plan.origin, self.origin,
             "plan and reference share an origin"
         );
         let inv = plan.clip_from_world.inverse();
-        let eye = plan.camera_position;
         let n = (width * height) as usize;
-        let c = umbra::plan::CLEAR_COLOR;
-        let background = [srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255];
+        let encode = |c: Vec3| [srgb_encode(c.x), srgb_encode(c.y), srgb_encode(c.z), 255];
         let results: Vec<PixelResult> = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -636,12 +646,19 @@ impl<'a> ReferenceScene<'a> {
                     (i as u32 % width) as f32 + 0.5,
                     (i as u32 / width) as f32 + 0.5,
                 );
-                let ray = primary_ray(&inv, eye, x, y, width, height);
+                let ray = primary_ray(plan, &inv, x, y, width, height);
                 match self.intersect(&ray) {
-                    None => (None, f32::INFINITY, background, false, 1.0),
+                    None => (
+                        None,
+                        f32::INFINITY,
+                        encode(plan.background_along(ray.dir)),
+                        false,
+                        1.0,
+                    ),
                     Some(h) => {
                         let (vis, cover, rgb) = self.shade(plan, &ray, &h, ambient);
-                        let rgb = self.blend_behind(plan, &ray, &h, plan.display(rgb), ambient, 0);
+                        let rgb = plan.display_surface(rgb, self.unlit(&h));
+                        let rgb = self.blend_behind(plan, &ray, &h, rgb, ambient, 0);
                         let (ng, n) = self.hit_normals(&h);
                         let incidence = plan.shadow_light.map_or(1.0, |i| {
                             let (_, flip) = face_viewer(ng, n, ray.dir);
@@ -651,12 +668,7 @@ impl<'a> ReferenceScene<'a> {
                         (
                             Some((vis, cover)),
                             h.t,
-                            [
-                                srgb_encode(rgb.x),
-                                srgb_encode(rgb.y),
-                                srgb_encode(rgb.z),
-                                255,
-                            ],
+                            encode(rgb),
                             ng.dot(n).abs() < CURVED_COS,
                             incidence,
                         )
@@ -681,7 +693,7 @@ impl<'a> ReferenceScene<'a> {
     }
 
     /// The shown light's centre visibility and emitter fraction, and the lit colour.
-    fn shade(&self, plan: &FramePlan, ray: &Ray, h: &Hit, ambient: Vec3) -> (bool, f32, Vec3) {
+    fn shade(&self, plan: &FramePlan, ray: &Ray, h: &Hit, ambient: Ambient) -> (bool, f32, Vec3) {
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
         let idx = [
@@ -734,7 +746,7 @@ impl<'a> ReferenceScene<'a> {
         } else {
             1.0
         };
-        let mut color = bp.ka * ambient * occlusion + emissive;
+        let mut color = bp.ka * ambient.at(n) * occlusion + emissive;
         let (mut shadow_vis, mut shadow_cover) = (true, 1.0);
         for i in 0..plan.lights.len() {
             let (vis, cover, l, radiance) = self.visible(plan, i, p, ng, n_geo);

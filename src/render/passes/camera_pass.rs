@@ -8,18 +8,17 @@ use crate::gpu::shaders::{
     allocate_sets, create_module, scene as sh, set_layout, ReflectedBinding,
 };
 use crate::gpu::Buffer;
+use crate::plan::flat_hides_nothing;
 use crate::plan::uniforms::FrameUniform;
-use crate::plan::{flat_hides_nothing, Viewpoint};
 use crate::render::gpu_scene::{vertex_layout, AlphaDraw, GpuScene};
 use crate::render::passes::cull::{CameraCull, Entry};
 use crate::render::passes::deferred::{self, DeferPlan, GBuffer, GBUFFER_FORMAT, GBUFFER_TARGETS};
 use crate::render::passes::receivers::{self, Split};
 use crate::render::pipeline::{
-    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
-    Stencil,
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
+    PipelineDesc, Stencil,
 };
 use ash::vk;
-use glam::Vec3;
 use gpu_allocator::MemoryLocation;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -58,6 +57,8 @@ pub struct CameraPass {
     /// Scene pipelines created so far, by (variant index, entry point).
     pipelines: HashMap<(usize, Entry), vk::Pipeline>,
     map_pipeline: vk::Pipeline,
+    /// The background where nothing was drawn (`fs_sky`).
+    sky_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
     linear_sampler: vk::Sampler,
@@ -103,11 +104,21 @@ impl CameraPass {
             stencil: Stencil::Off,
             depth_clamp: false,
             depth_bias: false,
-            depth_test: false,
+            depth: Depth::Off,
             blend: ColorBlend::Off,
             samples,
         };
         let map_pipeline = create_pipeline(ctx, &desc)?;
+        // The sky: a full-screen triangle at depth 0 drawn where no surface was.
+        let sky_pipeline = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "sky pipeline",
+                fragment: Some((module, sh::ENTRY_FS_SKY)),
+                depth: Depth::Empty,
+                ..desc
+            },
+        )?;
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, frame_layout, slots)?;
         let mut slot_list = Vec::new();
         for (i, set) in sets.into_iter().enumerate() {
@@ -156,6 +167,7 @@ impl CameraPass {
             variant_modules: HashMap::new(),
             pipelines: HashMap::new(),
             map_pipeline,
+            sky_pipeline,
             pool,
             slots: slot_list,
             linear_sampler,
@@ -349,7 +361,7 @@ impl CameraPass {
         let mut unshadowed = 0;
         let mut deferred_draws = 0;
         if deferring {
-            deferred_draws = self.record_gbuffer(cmd, scene, targets, frame_set, plan, cull.eye);
+            deferred_draws = self.record_gbuffer(cmd, scene, targets, frame_set, plan, cull);
         }
         let mut color_att = vk::RenderingAttachmentInfo::default()
             .image_view(color)
@@ -399,7 +411,7 @@ impl CameraPass {
             if deferring {
                 self.record_resolve(cmd, scene, plan, cull.frame_bits, extent);
             }
-            if !plan.forward.is_empty() {
+            if !plan.forward.is_empty() || frame.sky {
                 let (n, u) = self.record_forward(cmd, scene, frame, extent);
                 drawn += n;
                 unshadowed += u;
@@ -415,8 +427,9 @@ impl CameraPass {
     }
 
     /// Records the forward draws of the frame, splitting each into its shadowed and unshadowed
-    /// pieces (`receivers::split`). Returns the draws recorded and how many of them were drawn (in
-    /// part) without the shadow lookup.
+    /// pieces (`receivers::split`), and with `frame.sky` the sky after the opaque and masked draws
+    /// and before the blended ones (which composite over it). Returns the draws recorded and how
+    /// many of them were drawn (in part) without the shadow lookup.
     fn record_forward(
         &self,
         cmd: vk::CommandBuffer,
@@ -431,9 +444,15 @@ impl CameraPass {
             bind_geometry(d, cmd, scene);
             let mut bound_material = usize::MAX;
             let mut bound_pipeline = vk::Pipeline::null();
+            let mut sky = frame.sky;
             for (&i, split) in frame.defer.forward.iter().zip(&frame.splits) {
                 let dr = &scene.draws[i];
                 let entry = Entry::of(dr.alpha, cull.debug_view);
+                if sky && entry == Entry::Blended {
+                    self.record_sky(cmd);
+                    bound_pipeline = self.sky_pipeline;
+                    sky = false;
+                }
                 let bits = dr.material_bits | cull.frame_bits;
                 unshadowed += usize::from(*split != Split::Shadowed);
                 let pieces = pieces(bits, split.clone());
@@ -468,7 +487,7 @@ impl CameraPass {
                         self.layout,
                         dr,
                         Some(cull.eye),
-                        Viewpoint::Eye(cull.eye.0),
+                        cull.viewpoint,
                         bytemuck::bytes_of(&imm),
                     );
                 }
@@ -476,8 +495,23 @@ impl CameraPass {
                     d.cmd_set_scissor(cmd, 0, &[full_rect(extent)]);
                 }
             }
+            if sky {
+                self.record_sky(cmd);
+            }
         }
         (drawn, unshadowed)
+    }
+
+    /// Records the sky: one full-screen triangle at depth 0, shaded only where no surface was
+    /// drawn (inside a rendering whose set 0 is bound).
+    fn record_sky(&self, cmd: vk::CommandBuffer) {
+        let d = &self.ctx.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.sky_pipeline);
+            d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
+            d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
+            d.cmd_draw(cmd, 3, 1, 0, 0);
+        }
     }
 
     /// Records the G-buffer pass of `plan`'s deferred draws (clearing depth and stencil, each
@@ -490,7 +524,7 @@ impl CameraPass {
         targets: &CameraTargets,
         frame_set: vk::DescriptorSet,
         plan: &DeferPlan,
-        eye: (Vec3, f32),
+        cull: &CameraCull,
     ) -> usize {
         let (depth, extent) = (targets.depth, targets.extent);
         let ctx = self.ctx.clone();
@@ -531,8 +565,8 @@ impl CameraPass {
                 cmd,
                 self.layout,
                 dr,
-                Some(eye),
-                Viewpoint::Eye(eye.0),
+                Some(cull.eye),
+                cull.viewpoint,
                 bytemuck::bytes_of(&dr.immediates),
             );
         }
@@ -659,9 +693,9 @@ fn draw_order(scene: &GpuScene, cull: &CameraCull) -> Vec<usize> {
             let nearest = cull.eye.0.clamp(dr.world_bounds.min, dr.world_bounds.max);
             // A ground plane's nearest point is right under the eye, but it hides nothing: drawn
             // last, its fragments behind everything else fail the early depth test.
-            let hides_nothing = dr.world_plane.is_some_and(|pl| {
-                flat_hides_nothing(pl, Viewpoint::Eye(cull.eye.0), &scene.bounds)
-            });
+            let hides_nothing = dr
+                .world_plane
+                .is_some_and(|pl| flat_hides_nothing(pl, cull.viewpoint, &scene.bounds));
             let key = (dr.alpha, hides_nothing && dr.alpha != AlphaDraw::Blended);
             let distance = match dr.alpha {
                 AlphaDraw::Blended => -dr.world_bounds.center().distance_squared(cull.eye.0),
@@ -682,6 +716,8 @@ pub struct CameraFrame {
     pub cull: CameraCull,
     /// Draw the shadow map full-screen instead of the scene (the map debug view).
     pub shadow_map_view: bool,
+    /// Draw the sky where no surface is (the lit image with `Background::Sky`).
+    pub sky: bool,
     /// Deferred and forward draws.
     pub defer: DeferPlan,
     /// Per forward draw (`defer.forward`), its receiver split.
@@ -690,13 +726,15 @@ pub struct CameraFrame {
 
 impl CameraPass {
     /// Decides what the camera pass draws for `cull` at `extent`: the draw order, the deferred
-    /// split (`deferred::plan`) and each forward draw's receiver split.
+    /// split (`deferred::plan`) and each forward draw's receiver split; `sky`: the background is
+    /// the sky (not drawn with the shadow-map view).
     pub fn plan_frame(
         &self,
         scene: &GpuScene,
         cull: CameraCull,
         extent: vk::Extent2D,
         shadow_map_view: bool,
+        sky: bool,
     ) -> CameraFrame {
         let order = if shadow_map_view {
             Vec::new()
@@ -716,6 +754,7 @@ impl CameraPass {
         CameraFrame {
             cull,
             shadow_map_view,
+            sky: sky && !shadow_map_view,
             defer,
             splits,
         }
@@ -823,7 +862,11 @@ fn scene_pipeline(
             },
             depth_clamp: false,
             depth_bias: false,
-            depth_test: entry != Entry::Overdraw && !resolve,
+            depth: if entry == Entry::Overdraw || resolve {
+                Depth::Off
+            } else {
+                Depth::Test
+            },
             blend: match entry {
                 Entry::Overdraw => ColorBlend::Additive,
                 Entry::Blended => ColorBlend::Over,
@@ -846,6 +889,7 @@ impl Drop for CameraPass {
                 d.destroy_shader_module(m, None);
             }
             d.destroy_pipeline(self.map_pipeline, None);
+            d.destroy_pipeline(self.sky_pipeline, None);
             self.gbuffer = None;
             d.destroy_descriptor_set_layout(self.gbuffer_layout, None);
             d.destroy_shader_module(self.module, None);

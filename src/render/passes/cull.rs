@@ -1,6 +1,7 @@
 //! What the camera pass is told per frame: which draws it records and with which fragment
 //! entry point.
 
+use crate::plan::Viewpoint;
 use crate::render::gpu_scene::AlphaDraw;
 use crate::render::passes::receivers::ShadowReach;
 use glam::{Mat4, Vec3};
@@ -13,6 +14,9 @@ pub struct CameraCull {
     pub clip_from_world: Mat4,
     /// Eye position and the distance from it to the near plane's farthest corner.
     pub eye: (Vec3, f32),
+    /// What faces are seen from: the eye (perspective) or the viewing direction (orthographic),
+    /// for skipping clusters that face away and flat draws that hide nothing.
+    pub viewpoint: Viewpoint,
     /// The frame's shader variant bits (`FramePlan::shader_variant`).
     pub frame_bits: usize,
     /// A debug view's entry (`Entry::Debug` or `Entry::Overdraw`); `None` for the lit image.

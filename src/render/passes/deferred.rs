@@ -323,6 +323,7 @@ mod tests {
         let c = CameraCull {
             clip_from_world: perspective_infinite_reversed(90f32.to_radians(), 1.0, 0.1),
             eye: (Vec3::ZERO, 0.1),
+            viewpoint: crate::plan::Viewpoint::Eye(Vec3::ZERO),
             frame_bits: 0,
             debug_view: None,
             highlight: None,

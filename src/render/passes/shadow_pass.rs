@@ -12,8 +12,8 @@ use crate::plan::{flat_hides_nothing, CasterPlan, Viewpoint};
 use crate::render::gpu_scene::{vertex_layout, GpuScene};
 use crate::render::passes::shadow_cache::{split_moving, LayerKey, LayerWork, ShadowCache};
 use crate::render::pipeline::{
-    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, PipelineDesc,
-    Stencil,
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
+    PipelineDesc, Stencil,
 };
 use crate::render::targets::Attachment;
 use ash::vk;
@@ -176,7 +176,7 @@ fn depth_pipeline(
             stencil: Stencil::Off,
             depth_clamp: true,
             depth_bias: true,
-            depth_test: true,
+            depth: Depth::Test,
             blend: ColorBlend::Off,
             samples: 1,
         },

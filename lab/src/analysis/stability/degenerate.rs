@@ -98,7 +98,13 @@ fn cases(scene: &Scene, view: &View, quick: bool) -> Vec<Case> {
     };
     let cam = |eye: Vec3, target: Vec3, near: f32| {
         let mut v = view.clone();
-        v.camera = Camera::look_at(eye, target, view.camera.fov_y, near);
+        let fov = view.camera.fov_y();
+        v.camera = Camera::look_at(
+            eye,
+            target,
+            fov.unwrap_or(umbra::scene::framing::FOV_Y_DEG.to_radians()),
+            near,
+        );
         v
     };
     let inside = scene
@@ -237,8 +243,14 @@ pub fn degenerate(
             counts.judged - counts.edge_on,
         );
         let shows = if s.instances.is_empty() {
-            let first = *lit.image.get_pixel(0, 0);
-            lit.image.pixels().all(|p| *p == first) && counts.judged == 0
+            // Each pixel the background along its direction, within a level.
+            let bg = lit.plan.background_image(size.0, size.1);
+            let same = lit
+                .image
+                .pixels()
+                .zip(bg.pixels())
+                .all(|(a, b)| (0..3).all(|k| a[k].abs_diff(b[k]) <= 1));
+            same && counts.judged == 0
         } else {
             !case.judged || interior <= INTERIOR_BOUND
         };
