@@ -281,14 +281,25 @@ fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let view = make_view(&scene, &a.view)?;
     let start = app::cli::playing(&scene, &a.view)?;
+    let args = a.view.clone();
     app::viewer::run(app::viewer::ViewerOptions {
         scene,
+        path: a.scene.clone(),
+        loader: Box::new(move |p| {
+            let s = load_scene(Some(&p.to_path_buf()), &args)?;
+            if s.triangle_count() == 0 {
+                anyhow::bail!("{}: nothing to draw", p.display());
+            }
+            Ok(s)
+        }),
         view,
         size: a.view.size,
         scene_options: app::cli::animated_scene_options(&a.view),
         vsync: !a.no_vsync,
         frames: a.frames,
         screenshot: a.screenshot,
+        screenshot_ui: a.screenshot_ui,
+        panel: !a.no_panel,
         device: a.device,
         validation: a.validation,
         script: app::script::expand(&a.script).map_err(|e| anyhow::anyhow!("--script: {e}"))?,

@@ -22,4 +22,7 @@ pub use crate::plan::{
 };
 pub use renderer::{FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 #[cfg(feature = "viewer")]
-pub use window::{surface_extensions, Capture, DrawResult, FrameSummary, Overlay, WindowRenderer};
+pub use window::{
+    surface_extensions, Capture, DrawResult, FrameSummary, Overlay, WindowRenderer,
+    FRAMES_IN_FLIGHT,
+};

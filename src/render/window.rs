@@ -206,6 +206,11 @@ impl WindowRenderer {
         self.ensure_depth()
     }
 
+    /// The swapchain's colour format (what an [`Overlay`] draws into).
+    pub fn format(&self) -> vk::Format {
+        self.swapchain.format
+    }
+
     /// The triangles drawn per frame.
     pub fn triangles(&self) -> usize {
         self.core.gpu.triangles

@@ -1,11 +1,13 @@
-//! Viewer key actions on the view settings, as pure logic; each returns the line to print.
+//! Viewer actions on the view settings, from keys (steps and cycles) and from the panel's
+//! widgets (values set directly), as pure logic; each returns the line to print. A key and the
+//! widget that sets the same value leave the same view, so they draw the same frame.
 
 use glam::Vec3;
 use umbra::render::{Pcf, Tonemap, View, ViewMode, MAX_CASCADES};
 use umbra::scene::Light;
 
-/// What a key does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What a key or a panel widget does to the view.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Action {
     /// Sun azimuth −5° (left arrow).
     SunLeft,
@@ -41,6 +43,22 @@ pub enum Action {
     ToggleDepthFit,
     /// Soft shadows (PCSS) for lights with a size on/off (`J`; `ShadowSettings::soft`).
     ToggleSoft,
+    /// The sun at these angles (the panel's sliders).
+    SetSun(SunAngles),
+    /// Shadow map of this side (64…8192).
+    SetMapSize(u32),
+    /// This PCF kernel.
+    SetPcf(Pcf),
+    /// This cascade count (0: automatic).
+    SetCascades(u32),
+    /// This debug view.
+    SetView(ViewMode),
+    /// This tone curve.
+    SetTonemap(Tonemap),
+    /// Exposure compensation in stops.
+    SetExposure(f32),
+    /// Constant bias (texels), slope bias and normal offset (texels).
+    SetBiases(f32, f32, f32),
 }
 
 /// The sun as elevation/azimuth in degrees.
@@ -88,6 +106,9 @@ pub const VIEW_CYCLE: [ViewMode; 14] = [
 
 /// Applies `a` to the view (and the sun angles); returns a one-line description of the change.
 pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
+    if let Some(line) = apply_set(a, view, sun) {
+        return line;
+    }
     let s = &mut view.shadow;
     match a {
         Action::SunLeft | Action::SunRight | Action::SunUp | Action::SunDown => {
@@ -97,62 +118,47 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 Action::SunUp => sun.elevation = (sun.elevation + 5.0).min(90.0),
                 _ => sun.elevation = (sun.elevation - 5.0).max(-90.0),
             }
-            sun.azimuth = (sun.azimuth + 540.0) % 360.0 - 180.0;
-            view.sun_direction = Some(sun.direction());
-            let note = if sun.elevation < 0.0 {
-                " (below the horizon: upward faces unlit, the shadow map fitted from below)"
-            } else if sun.elevation < 1.0 {
-                " (on the horizon: upward faces unlit)"
-            } else {
-                ""
-            };
-            format!(
-                "sun: elevation {:.0}°, azimuth {:.0}°{note}",
-                sun.elevation, sun.azimuth
-            )
+            apply(Action::SetSun(*sun), view, sun)
         }
         Action::MapSmaller => {
-            s.map_size = (s.map_size / 2).max(64);
-            format!("shadow map: {0}x{0}", s.map_size)
+            let n = (s.map_size / 2).max(64);
+            apply(Action::SetMapSize(n), view, sun)
         }
         Action::MapLarger => {
-            s.map_size = (s.map_size * 2).min(8192);
-            format!("shadow map: {0}x{0}", s.map_size)
+            let n = (s.map_size * 2).min(8192);
+            apply(Action::SetMapSize(n), view, sun)
         }
         Action::CyclePcf => {
-            s.pcf = match s.pcf {
+            let next = match s.pcf {
                 Pcf::None => Pcf::P2x2,
                 Pcf::P2x2 => Pcf::P3x3,
                 Pcf::P3x3 => Pcf::P5x5,
                 Pcf::P5x5 => Pcf::None,
             };
-            format!("PCF: {:?}", s.pcf)
+            apply(Action::SetPcf(next), view, sun)
         }
         Action::BiasUp | Action::BiasDown => {
             let k = if a == Action::BiasUp { 1.25 } else { 0.8 };
             s.constant_bias *= k;
             s.slope_bias *= k;
             s.normal_offset *= k;
-            format!(
-                "bias: constant {:.2} texels, slope {:.2}, normal offset {:.2} texels",
-                s.constant_bias, s.slope_bias, s.normal_offset
-            )
+            bias_line(s)
         }
         Action::CycleView => {
             let i = VIEW_CYCLE.iter().position(|m| *m == view.mode).unwrap_or(0);
-            view.mode = VIEW_CYCLE[(i + 1) % VIEW_CYCLE.len()];
-            format!("view: {:?}", view.mode)
+            apply(
+                Action::SetView(VIEW_CYCLE[(i + 1) % VIEW_CYCLE.len()]),
+                view,
+                sun,
+            )
         }
         Action::ToggleShadows => {
             s.enabled = !s.enabled;
             format!("shadows: {}", if s.enabled { "on" } else { "off" })
         }
         Action::CycleCascades => {
-            s.cascades = (s.cascades + 1) % (MAX_CASCADES + 1);
-            match s.cascades {
-                0 => "cascades: automatic (1, 2 or 4 by texel size)".into(),
-                n => format!("cascades: {n}"),
-            }
+            let n = (s.cascades + 1) % (MAX_CASCADES + 1);
+            apply(Action::SetCascades(n), view, sun)
         }
         Action::ToggleDepthFit => {
             s.depth_fit = !s.depth_fit;
@@ -173,22 +179,97 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
             )
         }
         Action::CycleTonemap => {
-            view.tonemap = match view.tonemap {
+            let next = match view.tonemap {
                 Tonemap::Neutral => Tonemap::Aces,
                 Tonemap::Aces => Tonemap::None,
                 Tonemap::None => Tonemap::Neutral,
             };
-            format!("tone mapping: {:?}", view.tonemap)
+            apply(Action::SetTonemap(next), view, sun)
         }
         Action::ExposureUp | Action::ExposureDown => {
             let step = if a == Action::ExposureUp { 0.5 } else { -0.5 };
-            view.exposure_compensation = (view.exposure_compensation + step).clamp(-16.0, 16.0);
+            apply(
+                Action::SetExposure(view.exposure_compensation + step),
+                view,
+                sun,
+            )
+        }
+        _ => unreachable!("set actions are applied by apply_set"),
+    }
+}
+
+/// Applies the panel's set actions (None for the keys' steps and cycles).
+fn apply_set(a: Action, view: &mut View, sun: &mut SunAngles) -> Option<String> {
+    let s = &mut view.shadow;
+    Some(match a {
+        Action::SetSun(angles) => {
+            *sun = SunAngles {
+                elevation: angles.elevation.clamp(-90.0, 90.0),
+                azimuth: (angles.azimuth + 540.0).rem_euclid(360.0) - 180.0,
+            };
+            view.sun_direction = Some(sun.direction());
+            format!(
+                "sun: elevation {:.0}°, azimuth {:.0}°{}",
+                sun.elevation,
+                sun.azimuth,
+                horizon_note(sun.elevation)
+            )
+        }
+        Action::SetMapSize(n) => {
+            s.map_size = n.clamp(64, 8192);
+            format!("shadow map: {0}x{0}", s.map_size)
+        }
+        Action::SetPcf(k) => {
+            s.pcf = k;
+            format!("PCF: {:?}", s.pcf)
+        }
+        Action::SetCascades(n) => {
+            s.cascades = n.min(MAX_CASCADES);
+            match s.cascades {
+                0 => "cascades: automatic (1, 2 or 4 by texel size)".into(),
+                n => format!("cascades: {n}"),
+            }
+        }
+        Action::SetView(m) => {
+            view.mode = m;
+            format!("view: {:?}", view.mode)
+        }
+        Action::SetTonemap(t) => {
+            view.tonemap = t;
+            format!("tone mapping: {:?}", view.tonemap)
+        }
+        Action::SetExposure(ev) => {
+            view.exposure_compensation = ev.clamp(-16.0, 16.0);
             format!(
                 "exposure compensation: {:+.1} EV",
                 view.exposure_compensation
             )
         }
+        Action::SetBiases(c, sl, n) => {
+            (s.constant_bias, s.slope_bias, s.normal_offset) = (c, sl, n);
+            bias_line(s)
+        }
+        _ => return None,
+    })
+}
+
+/// What the sun's elevation means for what it lights.
+fn horizon_note(elevation: f32) -> &'static str {
+    if elevation < 0.0 {
+        " (below the horizon: upward faces unlit, the shadow map fitted from below)"
+    } else if elevation < 1.0 {
+        " (on the horizon: upward faces unlit)"
+    } else {
+        ""
     }
+}
+
+/// The biases, as printed.
+fn bias_line(s: &umbra::render::ShadowSettings) -> String {
+    format!(
+        "bias: constant {:.2} texels, slope {:.2}, normal offset {:.2} texels",
+        s.constant_bias, s.slope_bias, s.normal_offset
+    )
 }
 
 /// The next light whose visibility the shadow view shows (`L`), of a frame with `lights` lights

@@ -239,9 +239,15 @@ pub struct ViewArgsCmd {
     /// Render this many frames, then exit.
     #[arg(long)]
     pub frames: Option<u64>,
-    /// With --frames: save the last frame here.
+    /// With --frames: save the last frame here (the scene without the panel).
     #[arg(long, requires = "frames")]
     pub screenshot: Option<PathBuf>,
+    /// Screenshots (`P`, --screenshot) hold the panel too.
+    #[arg(long)]
+    pub screenshot_ui: bool,
+    /// Start with the panel hidden (F1 shows it).
+    #[arg(long)]
+    pub no_panel: bool,
     /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
     #[arg(long)]
     pub device: Option<String>,
@@ -250,9 +256,12 @@ pub struct ViewArgsCmd {
     pub validation: bool,
     /// Automation: inputs to play, one every two frames, comma-separated, each optionally
     /// repeated with `*N`: `WxH` resizes (0x0 minimises), `key:NAME` presses a key (up down left
-    /// right [ ] k + - v h f tab c p), `wheel:N` scrolls N lines (positive zooms in),
-    /// `click:X:Y` picks at window pixel (X, Y); e.g. `key:down*40,wheel:1*80,640x360,click:9:9`.
-    /// With --frames, the run ends after the last step.
+    /// right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r f1), `wheel:N`
+    /// scrolls N lines (positive zooms in), `click:X:Y` picks at window pixel (X, Y), `ui:NAME`
+    /// clicks the panel's widget NAME, `drop:PATH` drops a file on the window,
+    /// `copy:SRC>DST` copies a file (a model changed on disk) and `wait:reload` waits for the
+    /// reload; e.g. `key:down*40,wheel:1*80,640x360,click:9:9,ui:pcf.3x3`. With --frames, the
+    /// run ends after the last step.
     #[arg(long, alias = "resize-script", value_delimiter = ',', value_parser = super::script::parse_item)]
     pub script: Vec<(super::script::ScriptStep, u32)>,
 }

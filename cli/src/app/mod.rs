@@ -9,11 +9,19 @@ pub mod cli;
 #[cfg(feature = "viewer")]
 pub mod controller;
 pub mod inspect_view;
+#[cfg(feature = "viewer")]
+pub mod overlay;
+#[cfg(feature = "viewer")]
+pub mod panel;
 pub mod parse;
 #[cfg(all(feature = "viewer", feature = "reference"))]
 pub mod pick;
 #[cfg(feature = "viewer")]
 pub mod player;
+#[cfg(feature = "viewer")]
+pub mod reload;
+#[cfg(feature = "viewer")]
+pub mod scene_tree;
 #[cfg(feature = "viewer")]
 pub mod script;
 #[cfg(feature = "viewer")]

@@ -4,22 +4,25 @@
 //!
 //! A script is a comma-separated list of steps, each optionally repeated with `*N`:
 //! `WxH` resizes the window (`0x0` simulates minimising), `key:NAME` presses and releases a key
-//! (`up down left right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r`, the
-//! viewer's own bindings), `wheel:N`
-//! scrolls N lines (positive zooms in) and `click:X:Y` clicks (picks) at window pixel (X, Y).
-//! Example: `key:down*40,wheel:1*80,640x360*3,0x0,click:320:200`.
+//! (`up down left right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r f1`,
+//! the viewer's own bindings), `wheel:N` scrolls N lines (positive zooms in), `click:X:Y`
+//! clicks (picks) at window pixel (X, Y), `ui:NAME` clicks the panel's widget NAME (through
+//! egui's own input), `drop:PATH` drops a file on the window, `copy:SRC>DST` copies a file (a
+//! model changed on disk, for the viewer's watcher to see) and `wait:reload` holds the script
+//! until the next reload is done (at most 30 s).
+//! Example: `key:down*40,wheel:1*80,640x360*3,0x0,click:320:200,ui:pcf.3x3`.
 
 /// Key names a script may press (each one of the viewer's bindings).
 pub const KEYS: &[&str] = &[
     "up", "down", "left", "right", "[", "]", "k", "+", "-", "v", "h", "n", "g", "j", "l", "t",
-    "comma", "period", "f", "tab", "c", "o", "p", "space", "u", "i", "z", "x", "r",
+    "comma", "period", "f", "tab", "c", "o", "p", "space", "u", "i", "z", "x", "r", "f1",
 ];
 
 /// Most steps one script may expand to (a typo such as `*1000000000` is an error, not a hang).
 pub const MAX_STEPS: u64 = 100_000;
 
 /// One scripted input.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum ScriptStep {
     /// Resize the window's inner size (0×0: minimised).
     Resize(u32, u32),
@@ -29,6 +32,14 @@ pub enum ScriptStep {
     Wheel(f32),
     /// Click (pick) at this window position in pixels.
     Click(f32, f32),
+    /// Click the panel's widget of this name (`super::panel::Widgets`).
+    Ui(String),
+    /// A file dropped on the window.
+    Drop(std::path::PathBuf),
+    /// Copy a file over another (a model changed on disk).
+    Copy(std::path::PathBuf, std::path::PathBuf),
+    /// Hold the script until the next reload is done.
+    WaitReload,
 }
 
 /// Parses one comma-separated item: a step and how many times it repeats.
@@ -64,6 +75,20 @@ pub fn parse_item(s: &str) -> Result<(ScriptStep, u32), String> {
                 .ok_or_else(|| format!("bad click position '{step}'"))
         };
         ScriptStep::Click(coord(x)?, coord(y)?)
+    } else if let Some(name) = step.strip_prefix("ui:") {
+        if name.trim().is_empty() {
+            return Err(format!("'{step}' names no widget"));
+        }
+        ScriptStep::Ui(name.trim().to_string())
+    } else if let Some(path) = step.strip_prefix("drop:") {
+        ScriptStep::Drop(path.trim().into())
+    } else if let Some(paths) = step.strip_prefix("copy:") {
+        let (a, b) = paths
+            .split_once('>')
+            .ok_or_else(|| format!("'{step}' is not copy:SRC>DST"))?;
+        ScriptStep::Copy(a.trim().into(), b.trim().into())
+    } else if step == "wait:reload" {
+        ScriptStep::WaitReload
     } else if let Some(n) = step.strip_prefix("wheel:") {
         let lines: f32 = n
             .trim()
@@ -77,8 +102,12 @@ pub fn parse_item(s: &str) -> Result<(ScriptStep, u32), String> {
         let (w, h) = if step == "0x0" {
             (0, 0)
         } else {
-            super::parse::parse_size(step)
-                .map_err(|e| format!("{e} (a step is WxH, 0x0, key:NAME, wheel:N or click:X:Y)"))?
+            super::parse::parse_size(step).map_err(|e| {
+                format!(
+                    "{e} (a step is WxH, 0x0, key:NAME, wheel:N, click:X:Y, ui:NAME, \
+                         drop:PATH, copy:SRC>DST or wait:reload)"
+                )
+            })?
         };
         ScriptStep::Resize(w, h)
     };
@@ -93,7 +122,7 @@ pub fn expand(items: &[(ScriptStep, u32)]) -> Result<Vec<ScriptStep>, String> {
     }
     Ok(items
         .iter()
-        .flat_map(|&(s, n)| std::iter::repeat_n(s, n as usize))
+        .flat_map(|(s, n)| std::iter::repeat_n(s.clone(), *n as usize))
         .collect())
 }
 
@@ -109,13 +138,17 @@ mod tests {
             "640x360*2",
             "0x0",
             "click:10:20.5",
+            "ui:pcf.3x3",
+            "copy:a.glb>b.glb",
         ]
         .iter()
         .map(|s| parse_item(s).unwrap())
         .collect();
         let steps = expand(&items).unwrap();
-        assert_eq!(steps.len(), 8);
+        assert_eq!(steps.len(), 10);
         assert_eq!(steps[7], ScriptStep::Click(10.0, 20.5));
+        assert_eq!(steps[8], ScriptStep::Ui("pcf.3x3".into()));
+        assert_eq!(steps[9], ScriptStep::Copy("a.glb".into(), "b.glb".into()));
         assert_eq!(steps[0], ScriptStep::Key("down"));
         assert_eq!(steps[3], ScriptStep::Wheel(-1.5));
         assert_eq!(steps[5], ScriptStep::Resize(640, 360));
@@ -130,6 +163,8 @@ mod tests {
             "99999x1",
             "click:5",
             "click:-1:2",
+            "ui:",
+            "copy:a.glb",
         ] {
             assert!(parse_item(bad).is_err(), "{bad}");
         }

@@ -1,22 +1,26 @@
 //! `umbra view`: the real-time viewer (winit). Same passes as the offscreen path; orbit/fly
-//! cameras; keys change the light and shadow settings and print what changed; frame statistics
-//! in the title a few times a second; `P` saves a screenshot of what is on screen.
-//!
-//! Keys: mouse left-drag rotate, right/middle-drag pan, wheel zoom, `F` frame the scene, `Tab`
-//! orbit/fly (WASD, Q/E down/up, Shift faster), `C` next glTF camera, arrows rotate the sun,
-//! `[`/`]` shadow-map size, `K` PCF kernel, `+`/`-` bias, `V` debug view, `H` shadows on/off,
-//! `P` screenshot, `Esc` quit.
+//! cameras, perspective or orthographic; an on-screen panel (egui, `F1`) with the frame's
+//! figures, every setting, the pick result and the scene tree; keys for the same settings, each
+//! change printed; a dropped file opens, and the model reloads when it changes on disk; `P`
+//! saves a screenshot. Key bindings: `keys`; the panel: `crate::app::panel`.
 
-use super::actions::{apply, next_shadow_light, Action, SunAngles};
-use super::controller::{Button, Controller, Input, MoveKey};
-use super::script::ScriptStep;
+mod files;
+mod keys;
+mod ui;
+
+use crate::app::actions::{apply, next_shadow_light, SunAngles};
+use crate::app::controller::{Button, Controller, Input};
+use crate::app::overlay::EguiOverlay;
+use crate::app::panel::{Stats, Widgets};
+use crate::app::script::ScriptStep;
 use anyhow::{anyhow, Context as _};
-use std::path::PathBuf;
+use keys::{key_action, script_key, AnimKey, KeyAction};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 use umbra::gpu::{Context, ContextDesc, Validation};
-use umbra::render::View;
-use umbra::render::{effective_lights, surface_extensions, DrawResult, WindowRenderer};
+use umbra::render::{effective_lights, surface_extensions, Capture, DrawResult, WindowRenderer};
+use umbra::render::{Overlay, View};
 use umbra::scene::{LightKind, Scene};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -26,10 +30,18 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
+/// Loads a model for the viewer as the command line loaded the first one (ground, pose).
+pub type Loader = Box<dyn Fn(&Path) -> anyhow::Result<Scene>>;
+
 /// How to run the viewer.
 pub struct ViewerOptions {
     /// The scene.
     pub scene: Scene,
+    /// The file it was loaded from (watched, and reloaded when it changes; None for built-in
+    /// scenes).
+    pub path: Option<PathBuf>,
+    /// How to load a dropped or changed file.
+    pub loader: Loader,
     /// Initial view (camera, sun, shadow settings, mode).
     pub view: View,
     /// Window inner size.
@@ -42,11 +54,15 @@ pub struct ViewerOptions {
     pub frames: Option<u64>,
     /// Where `--frames` saves the last frame.
     pub screenshot: Option<PathBuf>,
+    /// Screenshots hold the panel too (else the scene alone).
+    pub screenshot_ui: bool,
+    /// The panel is shown at the start (`F1` toggles it).
+    pub panel: bool,
     /// Device name substring.
     pub device: Option<String>,
     /// Khronos validation on (exit 1 on any message).
     pub validation: bool,
-    /// Inputs to play, one every few frames (automation, tests): `super::script`.
+    /// Inputs to play, one every few frames (automation, tests): `crate::app::script`.
     pub script: Vec<ScriptStep>,
     /// Re-choose the shadow settings for this misclassification budget as the camera moves.
     pub shadow_budget: Option<f64>,
@@ -55,19 +71,12 @@ pub struct ViewerOptions {
     pub start: Option<(umbra::scene::anim::Playing, f32)>,
 }
 
-/// The animation keys.
-#[derive(Clone, Copy)]
-enum AnimKey {
-    Toggle,
-    Step(i32),
-    Speed(f32),
-    Next,
-}
-
 /// Frames between two script steps.
 const SCRIPT_STEP_FRAMES: u64 = 2;
 /// Frames after which resident memory is sampled for the end-of-run report.
 const WARM_UP_FRAMES: u64 = 100;
+/// How long `wait:reload` waits.
+const RELOAD_WAIT: std::time::Duration = std::time::Duration::from_secs(30);
 
 /// Resident set size of this process in bytes (Linux; None elsewhere).
 fn resident_bytes() -> Option<u64> {
@@ -76,102 +85,32 @@ fn resident_bytes() -> Option<u64> {
     Some(pages * 4096)
 }
 
-/// What a key does in the viewer.
-enum KeyAction {
-    Setting(Action),
-    ShadowLight,
-    Move(MoveKey),
-    Frame,
-    ToggleFly,
-    NextCamera,
-    ToggleOrthographic,
-    Screenshot,
-    Anim(AnimKey),
-    Quit,
-}
-
-/// The key a script names (`super::script::KEYS`).
-fn script_key(name: &str) -> Option<KeyCode> {
-    Some(match name {
-        "up" => KeyCode::ArrowUp,
-        "down" => KeyCode::ArrowDown,
-        "left" => KeyCode::ArrowLeft,
-        "right" => KeyCode::ArrowRight,
-        "[" => KeyCode::BracketLeft,
-        "]" => KeyCode::BracketRight,
-        "k" => KeyCode::KeyK,
-        "+" => KeyCode::Equal,
-        "-" => KeyCode::Minus,
-        "v" => KeyCode::KeyV,
-        "h" => KeyCode::KeyH,
-        "n" => KeyCode::KeyN,
-        "g" => KeyCode::KeyG,
-        "j" => KeyCode::KeyJ,
-        "l" => KeyCode::KeyL,
-        "f" => KeyCode::KeyF,
-        "tab" => KeyCode::Tab,
-        "c" => KeyCode::KeyC,
-        "p" => KeyCode::KeyP,
-        "t" => KeyCode::KeyT,
-        "comma" => KeyCode::Comma,
-        "period" => KeyCode::Period,
-        "space" => KeyCode::Space,
-        "u" => KeyCode::KeyU,
-        "i" => KeyCode::KeyI,
-        "o" => KeyCode::KeyO,
-        "z" => KeyCode::KeyZ,
-        "x" => KeyCode::KeyX,
-        "r" => KeyCode::KeyR,
-        _ => return None,
-    })
-}
-
-fn key_action(code: KeyCode) -> Option<KeyAction> {
-    use KeyAction::*;
-    Some(match code {
-        KeyCode::ArrowLeft => Setting(Action::SunLeft),
-        KeyCode::ArrowRight => Setting(Action::SunRight),
-        KeyCode::ArrowUp => Setting(Action::SunUp),
-        KeyCode::ArrowDown => Setting(Action::SunDown),
-        KeyCode::BracketLeft => Setting(Action::MapSmaller),
-        KeyCode::BracketRight => Setting(Action::MapLarger),
-        KeyCode::KeyK => Setting(Action::CyclePcf),
-        KeyCode::Equal | KeyCode::NumpadAdd => Setting(Action::BiasUp),
-        KeyCode::Minus | KeyCode::NumpadSubtract => Setting(Action::BiasDown),
-        KeyCode::KeyV => Setting(Action::CycleView),
-        KeyCode::KeyH => Setting(Action::ToggleShadows),
-        KeyCode::KeyN => Setting(Action::CycleCascades),
-        KeyCode::KeyG => Setting(Action::ToggleDepthFit),
-        KeyCode::KeyJ => Setting(Action::ToggleSoft),
-        KeyCode::KeyT => Setting(Action::CycleTonemap),
-        KeyCode::Period => Setting(Action::ExposureUp),
-        KeyCode::Comma => Setting(Action::ExposureDown),
-        KeyCode::KeyL => ShadowLight,
-        KeyCode::KeyW => Move(MoveKey::W),
-        KeyCode::KeyA => Move(MoveKey::A),
-        KeyCode::KeyS => Move(MoveKey::S),
-        KeyCode::KeyD => Move(MoveKey::D),
-        KeyCode::KeyQ => Move(MoveKey::Q),
-        KeyCode::KeyE => Move(MoveKey::E),
-        KeyCode::ShiftLeft | KeyCode::ShiftRight => Move(MoveKey::Shift),
-        KeyCode::KeyF => Frame,
-        KeyCode::Tab => ToggleFly,
-        KeyCode::KeyC => NextCamera,
-        KeyCode::KeyO => ToggleOrthographic,
-        KeyCode::KeyP => Screenshot,
-        KeyCode::Space => Anim(AnimKey::Toggle),
-        KeyCode::KeyU => Anim(AnimKey::Step(-1)),
-        KeyCode::KeyI => Anim(AnimKey::Step(1)),
-        KeyCode::KeyZ => Anim(AnimKey::Speed(0.5)),
-        KeyCode::KeyX => Anim(AnimKey::Speed(2.0)),
-        KeyCode::KeyR => Anim(AnimKey::Next),
-        KeyCode::Escape => Quit,
-        _ => return None,
-    })
+/// The panel's state in the viewer.
+struct PanelState {
+    /// Shown.
+    open: bool,
+    /// The last pass's widgets, for scripted clicks.
+    widgets: Widgets,
+    /// Input events for the next pass (scripted clicks); the release of a scripted press, and
+    /// that release once due (on the pass after the press's).
+    events: Vec<egui::Event>,
+    release: Option<egui::Pos2>,
+    release_due: Option<egui::Pos2>,
+    /// Frame figures.
+    stats: Stats,
+    /// The last pick's report.
+    pick: Option<String>,
+    /// The glTF scene tree, and the node selected in it.
+    tree: Option<crate::app::scene_tree::SceneTree>,
+    selected: Option<usize>,
+    /// The last load's message.
+    status: Option<String>,
 }
 
 struct State {
-    // Field order is drop order: the renderer (swapchain, surface) before the window.
+    // Field order is drop order: GPU objects (the panel's, the renderers) before the context, the
+    // renderer (swapchain, surface) before the window.
+    overlay: Option<EguiOverlay>,
     renderer: WindowRenderer,
     /// Offscreen renderer of the same scene for reading the GPU's shadow verdict at a picked
     /// pixel (created at the first pick).
@@ -201,10 +140,19 @@ struct State {
     script_pos: usize,
     minimized: bool,
     /// The animation clock, and whether the scene must be posed anew before the next frame.
-    player: super::player::Player,
+    player: crate::app::player::Player,
     pose_dirty: bool,
+    panel: PanelState,
+    /// The model's folder, watched for changes.
+    watch: Option<crate::app::reload::Watch>,
+    /// Reloads done, and since when a `wait:reload` step waits (with the count it waits past).
+    reloads: u64,
+    waiting: Option<(Instant, u64)>,
     #[cfg(feature = "sweep")]
-    budget: Option<super::budget_worker::BudgetWorker>,
+    budget: Option<crate::app::budget_worker::BudgetWorker>,
+    /// The budget in force, and the validation messages of budget workers already finished.
+    budget_value: Option<f64>,
+    worker_problems: usize,
 }
 
 struct App {
@@ -245,7 +193,7 @@ impl App {
             device: self.opts.device.clone(),
             instance_extensions,
             swapchain: true,
-            pipeline_cache: super::pipeline_cache_path(),
+            pipeline_cache: crate::app::pipeline_cache_path(),
             ..Default::default()
         })?;
         let handle = window
@@ -261,13 +209,11 @@ impl App {
             self.opts.vsync,
             &self.opts.scene_options,
         )?;
+        let overlay = EguiOverlay::new(&ctx, &window, renderer.format())
+            .map_err(|e| eprintln!("warning: no panel: {e:#}"))
+            .ok();
         let view = self.opts.view.clone();
-        // What the camera frames and scales its speeds by (the model, not a helper ground).
-        let bounds = self
-            .opts
-            .scene
-            .framing
-            .unwrap_or_else(|| self.opts.scene.bounds());
+        let bounds = framing_bounds(&self.opts.scene);
         let controller = Controller::from_camera(&view.camera, &bounds);
         let lights = effective_lights(&self.opts.scene.lights, &view);
         let sun_dir = lights
@@ -276,12 +222,24 @@ impl App {
             .map(|l| l.direction)
             .unwrap_or(glam::Vec3::NEG_Y);
         println!(
-            "viewer: {} on {} ({} triangles); press Esc to quit",
+            "viewer: {} on {} ({} triangles); press Esc to quit, F1 for the panel",
             self.opts.scene.name,
             ctx.device_name,
             renderer.triangles()
         );
+        let watch = self.opts.path.as_deref().and_then(|p| {
+            crate::app::reload::Watch::new(p)
+                .map_err(|e| eprintln!("warning: {}: not watched for changes: {e}", p.display()))
+                .ok()
+        });
+        let tree = self
+            .opts
+            .path
+            .as_deref()
+            .and_then(|p| files::tree_of(p, &self.opts.scene));
+        let triangles = renderer.triangles();
         Ok(State {
+            overlay,
             renderer,
             #[cfg(feature = "reference")]
             pick_renderer: None,
@@ -306,68 +264,107 @@ impl App {
             screenshot_count: 0,
             script_pos: 0,
             minimized: size.width == 0 || size.height == 0,
-            player: super::player::Player::new(
+            player: crate::app::player::Player::new(
                 self.opts.scene.rig.as_deref(),
                 self.opts.start.clone(),
             ),
             pose_dirty: false,
+            panel: PanelState {
+                open: self.opts.panel,
+                widgets: Widgets::default(),
+                events: Vec::new(),
+                release: None,
+                release_due: None,
+                stats: Stats {
+                    triangles,
+                    ..Default::default()
+                },
+                pick: None,
+                tree,
+                selected: None,
+                status: None,
+            },
+            watch,
+            reloads: 0,
+            waiting: None,
             #[cfg(feature = "sweep")]
             budget: self.opts.shadow_budget.map(|b| {
-                super::budget_worker::BudgetWorker::start(
+                crate::app::budget_worker::BudgetWorker::start(
                     self.opts.scene.clone(),
                     b,
                     self.opts.device.clone(),
                     self.opts.validation,
                 )
             }),
+            budget_value: self.opts.shadow_budget,
+            worker_problems: 0,
         })
     }
 
-    /// Runs the input script's next step when it is due (one every `SCRIPT_STEP_FRAMES` frames).
+    /// Runs the input script's next step when it is due (one every `SCRIPT_STEP_FRAMES` frames;
+    /// none while a `wait:reload` waits).
     fn script_step(&mut self, el: &ActiveEventLoop) -> anyhow::Result<()> {
-        // Input script (automation): one step every few frames.
         let step = {
             let Some(s) = self.state.as_mut() else {
                 return Ok(());
             };
             s.ticks += 1;
+            if let Some((since, count)) = s.waiting {
+                if s.reloads > count {
+                    s.waiting = None;
+                } else if since.elapsed() > RELOAD_WAIT {
+                    anyhow::bail!("script: wait:reload: no reload within {RELOAD_WAIT:?}");
+                } else {
+                    return Ok(());
+                }
+            }
             let due = s.ticks % SCRIPT_STEP_FRAMES == 0 && s.script_pos < self.opts.script.len();
             due.then(|| {
                 s.script_pos += 1;
-                self.opts.script[s.script_pos - 1]
+                self.opts.script[s.script_pos - 1].clone()
             })
         };
-        if let Some(step) = step {
-            let s = self.state.as_mut().expect("state");
-            match step {
-                ScriptStep::Resize(0, _) | ScriptStep::Resize(_, 0) => {
-                    // What a minimised window reports on platforms that do: a 0×0 resize.
-                    s.minimized = true;
-                    s.renderer.resize(0, 0)?;
-                }
-                ScriptStep::Resize(w, h) => {
-                    s.minimized = false;
-                    let now = s
-                        .window
-                        .request_inner_size(PhysicalSize::new(w, h))
-                        .unwrap_or_else(|| s.window.inner_size());
-                    s.renderer.resize(now.width, now.height)?;
-                }
-                ScriptStep::Key(name) => {
-                    if let Some(code) = script_key(name) {
-                        self.key(el, code, true);
-                        self.key(el, code, false);
-                    }
-                }
-                ScriptStep::Wheel(lines) => self.wheel(lines),
-                ScriptStep::Click(x, y) => self.pick(x, y),
+        let Some(step) = step else {
+            return Ok(());
+        };
+        let s = self.state.as_mut().expect("state");
+        match step {
+            ScriptStep::Resize(0, _) | ScriptStep::Resize(_, 0) => {
+                // What a minimised window reports on platforms that do: a 0×0 resize.
+                s.minimized = true;
+                s.renderer.resize(0, 0)?;
             }
+            ScriptStep::Resize(w, h) => {
+                s.minimized = false;
+                let now = s
+                    .window
+                    .request_inner_size(PhysicalSize::new(w, h))
+                    .unwrap_or_else(|| s.window.inner_size());
+                s.renderer.resize(now.width, now.height)?;
+            }
+            ScriptStep::Key(name) => {
+                if let Some(code) = script_key(name) {
+                    self.key(el, code, true);
+                    self.key(el, code, false);
+                }
+            }
+            ScriptStep::Wheel(lines) => self.wheel(lines),
+            ScriptStep::Click(x, y) => self.pick(x, y),
+            ScriptStep::Ui(name) => self.click_widget(&name)?,
+            ScriptStep::Drop(path) => self.open(&path, true),
+            ScriptStep::Copy(from, to) => {
+                std::fs::copy(&from, &to).with_context(|| {
+                    format!("script: copy {} to {}", from.display(), to.display())
+                })?;
+            }
+            ScriptStep::WaitReload => s.waiting = Some((Instant::now(), s.reloads)),
         }
         Ok(())
     }
 
     fn redraw(&mut self, el: &ActiveEventLoop) -> anyhow::Result<()> {
         self.script_step(el)?;
+        self.reload_if_changed();
         let Some(s) = self.state.as_mut() else {
             return Ok(());
         };
@@ -377,7 +374,7 @@ impl App {
         // The animation: wall time, or one frame step per frame in a run of --frames (so what
         // it draws does not depend on the machine's speed). Posing counts as CPU time.
         let clock = if self.opts.frames.is_some() {
-            super::player::FRAME_STEP
+            crate::app::player::FRAME_STEP
         } else {
             dt
         };
@@ -393,38 +390,38 @@ impl App {
             }
             pose_ms = t0.elapsed().as_secs_f64() * 1e3;
         }
-        let opts = &self.opts;
         s.controller.update(dt);
         if s.camera_index.is_none() {
             s.view.camera = s.controller.camera();
         }
-        #[cfg(feature = "sweep")]
-        if let Some(b) = s.budget.as_mut() {
-            let size = s.window.inner_size();
-            b.request(&s.view, (size.width, size.height));
-            // A run of a fixed number of frames (automation) waits for each choice, so what it
-            // draws and prints does not depend on the machine's speed.
-            if let Some(out) = b.poll(&mut s.view, opts.frames.is_some())? {
-                let label = umbra_lab::analysis::chart::short_label_of(&out.choice.chosen.config);
-                let line = super::cli::budget_line(&out.choice, &label);
-                if out.kept {
-                    println!("{line}; keeping the running settings (within budget here)");
-                } else {
-                    println!("{line}");
-                }
-            }
-        }
-        let last_scripted = s.script_pos >= opts.script.len();
+        self.poll_budget()?;
+        let t0 = Instant::now();
+        self.run_panel(el)?;
+        let opts = &self.opts;
+        let s = self.state.as_mut().expect("state");
+        let last_scripted = s.script_pos >= opts.script.len() && s.waiting.is_none();
         let final_frame = opts.frames.is_some_and(|n| s.drawn + 1 >= n) && last_scripted;
         let shot = s.want_screenshot || (final_frame && opts.screenshot.is_some());
-        let t0 = Instant::now();
+        let capture = match (shot, opts.screenshot_ui) {
+            (false, _) => Capture::None,
+            (true, false) => Capture::Scene,
+            (true, true) => Capture::Screen,
+        };
+        let overlay = match (&mut s.overlay, s.panel.open) {
+            (Some(o), true) => Some(o as &mut dyn Overlay),
+            _ => None,
+        };
         let result = if s.minimized {
             DrawResult::Skipped
         } else {
-            s.renderer.draw(&s.view, shot)?
+            s.renderer.draw_with(&s.view, capture, overlay)?
         };
         let cpu = t0.elapsed().as_secs_f64() * 1e3 + pose_ms;
-        if let DrawResult::Drawn { screenshot, .. } = result {
+        if let DrawResult::Drawn {
+            screenshot,
+            summary,
+        } = result
+        {
             s.drawn += 1;
             if s.drawn == WARM_UP_FRAMES {
                 s.rss_warm = resident_bytes();
@@ -432,6 +429,7 @@ impl App {
             s.first_draw.get_or_insert(t0);
             s.cpu_ms.push(cpu);
             s.frame_ms.push(dt as f64 * 1e3);
+            s.panel.stats.summary = summary;
             if let Some(img) = screenshot {
                 save_screenshot(s, opts, &img, final_frame)?;
                 s.want_screenshot = false;
@@ -444,8 +442,36 @@ impl App {
         Ok(())
     }
 
-    /// Picks at window position (`x`, `y`): prints what is there and highlights its primitive
-    /// (nothing there: clears the highlight).
+    /// Asks the budget worker for settings for the current view and applies its answer.
+    fn poll_budget(&mut self) -> anyhow::Result<()> {
+        #[cfg(feature = "sweep")]
+        {
+            let wait = self.opts.frames.is_some();
+            let Some(s) = self.state.as_mut() else {
+                return Ok(());
+            };
+            if let Some(b) = s.budget.as_mut() {
+                let size = s.window.inner_size();
+                b.request(&s.view, (size.width, size.height));
+                // A run of a fixed number of frames (automation) waits for each choice, so
+                // what it draws and prints does not depend on the machine's speed.
+                if let Some(out) = b.poll(&mut s.view, wait)? {
+                    let label =
+                        umbra_lab::analysis::chart::short_label_of(&out.choice.chosen.config);
+                    let line = crate::app::cli::budget_line(&out.choice, &label);
+                    if out.kept {
+                        println!("{line}; keeping the running settings (within budget here)");
+                    } else {
+                        println!("{line}");
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Picks at window position (`x`, `y`): reports what is there (printed and in the panel)
+    /// and highlights its primitive (nothing there: clears the highlight).
     #[cfg(feature = "reference")]
     fn pick(&mut self, x: f32, y: f32) {
         let Some(s) = self.state.as_mut() else { return };
@@ -474,7 +500,7 @@ impl App {
             let pick = reference.pick(&frame.plan, x, y, w, h);
             let gpu = frame.image.get_pixel(x as u32, y as u32)[0] as f32 / 255.0;
             s.view.highlight = pick.as_ref().map(|p| (p.instance, p.primitive));
-            Ok(super::pick::describe(
+            Ok(crate::app::pick::describe(
                 scene,
                 &frame.plan,
                 (x, y),
@@ -482,15 +508,20 @@ impl App {
                 Some(gpu),
             ))
         })();
-        match result {
-            Ok(line) => println!("{line}"),
-            Err(e) => println!("pick: failed: {e:#}"),
-        }
+        let line = result.unwrap_or_else(|e| format!("pick: failed: {e:#}"));
+        println!("{line}");
+        s.panel.pick = Some(line);
     }
 
     #[cfg(not(feature = "reference"))]
     fn pick(&mut self, x: f32, y: f32) {
-        println!("pick: ({x:.0}, {y:.0}): picking needs umbra built with the `reference` feature");
+        let line = format!(
+            "pick: ({x:.0}, {y:.0}): picking needs umbra built with the `reference` feature"
+        );
+        println!("{line}");
+        if let Some(s) = self.state.as_mut() {
+            s.panel.pick = Some(line);
+        }
     }
 
     fn wheel(&mut self, lines: f32) {
@@ -501,14 +532,26 @@ impl App {
     }
 
     fn key(&mut self, el: &ActiveEventLoop, code: KeyCode, pressed: bool) {
-        let opts = &self.opts;
-        let Some(s) = self.state.as_mut() else { return };
         let Some(action) = key_action(code) else {
             return;
         };
         match action {
-            KeyAction::Move(k) => s.controller.handle(Input::Key(k, pressed)),
+            KeyAction::Move(k) => {
+                if let Some(s) = self.state.as_mut() {
+                    s.controller.handle(Input::Key(k, pressed));
+                }
+            }
             _ if !pressed => {}
+            a => self.act(el, a),
+        }
+    }
+
+    /// Does what a key (or the panel's widget for it) does.
+    fn act(&mut self, el: &ActiveEventLoop, action: KeyAction) {
+        let opts = &self.opts;
+        let Some(s) = self.state.as_mut() else { return };
+        match action {
+            KeyAction::Move(_) => {}
             KeyAction::Setting(a) => println!("{}", apply(a, &mut s.view, &mut s.sun)),
             KeyAction::ShadowLight => {
                 let n = effective_lights(&opts.scene.lights, &s.view).len();
@@ -536,15 +579,7 @@ impl App {
                         .camera_index
                         .map(|i| (i + 1) % opts.scene.cameras.len())
                         .unwrap_or(0);
-                    s.camera_index = Some(i);
-                    s.view.camera = opts.scene.cameras[i];
-                    s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
-                    let kind = if s.view.camera.is_orthographic() {
-                        "orthographic"
-                    } else {
-                        "perspective"
-                    };
-                    println!("camera: glTF camera {i} ({kind})");
+                    self.use_camera(Some(i));
                 }
             }
             KeyAction::ToggleOrthographic => {
@@ -553,14 +588,12 @@ impl App {
                     s.controller = Controller::from_camera(&opts.scene.cameras[i], &s.bounds);
                 }
                 s.controller.toggle_projection();
-                println!(
-                    "camera: {}",
-                    if s.controller.orthographic {
-                        "orthographic"
-                    } else {
-                        "perspective"
-                    }
-                );
+                let kind = if s.controller.orthographic {
+                    "orthographic"
+                } else {
+                    "perspective"
+                };
+                println!("camera: {kind}");
             }
             KeyAction::Screenshot => s.want_screenshot = true,
             KeyAction::Anim(k) => {
@@ -574,9 +607,76 @@ impl App {
                 s.pose_dirty = true;
                 println!("{line}");
             }
+            KeyAction::TogglePanel => {
+                s.panel.open = !s.panel.open && s.overlay.is_some();
+                if let Some(o) = s.overlay.as_mut() {
+                    o.clear();
+                }
+                println!("panel: {}", if s.panel.open { "shown" } else { "hidden" });
+            }
             KeyAction::Quit => el.exit(),
         }
     }
+
+    /// Looks through glTF camera `i` (None: back to the viewer's own camera).
+    fn use_camera(&mut self, i: Option<usize>) {
+        let opts = &self.opts;
+        let Some(s) = self.state.as_mut() else { return };
+        s.camera_index = i.filter(|&i| i < opts.scene.cameras.len());
+        match s.camera_index {
+            Some(i) => {
+                s.view.camera = opts.scene.cameras[i];
+                s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
+                let kind = if s.view.camera.is_orthographic() {
+                    "orthographic"
+                } else {
+                    "perspective"
+                };
+                println!("camera: glTF camera {i} ({kind})");
+            }
+            None => println!("camera: the viewer's"),
+        }
+    }
+
+    /// A mouse button: a left click that does not move the cursor (3 px) picks; buttons drive
+    /// the camera controller.
+    fn mouse(&mut self, state: ElementState, button: MouseButton) {
+        let b = match button {
+            MouseButton::Left => Some(Button::Left),
+            MouseButton::Right => Some(Button::Right),
+            MouseButton::Middle => Some(Button::Middle),
+            _ => None,
+        };
+        let mut click = None;
+        if let (Some(Button::Left), Some(s)) = (b, self.state.as_mut()) {
+            if state == ElementState::Pressed {
+                s.press_at = Some(s.cursor);
+            } else if let Some((px, py)) = s.press_at.take() {
+                let (cx, cy) = s.cursor;
+                if (cx - px).abs() <= 3.0 && (cy - py).abs() <= 3.0 {
+                    click = Some((cx, cy));
+                }
+            }
+        }
+        if let Some((x, y)) = click {
+            self.pick(x, y);
+        }
+        if let (Some(b), Some(s)) = (b, self.state.as_mut()) {
+            if s.camera_index.take().is_some() {
+                s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
+            }
+            s.controller.handle(if state == ElementState::Pressed {
+                Input::Press(b)
+            } else {
+                Input::Release(b)
+            });
+        }
+    }
+}
+
+/// What the camera frames and scales its speeds by (the model, not a helper ground).
+fn framing_bounds(scene: &Scene) -> umbra::math::Aabb {
+    scene.framing.unwrap_or_else(|| scene.bounds())
 }
 
 impl ApplicationHandler for App {
@@ -591,81 +691,60 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
-        if self.state.is_none() {
+        let Some(s) = self.state.as_mut() else {
             return;
-        }
+        };
+        // The panel sees every event first; what it takes goes no further.
+        let taken = match (&mut s.overlay, s.panel.open) {
+            (Some(o), true) => o.on_window_event(&s.window, &event),
+            _ => Default::default(),
+        };
         let r: anyhow::Result<()> = match event {
             WindowEvent::CloseRequested => {
                 el.exit();
                 Ok(())
             }
             WindowEvent::Resized(size) => {
-                let s = self.state.as_mut().expect("state");
                 s.minimized = size.width == 0 || size.height == 0;
                 s.renderer
                     .resize(size.width, size.height)
                     .map_err(Into::into)
             }
             WindowEvent::RedrawRequested => self.redraw(el),
-            WindowEvent::KeyboardInput { event, .. } => {
+            WindowEvent::DroppedFile(path) => {
+                self.open(&path, true);
+                Ok(())
+            }
+            WindowEvent::KeyboardInput { event, .. } if !taken.keyboard => {
                 if let PhysicalKey::Code(code) = event.physical_key {
-                    if !event.repeat
-                        || matches!(
-                            code,
-                            KeyCode::ArrowLeft
-                                | KeyCode::ArrowRight
-                                | KeyCode::ArrowUp
-                                | KeyCode::ArrowDown
-                        )
-                    {
+                    let arrow = matches!(
+                        code,
+                        KeyCode::ArrowLeft
+                            | KeyCode::ArrowRight
+                            | KeyCode::ArrowUp
+                            | KeyCode::ArrowDown
+                    );
+                    if !event.repeat || arrow {
                         self.key(el, code, event.state == ElementState::Pressed);
                     }
                 }
                 Ok(())
             }
             WindowEvent::MouseInput { state, button, .. } => {
-                let b = match button {
-                    MouseButton::Left => Some(Button::Left),
-                    MouseButton::Right => Some(Button::Right),
-                    MouseButton::Middle => Some(Button::Middle),
-                    _ => None,
-                };
-                // A left click that does not move the cursor (3 px) picks.
-                let mut click = None;
-                if let (Some(Button::Left), Some(s)) = (b, self.state.as_mut()) {
-                    if state == ElementState::Pressed {
-                        s.press_at = Some(s.cursor);
-                    } else if let Some((px, py)) = s.press_at.take() {
-                        let (cx, cy) = s.cursor;
-                        if (cx - px).abs() <= 3.0 && (cy - py).abs() <= 3.0 {
-                            click = Some((cx, cy));
-                        }
-                    }
-                }
-                if let Some((x, y)) = click {
-                    self.pick(x, y);
-                }
-                if let (Some(b), Some(s)) = (b, self.state.as_mut()) {
-                    if s.camera_index.take().is_some() {
-                        s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
-                    }
-                    s.controller.handle(if state == ElementState::Pressed {
-                        Input::Press(b)
-                    } else {
-                        Input::Release(b)
-                    });
+                // A press over the panel is the panel's; a release always reaches the camera
+                // (a drag that started on the scene ends wherever it ends).
+                if !taken.pointer || state == ElementState::Released {
+                    self.mouse(state, button);
                 }
                 Ok(())
             }
             WindowEvent::CursorMoved { position, .. } => {
-                if let Some(s) = self.state.as_mut() {
-                    s.cursor = (position.x as f32, position.y as f32);
-                    s.controller
-                        .handle(Input::Cursor(position.x as f32, position.y as f32));
-                }
+                s.cursor = (position.x as f32, position.y as f32);
+                s.controller
+                    .handle(Input::Cursor(position.x as f32, position.y as f32));
                 Ok(())
             }
-            WindowEvent::MouseWheel { delta, .. } => {
+            WindowEvent::MouseWheel { delta, .. } if !taken.pointer => {
                 let lines = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
@@ -682,7 +761,7 @@ impl ApplicationHandler for App {
 
     fn about_to_wait(&mut self, el: &ActiveEventLoop) {
         if let Some(s) = &self.state {
-            let scripted = s.script_pos < self.opts.script.len();
+            let scripted = s.script_pos < self.opts.script.len() || s.waiting.is_some();
             if s.minimized && !scripted {
                 el.set_control_flow(ControlFlow::Wait);
             } else {
@@ -721,13 +800,14 @@ fn save_screenshot(
 }
 
 /// Puts the frame rate, GPU and CPU times, triangles, map size and animation in the window's
-/// title (and the log), four times a second.
+/// title (and the log) and the panel's figures, four times a second.
 fn update_title(s: &mut State, opts: &ViewerOptions) {
     if s.last_title.elapsed().as_secs_f64() >= 0.25 && !s.cpu_ms.is_empty() {
         let n = s.cpu_ms.len() as f64;
         let cpu = s.cpu_ms.iter().sum::<f64>() / n;
         let frame = s.frame_ms.iter().sum::<f64>() / n;
-        let gpu = match s.renderer.gpu_times() {
+        let gpu_times = s.renderer.gpu_times();
+        let gpu = match gpu_times {
             Some((a, b)) => format!("GPU {:.1} ms (shadow {a:.1} + camera {b:.1})", a + b),
             None => "GPU n/a".into(),
         };
@@ -736,15 +816,18 @@ fn update_title(s: &mut State, opts: &ViewerOptions) {
         } else {
             String::new()
         };
+        let fps = 1000.0 / frame.max(1e-3);
         let title = format!(
-            "umbra — {} — {:.1} fps | {gpu} | CPU {cpu:.1} ms | {} tris | map {}²{anim}",
+            "umbra — {} — {fps:.1} fps | {gpu} | CPU {cpu:.1} ms | {} tris | map {}²{anim}",
             opts.scene.name,
-            1000.0 / frame.max(1e-3),
             s.renderer.triangles(),
             s.view.shadow.map_size
         );
         s.window.set_title(&title);
         log::info!("{title}");
+        let st = &mut s.panel.stats;
+        (st.fps, st.cpu_ms, st.gpu_ms) = (fps, cpu, gpu_times);
+        st.triangles = s.renderer.triangles();
         s.cpu_ms.clear();
         s.frame_ms.clear();
         s.last_title = Instant::now();
@@ -793,12 +876,10 @@ pub fn run(opts: ViewerOptions) -> anyhow::Result<()> {
         // Keep the log past the teardown, so messages from destroying objects count too.
         let log = s.ctx.validation_log.clone();
         #[cfg(feature = "sweep")]
-        let worker_problems = match s.budget.take() {
-            Some(b) => b.finish()?,
-            None => 0,
-        };
-        #[cfg(not(feature = "sweep"))]
-        let worker_problems = 0;
+        if let Some(b) = s.budget.take() {
+            s.worker_problems += b.finish()?;
+        }
+        let worker_problems = s.worker_problems;
         drop(s);
         let problems = log.problem_count() + worker_problems;
         if problems > 0 {
