@@ -236,6 +236,13 @@ impl Builder {
         self.cameras.len() - 1
     }
 
+    /// An orthographic camera.
+    pub fn camera_orthographic(&mut self, xmag: f32, ymag: f32, znear: f32, zfar: f32) -> usize {
+        self.cameras.push(json!({"type": "orthographic",
+            "orthographic": {"xmag": xmag, "ymag": ymag, "znear": znear, "zfar": zfar}}));
+        self.cameras.len() - 1
+    }
+
     /// A KHR_lights_punctual light from its JSON object.
     pub fn light(&mut self, l: Value) -> usize {
         self.use_extension("KHR_lights_punctual");
