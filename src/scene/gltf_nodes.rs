@@ -45,7 +45,7 @@ pub(super) fn walk_nodes(
     // What motion needs from the walk: each node's parent, and the nodes lights and cameras
     // hang on.
     let mut parents: Vec<Option<usize>> = vec![None; gltf.nodes().len()];
-    let (mut light_nodes, mut camera_nodes) = (Vec::new(), Vec::new());
+    let (mut light_nodes, mut camera_nodes) = (Vec::new(), Vec::<usize>::new());
     while let Some((node, parent, depth)) = stack.pop() {
         visited += 1;
         if depth > 256 || visited > 1_000_000 {
@@ -81,6 +81,15 @@ pub(super) fn walk_nodes(
             stack.push((c, world, depth + 1));
         }
     }
+    // Cameras in the document's node order, not the walk's (`--camera N` and the viewer's `C`
+    // count them so).
+    let mut order: Vec<usize> = (0..camera_nodes.len()).collect();
+    order.sort_by_key(|&k| camera_nodes[k]);
+    let first = scene.cameras.len() - camera_nodes.len();
+    let sorted: Vec<_> = order.iter().map(|&k| scene.cameras[first + k]).collect();
+    scene.cameras.truncate(first);
+    scene.cameras.extend(sorted);
+    let camera_nodes = order.iter().map(|&k| camera_nodes[k]).collect();
     Ok(Walk {
         parents,
         light_nodes,
