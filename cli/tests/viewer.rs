@@ -5,7 +5,7 @@
 mod common;
 mod xvfb;
 
-use common::gltf_builder::{Builder, Container, U16};
+use common::gltf_builder::{Builder, Container};
 use serde_json::json;
 use std::process::Command;
 use umbra_lab::reference::metrics::{flip, psnr};
@@ -244,22 +244,10 @@ fn viewer_survives_sun_below_horizon_near_plane_zoom_and_1000_resizes() {
 fn a_click_picks_the_node_mesh_and_triangle_under_it() {
     let dir = out("pick_model");
     let mut b = Builder::default();
-    let pos = b.floats(
-        &[
-            -0.5, -0.5, 0.0, 0.5, -0.5, 0.0, 0.5, 0.5, 0.0, -0.5, 0.5, 0.0,
-        ],
-        3,
-        "VEC3",
-    );
-    let nrm = b.floats(&[0.0, 0.0, 1.0].repeat(4), 3, "VEC3");
-    let idx = b.indices(&[0, 1, 2, 0, 2, 3], U16);
     let mat = b.material(
         json!({"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1.0]}}),
     );
-    let mesh = b.mesh(
-        "panel",
-        vec![json!({"attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": idx, "material": mat})],
-    );
+    let mesh = b.quad("panel", 1.0, 1.0, mat);
     b.node(
         json!({"name": "left panel", "mesh": mesh, "translation": [-0.7, 0.0, 0.0]}),
         true,

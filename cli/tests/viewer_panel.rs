@@ -8,7 +8,7 @@
 mod common;
 mod xvfb;
 
-use common::gltf_builder::{Builder, Container, U16};
+use common::gltf_builder::{Builder, Container};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use xvfb::{out, umbra, Xvfb};
@@ -131,23 +131,11 @@ fn a_panel_widget_draws_what_its_key_draws() {
 /// Two flat, unlit quads facing +Z, 1.4 units apart: a model to pick and to swap.
 fn panels(dir: &Path, name: &str, rgb: [f32; 3]) -> PathBuf {
     let mut b = Builder::default();
-    let pos = b.floats(
-        &[
-            -0.5, -0.5, 0.0, 0.5, -0.5, 0.0, 0.5, 0.5, 0.0, -0.5, 0.5, 0.0,
-        ],
-        3,
-        "VEC3",
-    );
-    let nrm = b.floats(&[0.0, 0.0, 1.0].repeat(4), 3, "VEC3");
-    let idx = b.indices(&[0, 1, 2, 0, 2, 3], U16);
     b.use_extension("KHR_materials_unlit");
     let mat = b.material(json!({"name": "flat",
         "pbrMetallicRoughness": {"baseColorFactor": [rgb[0], rgb[1], rgb[2], 1.0]},
         "extensions": {"KHR_materials_unlit": {}}}));
-    let mesh = b.mesh(
-        "panel",
-        vec![json!({"attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": idx, "material": mat})],
-    );
+    let mesh = b.quad("panel", 1.0, 1.0, mat);
     for (i, x) in [-0.7f32, 0.7].into_iter().enumerate() {
         b.node(
             json!({"name": format!("panel {i}"), "mesh": mesh, "translation": [x, 0.0, 0.0]}),

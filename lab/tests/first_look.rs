@@ -51,22 +51,6 @@ fn box_mesh(b: &mut Builder, half: Vec3, material: usize) -> usize {
     )
 }
 
-/// A `w`×`h` quad in the XY plane facing +Z with texture coordinates, centred on its node.
-fn quad_mesh(b: &mut Builder, w: f32, h: f32, material: usize) -> usize {
-    let (x, y) = (w * 0.5, h * 0.5);
-    let p = b.floats(&[-x, -y, 0.0, x, -y, 0.0, x, y, 0.0, -x, y, 0.0], 3, "VEC3");
-    let n = b.floats(&[0.0, 0.0, 1.0].repeat(4), 3, "VEC3");
-    let uv = b.floats(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0], 2, "VEC2");
-    let i = b.indices(&[0, 1, 2, 0, 2, 3], U16);
-    b.mesh(
-        "quad",
-        vec![
-            json!({"attributes": {"POSITION": p, "NORMAL": n, "TEXCOORD_0": uv},
-                    "indices": i, "material": material}),
-        ],
-    )
-}
-
 fn dir() -> PathBuf {
     out_dir().join("first_look")
 }
@@ -94,7 +78,7 @@ fn boards() -> Vec<(&'static str, PathBuf)> {
     let mut b = Builder::default();
     let t = checker(&mut b);
     let m = b.material(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": t}}}));
-    let q = quad_mesh(&mut b, 2.0, 1.4, m);
+    let q = b.quad("quad", 2.0, 1.4, m);
     b.node(json!({"name": "board", "mesh": q}), true);
     out.push(("board", b.write(&dir(), "board", Container::Glb)));
     for (name, half, at) in [
@@ -310,7 +294,7 @@ fn palette_model(lux: f32) -> PathBuf {
         json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": t}},
                               "extensions": {"KHR_materials_unlit": {}}}),
     );
-    let q = quad_mesh(&mut b, 2.0, 2.0, m);
+    let q = b.quad("quad", 2.0, 2.0, m);
     b.node(json!({"name": "palette", "mesh": q}), true);
     // A bright sun (lux) that auto exposure meters, and that must not darken the palette.
     let sun = b.light(json!({"type": "directional", "intensity": lux}));
@@ -397,7 +381,7 @@ fn ortho_model() -> PathBuf {
         json!({"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0]},
                                   "extensions": {"KHR_materials_unlit": {}}}),
     );
-    let q = quad_mesh(&mut b, 1.0, 1.0, white);
+    let q = b.quad("quad", 1.0, 1.0, white);
     b.node(json!({"name": "square", "mesh": q}), true);
     let g = grey(&mut b);
     let ground = box_mesh(&mut b, Vec3::new(4.0, 0.05, 4.0), g);

@@ -47,7 +47,7 @@ pub struct Builder {
 }
 
 fn pad4(v: &mut Vec<u8>, byte: u8) {
-    while v.len() % 4 != 0 {
+    while v.len() & 3 != 0 {
         v.push(byte);
     }
 }
@@ -241,6 +241,24 @@ impl Builder {
         self.cameras.push(json!({"type": "orthographic",
             "orthographic": {"xmag": xmag, "ymag": ymag, "znear": znear, "zfar": zfar}}));
         self.cameras.len() - 1
+    }
+
+    /// A mesh `name` of one `w`×`h` quad in the XY plane facing +Z, centred on its node, with
+    /// texture coordinates (v down the image) and `material`: triangle 0 its lower-right half,
+    /// triangle 1 its upper-left.
+    pub fn quad(&mut self, name: &str, w: f32, h: f32, material: usize) -> usize {
+        let (x, y) = (w * 0.5, h * 0.5);
+        let p = self.floats(&[-x, -y, 0.0, x, -y, 0.0, x, y, 0.0, -x, y, 0.0], 3, "VEC3");
+        let n = self.floats(&[0.0, 0.0, 1.0].repeat(4), 3, "VEC3");
+        let uv = self.floats(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0], 2, "VEC2");
+        let i = self.indices(&[0, 1, 2, 0, 2, 3], U16);
+        self.mesh(
+            name,
+            vec![
+                json!({"attributes": {"POSITION": p, "NORMAL": n, "TEXCOORD_0": uv},
+                        "indices": i, "material": material}),
+            ],
+        )
     }
 
     /// A KHR_lights_punctual light from its JSON object.

@@ -219,42 +219,25 @@ fn shadow_section(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: 
             if r.changed() {
                 out.push(Command::ToggleShadows);
             }
-            ui.label("map size ([ ])");
-            ui.horizontal_wrapped(|ui| {
-                for n in MAP_SIZES {
-                    let r = ui.selectable_label(s.map_size == n, n.to_string());
-                    w.add(format!("map.{n}"), &r);
-                    if r.clicked() && s.map_size != n {
-                        out.push(Command::Set(Action::SetMapSize(n)));
-                    }
-                }
-            });
-            ui.label("filter (K)");
-            ui.horizontal(|ui| {
-                for (k, name) in [
-                    (Pcf::None, "none"),
-                    (Pcf::P2x2, "2x2"),
-                    (Pcf::P3x3, "3x3"),
-                    (Pcf::P5x5, "5x5"),
-                ] {
-                    let r = ui.selectable_label(s.pcf == k, name);
-                    w.add(format!("pcf.{name}"), &r);
-                    if r.clicked() && s.pcf != k {
-                        out.push(Command::Set(Action::SetPcf(k)));
-                    }
-                }
-            });
-            ui.label("cascades (N)");
-            ui.horizontal(|ui| {
-                for n in 0..=MAX_CASCADES {
-                    let label = if n == 0 { "auto".into() } else { n.to_string() };
-                    let r = ui.selectable_label(s.cascades == n, &label);
-                    w.add(format!("cascades.{label}"), &r);
-                    if r.clicked() && s.cascades != n {
-                        out.push(Command::Set(Action::SetCascades(n)));
-                    }
-                }
-            });
+            let sizes = MAP_SIZES.map(|n| (n, n.to_string()));
+            if let Some(n) = choice(ui, w, "map size ([ ])", "map", s.map_size, &sizes) {
+                out.push(Command::Set(Action::SetMapSize(n)));
+            }
+            let kernels = [
+                (Pcf::None, "none".to_string()),
+                (Pcf::P2x2, "2x2".into()),
+                (Pcf::P3x3, "3x3".into()),
+                (Pcf::P5x5, "5x5".into()),
+            ];
+            if let Some(k) = choice(ui, w, "filter (K)", "pcf", s.pcf, &kernels) {
+                out.push(Command::Set(Action::SetPcf(k)));
+            }
+            let counts: Vec<(u32, String)> = (0..=MAX_CASCADES)
+                .map(|n| (n, if n == 0 { "auto".into() } else { n.to_string() }))
+                .collect();
+            if let Some(n) = choice(ui, w, "cascades (N)", "cascades", s.cascades, &counts) {
+                out.push(Command::Set(Action::SetCascades(n)));
+            }
             let mut fit = s.depth_fit;
             let r = ui.checkbox(&mut fit, "fit cascades to the depths seen (G)");
             w.add("depth-fit", &r);
@@ -296,22 +279,37 @@ fn biases(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: &mut Wid
 }
 
 fn budget(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: &mut Widgets) {
-    ui.label("error budget (misclassified pixels)");
+    let options: Vec<(Option<f64>, String)> = std::iter::once((None, "off".to_string()))
+        .chain(BUDGETS.map(|b| (Some(b), b.to_string())))
+        .collect();
+    let label = "error budget (misclassified pixels, %)";
+    if let Some(b) = choice(ui, w, label, "budget", m.budget, &options) {
+        out.push(Command::Budget(b));
+    }
+}
+
+/// A labelled row of mutually exclusive options (value, name): each registered as
+/// `PREFIX.NAME`; the value clicked when it is not the `current` one.
+fn choice<T: PartialEq + Clone>(
+    ui: &mut egui::Ui,
+    w: &mut Widgets,
+    label: &str,
+    prefix: &str,
+    current: T,
+    options: &[(T, String)],
+) -> Option<T> {
+    ui.label(label);
+    let mut picked = None;
     ui.horizontal_wrapped(|ui| {
-        let r = ui.selectable_label(m.budget.is_none(), "off");
-        w.add("budget.off", &r);
-        if r.clicked() && m.budget.is_some() {
-            out.push(Command::Budget(None));
-        }
-        for b in BUDGETS {
-            let on = m.budget.is_some_and(|x| (x - b).abs() < 1e-9);
-            let r = ui.selectable_label(on, format!("{b} %"));
-            w.add(format!("budget.{b}"), &r);
-            if r.clicked() && !on {
-                out.push(Command::Budget(Some(b)));
+        for (value, name) in options {
+            let r = ui.selectable_label(*value == current, name.as_str());
+            w.add(format!("{prefix}.{name}"), &r);
+            if r.clicked() && *value != current {
+                picked = Some(value.clone());
             }
         }
     });
+    picked
 }
 
 fn light_section(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: &mut Widgets) {
@@ -330,41 +328,26 @@ fn light_section(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: &
             {
                 out.push(Command::Set(Action::SetSun(sun)));
             }
-            ui.label("light shown (L)");
-            ui.horizontal_wrapped(|ui| {
-                let r = ui.selectable_label(v.shown_light.is_none(), "first shadowed");
-                w.add("light.first", &r);
-                if r.clicked() && v.shown_light.is_some() {
-                    out.push(Command::ShadowLight(None));
-                }
-                for i in 0..m.lights {
-                    let r = ui.selectable_label(v.shown_light == Some(i), i.to_string());
-                    w.add(format!("light.{i}"), &r);
-                    if r.clicked() && v.shown_light != Some(i) {
-                        out.push(Command::ShadowLight(Some(i)));
-                    }
-                }
-            });
+            let lights: Vec<(Option<usize>, String)> = std::iter::once((None, "first".into()))
+                .chain((0..m.lights).map(|i| (Some(i), i.to_string())))
+                .collect();
+            if let Some(l) = choice(ui, w, "light shown (L)", "light", v.shown_light, &lights) {
+                out.push(Command::ShadowLight(l));
+            }
             let mut ev = v.exposure_compensation;
             let r = ui.add(egui::Slider::new(&mut ev, -8.0..=8.0).text("exposure (EV, , .)"));
             w.add("exposure", &r);
             if moved(&r, ev, v.exposure_compensation) {
                 out.push(Command::Set(Action::SetExposure(ev)));
             }
-            ui.label("tone curve (T)");
-            ui.horizontal(|ui| {
-                for (t, name) in [
-                    (Tonemap::Neutral, "neutral"),
-                    (Tonemap::Aces, "aces"),
-                    (Tonemap::None, "none"),
-                ] {
-                    let r = ui.selectable_label(v.tonemap == t, name);
-                    w.add(format!("tonemap.{name}"), &r);
-                    if r.clicked() && v.tonemap != t {
-                        out.push(Command::Set(Action::SetTonemap(t)));
-                    }
-                }
-            });
+            let curves = [
+                (Tonemap::Neutral, "neutral".to_string()),
+                (Tonemap::Aces, "aces".into()),
+                (Tonemap::None, "none".into()),
+            ];
+            if let Some(t) = choice(ui, w, "tone curve (T)", "tonemap", v.tonemap, &curves) {
+                out.push(Command::Set(Action::SetTonemap(t)));
+            }
             let name = |m: umbra::render::ViewMode| format!("{m:?}").to_lowercase();
             egui::ComboBox::from_label("view (V)")
                 .selected_text(name(v.mode))
@@ -407,22 +390,15 @@ fn camera_section(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: 
                 out.push(Command::ToggleOrthographic);
             }
             if !m.cameras.is_empty() {
-                ui.label("glTF cameras (C)");
-                ui.horizontal_wrapped(|ui| {
-                    let r = ui.selectable_label(m.camera.is_none(), "viewer");
-                    w.add("gltf-camera.viewer", &r);
-                    if r.clicked() && m.camera.is_some() {
-                        out.push(Command::Camera(None));
-                    }
-                    for (i, &ortho) in m.cameras.iter().enumerate() {
-                        let label = format!("{i}{}", if ortho { " (ortho)" } else { "" });
-                        let r = ui.selectable_label(m.camera == Some(i), label);
-                        w.add(format!("gltf-camera.{i}"), &r);
-                        if r.clicked() && m.camera != Some(i) {
-                            out.push(Command::Camera(Some(i)));
-                        }
-                    }
-                });
+                let cameras: Vec<(Option<usize>, String)> =
+                    std::iter::once((None, "viewer".into()))
+                        .chain(m.cameras.iter().enumerate().map(|(i, &ortho)| {
+                            (Some(i), format!("{i}{}", if ortho { "-ortho" } else { "" }))
+                        }))
+                        .collect();
+                if let Some(c) = choice(ui, w, "glTF cameras (C)", "camera", m.camera, &cameras) {
+                    out.push(Command::Camera(c));
+                }
             }
         });
 }
