@@ -42,7 +42,8 @@ fn pcf_taps() -> i32 {
 struct Immediates {
     world_from_model: mat4x4<f32>,
     // columns of the normal matrix (inverse transpose of the upper 3x3); normal_x.w = sign of det,
-    // normal_y.w = 1 to tint the draw orange (the viewer's picked primitive)
+    // normal_y.w = 1 to tint the draw orange (the viewer's picked primitive), normal_z.w = the
+    // draw's instance + 1 in the AOV pass
     normal_x: vec4<f32>,
     normal_y: vec4<f32>,
     normal_z: vec4<f32>,
@@ -197,6 +198,28 @@ fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(
         discard;
     }
     return vec4<f32>(highlight(display_surface(shade(in, front_facing, base).color)), 1.0);
+}
+
+// Per-pixel outputs for image tests and datasets (the Python package's `segmentation` and
+// `normals`): the draw's instance + 1 (pc.normal_z.w holds it as a float, exact below 2^24) and
+// the interpolated world normal, turned to face the viewer as shading turns it. Masked materials
+// discard below the cutoff as fs_masked does; blended ones are not drawn.
+struct Aov {
+    @location(0) id: u32,
+    @location(1) normal: vec4<f32>,
+}
+
+@fragment
+fn fs_aov(in: VsOut, @builtin(front_facing) front_facing: bool) -> Aov {
+    let base = base_color(in.uv, in.color);
+    if material.extra.x > 0.0 && base.a < material.extra.x {
+        discard;
+    }
+    let n = normalize(in.normal);
+    var out: Aov;
+    out.id = u32(pc.normal_z.w + 0.5);
+    out.normal = vec4<f32>(select(-n, n, front_facing), 1.0);
+    return out;
 }
 
 // A colour ramp of rising brightness: dark blue, teal, yellow, white over t in [0, 1].

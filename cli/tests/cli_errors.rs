@@ -57,7 +57,7 @@ fn data_uri(bytes: &[u8]) -> String {
 
 fn glb(json: &Value, bin: &[u8]) -> Vec<u8> {
     let mut j = serde_json::to_vec(json).unwrap();
-    while j.len() % 4 != 0 {
+    while j.len() & 3 != 0 {
         j.push(b' ');
     }
     let total = 12 + 8 + j.len() + 8 + bin.len();

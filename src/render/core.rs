@@ -10,7 +10,9 @@ use crate::math::shadow_fit::spot_near;
 use crate::plan::settings::{Background, SceneOptions, ShadowSettings, View, ViewMode};
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
-use crate::render::passes::camera_pass::{CameraFrame, CameraPass, CameraTargets, Resolve};
+use crate::render::passes::camera_pass::{
+    AovTargets, CameraFrame, CameraPass, CameraTargets, Resolve,
+};
 use crate::render::passes::cull::CameraCull;
 use crate::render::passes::receivers::ShadowReach;
 use crate::render::passes::shadow_pass::{plan_casters, ShadowPass};
@@ -291,6 +293,31 @@ impl FrameCore {
             deferred_draws: counts.deferred,
             unshadowed_draws: counts.unshadowed,
         }
+    }
+
+    /// Records the AOV pass of a prepared frame (`CameraPass::record_aov`: instance ids, world
+    /// normals, depth; one sample) into `ids`, `normals` and `depth`, making its pipelines first;
+    /// leaves them as attachments. Returns the draws recorded.
+    pub fn record_aov(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &Prepared,
+        (ids, normals, depth): (&mut Attachment, &mut Attachment, &mut Attachment),
+    ) -> Result<usize, GpuError> {
+        self.camera.ensure_aov_pipelines(&self.gpu, &frame.camera)?;
+        let d = &self.ctx.device;
+        ids.transition(d, cmd, Access::ColorAttachment);
+        normals.transition(d, cmd, Access::ColorAttachment);
+        depth.transition(d, cmd, Access::DepthAttachment);
+        let targets = AovTargets {
+            ids: ids.view,
+            normals: normals.view,
+            depth: depth.view,
+            extent: frame.extent,
+        };
+        Ok(self
+            .camera
+            .record_aov(cmd, frame.slot, &self.gpu, &targets, &frame.camera))
     }
 
     /// GPU milliseconds (shadow pass, camera pass) of slot `slot`'s last frame, which must have

@@ -14,6 +14,9 @@ use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod aov;
+pub use aov::Aovs;
+
 /// Colour format of offscreen frames (sRGB-encoded on write).
 pub const OFFSCREEN_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 /// Largest offscreen side.
@@ -78,6 +81,8 @@ pub struct Renderer {
     read_depth: bool,
     /// The depths the last measured camera saw (`ShadowSettings::depth_fit`).
     seen_depths: Option<SeenDepths>,
+    /// The AOV pass's images (`render_aovs`), made at its first call.
+    aov: Option<aov::AovTarget>,
 }
 
 /// A camera (view matrix, projection, image size) and the (nearest, farthest) view depth it saw
@@ -170,6 +175,7 @@ impl Renderer {
             fence,
             read_depth: false,
             seen_depths: None,
+            aov: None,
         })
     }
 
@@ -319,11 +325,7 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<RenderedFrame, GpuError> {
-        if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
-            return Err(GpuError::Unsupported(format!(
-                "image size {width}x{height} is outside 1x1..{MAX_SIDE}x{MAX_SIDE}"
-            )));
-        }
+        check_size(width, height)?;
         let start = Instant::now();
         let prepared = self.core.prepare(0, view, width, height)?;
         self.ensure_target(width, height)?;
@@ -404,6 +406,16 @@ impl Renderer {
             depth,
         })
     }
+}
+
+/// An error for an image size outside 1×1..`MAX_SIDE`².
+fn check_size(width: u32, height: u32) -> Result<(), GpuError> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(GpuError::Unsupported(format!(
+            "image size {width}x{height} is outside 1x1..{MAX_SIDE}x{MAX_SIDE}"
+        )));
+    }
+    Ok(())
 }
 
 /// The nearest and farthest view depth in a reversed-z depth buffer (0 = nothing drawn) under

@@ -47,6 +47,8 @@ pub enum Entry {
     /// `fs_gbuffer`: a deferred draw's varyings into the G-buffer, its material's mark into the
     /// stencil (one pipeline for every material).
     GBuffer,
+    /// `fs_aov`: instance ids and world normals into their own targets (`CameraPass::record_aov`).
+    Aov,
 }
 
 impl Entry {
