@@ -1,16 +1,19 @@
 #!/usr/bin/env bash
 # Makes sure a Vulkan loader, a driver (ICD) and, with --validation, the Khronos validation layer
-# are installed. Installs Mesa's lavapipe CPU driver with apt when root or with passwordless
-# sudo; otherwise prints exactly what to install and exits 1.
-# Usage: scripts/ensure-vulkan.sh [--validation] [--xvfb]
+# are installed (with --python, also Python 3 with venv and pip, for the Python package). Installs
+# them with apt when root or with passwordless sudo; otherwise prints exactly what to install and
+# exits 1.
+# Usage: scripts/ensure-vulkan.sh [--validation] [--xvfb] [--python]
 set -euo pipefail
 
 need_validation=0
 need_xvfb=0
+need_python=0
 for a in "$@"; do
   case "$a" in
     --validation) need_validation=1 ;;
     --xvfb) need_xvfb=1 ;;
+    --python) need_python=1 ;;
   esac
 done
 
@@ -47,11 +50,16 @@ if [ "$need_xvfb" = 1 ] && ! ldconfig -p 2>/dev/null | grep 'libxkbcommon-x11\.s
   missing+=(libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6)
 fi
 
+# The Python package's tests: an interpreter that can make a virtual environment with pip.
+if [ "$need_python" = 1 ] && ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
+  missing+=(python3 python3-venv python3-pip)
+fi
+
 if [ "${#missing[@]}" -eq 0 ]; then
   exit 0
 fi
 
-echo "umbra: installing missing Vulkan packages: ${missing[*]}" >&2
+echo "umbra: installing missing packages: ${missing[*]}" >&2
 if [ "$(id -u)" = 0 ]; then
   SUDO=""
 elif command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then

@@ -19,6 +19,20 @@ pub enum Tonemap {
     None,
 }
 
+impl std::str::FromStr for Tonemap {
+    type Err = String;
+
+    /// `neutral`, `aces` or `none`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "neutral" => Ok(Tonemap::Neutral),
+            "aces" => Ok(Tonemap::Aces),
+            "none" => Ok(Tonemap::None),
+            _ => Err(format!("tone curve '{s}' is not neutral, aces or none")),
+        }
+    }
+}
+
 impl Tonemap {
     /// The shader's operator number (`Frame.output.y`).
     pub fn shader_value(self) -> f32 {

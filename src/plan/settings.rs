@@ -395,6 +395,88 @@ pub enum Background {
     Color(Vec3),
 }
 
+impl std::str::FromStr for Background {
+    type Err = String;
+
+    /// `sky`, or a display (sRGB) colour: `#RRGGBB`, or `R,G,B` / one grey value within 0..1
+    /// (the command line's `--background`), kept as the linear colour cleared to.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let t = s.trim();
+        if t.eq_ignore_ascii_case("sky") {
+            return Ok(Background::Sky);
+        }
+        let bad = || format!("background '{s}' must be sky, #RRGGBB or R,G,B within 0..1");
+        let srgb: Vec<f32> = if let Some(hex) = t.strip_prefix('#') {
+            if hex.len() != 6 {
+                return Err(bad());
+            }
+            (0..3)
+                .map(|k| {
+                    hex.get(2 * k..2 * k + 2)
+                        .and_then(|b| u8::from_str_radix(b, 16).ok())
+                        .map(|b| b as f32 / 255.0)
+                        .ok_or_else(bad)
+                })
+                .collect::<Result<_, _>>()?
+        } else {
+            t.split(',')
+                .map(|v| v.trim().parse::<f32>().map_err(|_| bad()))
+                .collect::<Result<_, _>>()?
+        };
+        let c = match srgb.as_slice() {
+            [g] => Vec3::splat(*g),
+            [r, g, b] => Vec3::new(*r, *g, *b),
+            _ => return Err(bad()),
+        };
+        if !(c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0) {
+            return Err(bad());
+        }
+        Ok(Background::Color(
+            c.map(crate::math::tonemap::srgb_to_linear),
+        ))
+    }
+}
+
+impl std::str::FromStr for Exposure {
+    type Err = String;
+
+    /// `auto`, an EV100 within −64..64, or `x` and a linear scale above 0 (the command line's
+    /// `--exposure`).
+    fn from_str(s: &str) -> Result<Self, String> {
+        let t = s.trim();
+        if t.eq_ignore_ascii_case("auto") {
+            return Ok(Exposure::Auto);
+        }
+        if let Some(k) = t.strip_prefix(['x', 'X']) {
+            return match k.trim().parse::<f32>() {
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(Exposure::Scale(v)),
+                _ => Err(format!("exposure scale '{k}' must be a number above 0")),
+            };
+        }
+        match t.parse::<f32>() {
+            Ok(v) if v.is_finite() && v.abs() <= 64.0 => Ok(Exposure::Ev100(v)),
+            _ => Err(format!(
+                "'{s}' is not `auto`, an EV100 within -64..64, or `x` and a scale (e.g. x1)"
+            )),
+        }
+    }
+}
+
+impl std::str::FromStr for Pcf {
+    type Err = String;
+
+    /// `none`, `2x2`, `3x3` or `5x5`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "none" => Ok(Pcf::None),
+            "2x2" => Ok(Pcf::P2x2),
+            "3x3" => Ok(Pcf::P3x3),
+            "5x5" => Ok(Pcf::P5x5),
+            _ => Err(format!("filter '{s}' is not none, 2x2, 3x3 or 5x5")),
+        }
+    }
+}
+
 /// How bright the scene is drawn: the linear scale applied before tone mapping.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum Exposure {

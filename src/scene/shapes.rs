@@ -202,6 +202,82 @@ pub fn add_object(
     scene.meshes.len() - 1
 }
 
+/// A triangle mesh as arrays (what the Python package's `Scene.add_mesh` takes): positions, and
+/// optionally indices (a triangle list; without, every three positions are a triangle), normals,
+/// texture coordinates and linear RGBA vertex colours, each with one entry per position.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MeshArrays<'a> {
+    /// Object-space positions.
+    pub positions: &'a [[f32; 3]],
+    /// Triangle-list indices into `positions`.
+    pub indices: Option<&'a [u32]>,
+    /// Vertex normals (need not be unit length; smooth normals are computed without them).
+    pub normals: Option<&'a [[f32; 3]]>,
+    /// TEXCOORD_0.
+    pub uvs: Option<&'a [[f32; 2]]>,
+    /// Linear RGBA colours multiplying the base colour.
+    pub colors: Option<&'a [[f32; 4]]>,
+}
+
+/// The primitive of `a` (normals computed when absent, tangents from the normals), or a
+/// one-line reason it cannot be one: no positions, a non-finite value, an index past the
+/// positions, a count that is not a whole number of triangles, or an attribute whose count
+/// differs from the positions'.
+pub fn primitive_from_arrays(a: &MeshArrays) -> Result<Primitive, String> {
+    let n = a.positions.len();
+    if n == 0 {
+        return Err("positions are empty".into());
+    }
+    let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+    if !a.positions.iter().all(|p| finite(p)) {
+        return Err("positions hold a NaN or an infinity".into());
+    }
+    let indices: Vec<u32> = match a.indices {
+        Some(i) => i.to_vec(),
+        None => (0..n as u32).collect(),
+    };
+    if indices.len() % 3 != 0 || indices.is_empty() {
+        return Err(format!(
+            "{} indices are not a whole number of triangles",
+            indices.len()
+        ));
+    }
+    if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+        return Err(format!("index {bad} is past the {n} positions"));
+    }
+    let count = |name: &str, len: Option<usize>| match len {
+        Some(m) if m != n => Err(format!("{m} {name} for {n} positions")),
+        _ => Ok(()),
+    };
+    count("normals", a.normals.map(<[_]>::len))?;
+    count("texture coordinates", a.uvs.map(<[_]>::len))?;
+    count("colours", a.colors.map(<[_]>::len))?;
+    let positions: Vec<Vec3> = a.positions.iter().map(|&p| Vec3::from_array(p)).collect();
+    let normals = match a.normals {
+        Some(v) if v.iter().all(|p| finite(p)) => v
+            .iter()
+            .map(|&p| Vec3::from_array(p).try_normalize().unwrap_or(Vec3::Y))
+            .collect(),
+        Some(_) => return Err("normals hold a NaN or an infinity".into()),
+        None => super::tangents::compute_smooth_normals(&positions, &indices),
+    };
+    let uvs: Vec<Vec2> = a
+        .uvs
+        .map(|v| v.iter().map(|&t| Vec2::from_array(t)).collect())
+        .unwrap_or_else(|| vec![Vec2::ZERO; n]);
+    let tangents = normals
+        .iter()
+        .map(|&m| super::tangents::fallback_tangent(m))
+        .collect();
+    let mut p = prim(positions, normals, uvs, tangents, indices);
+    p.has_uvs = a.uvs.is_some();
+    p.colors = a
+        .colors
+        .map(|c| c.iter().map(|&c| Vec4::from_array(c)).collect())
+        .unwrap_or_default();
+    Ok(p)
+}
+
 /// Adds a texture and returns its index.
 pub fn add_texture(scene: &mut Scene, t: Texture) -> usize {
     scene.textures.push(t);
@@ -244,6 +320,59 @@ pub fn add_ground(scene: &mut Scene) {
         colored(Vec3::splat(0.3), 0.9),
         Mat4::from_translation(Vec3::new(c.x, y, c.z)),
     );
+}
+
+#[cfg(test)]
+mod array_tests {
+    use super::*;
+
+    #[test]
+    fn arrays_make_a_primitive_or_a_one_line_reason() {
+        let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let p = primitive_from_arrays(&MeshArrays {
+            positions: &tri,
+            ..Default::default()
+        })
+        .unwrap();
+        assert_eq!(p.indices, [0, 1, 2]);
+        assert!(p.normals.iter().all(|n| n.abs_diff_eq(Vec3::Z, 1e-6)));
+        assert_eq!(p.tangents.len(), 3);
+        for (a, want) in [
+            (
+                MeshArrays {
+                    positions: &tri,
+                    indices: Some(&[0, 1, 3]),
+                    ..Default::default()
+                },
+                "index 3 is past the 3 positions",
+            ),
+            (
+                MeshArrays {
+                    positions: &tri,
+                    indices: Some(&[0, 1]),
+                    ..Default::default()
+                },
+                "2 indices are not a whole number of triangles",
+            ),
+            (
+                MeshArrays {
+                    positions: &tri,
+                    normals: Some(&[[0.0, 0.0, 1.0]]),
+                    ..Default::default()
+                },
+                "1 normals for 3 positions",
+            ),
+            (
+                MeshArrays {
+                    positions: &[[f32::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                    ..Default::default()
+                },
+                "positions hold a NaN or an infinity",
+            ),
+        ] {
+            assert_eq!(primitive_from_arrays(&a).unwrap_err(), want);
+        }
+    }
 }
 
 #[cfg(test)]

@@ -74,57 +74,14 @@ pub(crate) fn parse_ambient(s: &str) -> Result<Vec3, String> {
     Ok(v)
 }
 
-/// `sky`, or a display (sRGB) colour: `#RRGGBB`, or `R,G,B` / one grey value within 0..1,
-/// returned as the linear colour the background is cleared to.
+/// `--background`: `Background`'s own parser.
 pub(crate) fn parse_background(s: &str) -> Result<Background, String> {
-    let t = s.trim();
-    if t.eq_ignore_ascii_case("sky") {
-        return Ok(Background::Sky);
-    }
-    let srgb = if let Some(hex) = t.strip_prefix('#') {
-        let byte = |i: usize| {
-            hex.get(i..i + 2)
-                .and_then(|b| u8::from_str_radix(b, 16).ok())
-                .map(|b| b as f32 / 255.0)
-        };
-        match (hex.len(), byte(0), byte(2), byte(4)) {
-            (6, Some(r), Some(g), Some(b)) => Vec3::new(r, g, b),
-            _ => return Err(format!("background '{s}' is not #RRGGBB")),
-        }
-    } else {
-        match t.parse::<f32>() {
-            Ok(g) => Vec3::splat(g),
-            Err(_) => parse_vec3(t)?,
-        }
-    };
-    if !(srgb.is_finite() && srgb.min_element() >= 0.0 && srgb.max_element() <= 1.0) {
-        return Err(format!(
-            "background '{s}' must be sky, #RRGGBB or R,G,B within 0..1"
-        ));
-    }
-    Ok(Background::Color(
-        srgb.map(umbra::math::tonemap::srgb_to_linear),
-    ))
+    s.parse()
 }
 
-/// `auto`, an EV100 number, or `x` and a linear scale.
+/// `--exposure`: `Exposure`'s own parser.
 pub(crate) fn parse_exposure(s: &str) -> Result<Exposure, String> {
-    let t = s.trim();
-    if t.eq_ignore_ascii_case("auto") {
-        return Ok(Exposure::Auto);
-    }
-    if let Some(k) = t.strip_prefix(['x', 'X']) {
-        return match k.trim().parse::<f32>() {
-            Ok(v) if v.is_finite() && v > 0.0 => Ok(Exposure::Scale(v)),
-            _ => Err(format!("exposure scale '{k}' must be a number above 0")),
-        };
-    }
-    match t.parse::<f32>() {
-        Ok(v) if v.is_finite() && v.abs() <= 64.0 => Ok(Exposure::Ev100(v)),
-        _ => Err(format!(
-            "'{s}' is not `auto`, an EV100 within -64..64, or `x` and a scale (e.g. x1)"
-        )),
-    }
+    s.parse()
 }
 
 pub(crate) fn parse_budget(s: &str) -> Result<f64, String> {

@@ -1,0 +1,50 @@
+"""Meshes of trimesh objects as the arrays ``Scene.add_mesh`` takes (``Scene.from_trimesh``)."""
+
+import numpy as np
+
+
+def _mesh_arrays(mesh, pose, name):
+    positions = np.asarray(mesh.vertices, dtype=np.float32)
+    indices = np.asarray(mesh.faces, dtype=np.uint32)
+    normals = None
+    if hasattr(mesh, "vertex_normals") and len(mesh.vertex_normals) == len(positions):
+        normals = np.asarray(mesh.vertex_normals, dtype=np.float32)
+    colors, uvs, base = None, None, [1.0, 1.0, 1.0, 1.0]
+    visual = getattr(mesh, "visual", None)
+    kind = getattr(visual, "kind", None)
+    if kind == "vertex":
+        colors = np.asarray(visual.vertex_colors, dtype=np.uint8)
+    elif kind == "face":
+        # One colour per face is not a vertex attribute: the first face's, for the material.
+        c = np.asarray(visual.face_colors, dtype=np.float64)
+        if len(c):
+            base = list(c[0] / 255.0)
+    elif kind == "texture":
+        uv = getattr(visual, "uv", None)
+        if uv is not None and len(uv) == len(positions):
+            uvs = np.asarray(uv, dtype=np.float32)
+    return {
+        "positions": positions,
+        "indices": indices,
+        "normals": normals,
+        "uvs": uvs,
+        "colors": colors,
+        "base_color": [float(x) for x in base],
+        "pose": np.asarray(pose, dtype=np.float64),
+        "name": name,
+    }
+
+
+def to_arrays(obj):
+    """The meshes of a ``trimesh.Trimesh`` or ``trimesh.Scene`` (with their world transforms)."""
+    if hasattr(obj, "graph") and hasattr(obj, "geometry"):
+        parts = []
+        for node in obj.graph.nodes_geometry:
+            transform, geometry = obj.graph[node]
+            mesh = obj.geometry[geometry]
+            if hasattr(mesh, "faces") and len(mesh.faces):
+                parts.append(_mesh_arrays(mesh, transform, str(node)))
+        return parts
+    if hasattr(obj, "faces") and hasattr(obj, "vertices"):
+        return [_mesh_arrays(obj, np.eye(4), getattr(obj, "metadata", {}).get("name", "mesh"))]
+    raise TypeError(f"not a trimesh.Trimesh or trimesh.Scene: {type(obj).__name__}")

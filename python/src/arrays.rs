@@ -1,0 +1,93 @@
+//! numpy in and out: any array-like converted (`numpy.ascontiguousarray`) to the dtype a call
+//! needs and checked for shape, and frames returned as arrays of the documented shapes.
+
+use glam::Mat4;
+use numpy::ndarray::{Array2, ArrayD, IxDyn};
+use numpy::{Element, IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+/// `obj` as a contiguous array of `dtype`: its values in C order and its shape.
+pub fn values<T: Element + Copy>(
+    obj: &Bound<'_, PyAny>,
+    dtype: &str,
+    name: &str,
+) -> PyResult<(Vec<T>, Vec<usize>)> {
+    let np = obj.py().import("numpy")?;
+    let a = np
+        .call_method1("ascontiguousarray", (obj, dtype))
+        .map_err(|e| PyValueError::new_err(format!("{name}: not an array of numbers ({e})")))?;
+    let a = a.cast_into::<PyArrayDyn<T>>()?;
+    let shape = a.shape().to_vec();
+    let ro = a.readonly();
+    Ok((ro.as_slice()?.to_vec(), shape))
+}
+
+/// `obj` as rows of `N` floats: an (n, N) array (or a flat one of n·N values).
+pub fn rows<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f32; N]>> {
+    let (v, shape) = values::<f32>(obj, "float32", name)?;
+    let ok = match shape.as_slice() {
+        [_, n] => *n == N,
+        [n] => n % N == 0,
+        _ => false,
+    };
+    if !ok {
+        return Err(PyValueError::new_err(format!(
+            "{name}: shape {shape:?}, expected (n, {N})"
+        )));
+    }
+    Ok(v.chunks_exact(N)
+        .map(|c| std::array::from_fn(|k| c[k]))
+        .collect())
+}
+
+/// A 4×4 matrix (row-major numpy, as pyrender's poses) as a glam matrix.
+pub fn matrix4(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Mat4> {
+    let (v, shape) = values::<f32>(obj, "float32", name)?;
+    if shape != [4, 4] {
+        return Err(PyValueError::new_err(format!(
+            "{name}: shape {shape:?}, expected (4, 4)"
+        )));
+    }
+    let m = Mat4::from_cols_slice(&v).transpose();
+    if !m.is_finite() {
+        return Err(PyValueError::new_err(format!(
+            "{name}: holds a NaN or an infinity"
+        )));
+    }
+    Ok(m)
+}
+
+/// A glam matrix as a row-major (4, 4) float64 array.
+pub fn matrix_out<'py>(py: Python<'py>, m: Mat4) -> Bound<'py, PyAny> {
+    let rows: Vec<f64> = m
+        .transpose()
+        .to_cols_array()
+        .iter()
+        .map(|&x| x as f64)
+        .collect();
+    Array2::from_shape_vec((4, 4), rows)
+        .expect("16 values")
+        .into_pyarray(py)
+        .into_any()
+}
+
+/// `data` (row-major: `frames` images of `c` values a pixel) as an array of shape
+/// ([frames,] h, w[, c]): the frame axis only when `stacked`, the channel axis only when `c` > 1.
+pub fn image_out<'py, T: Element>(
+    py: Python<'py>,
+    data: Vec<T>,
+    (w, h): (u32, u32),
+    c: usize,
+    stacked: Option<usize>,
+) -> Bound<'py, PyAny> {
+    let mut shape: Vec<usize> = stacked.into_iter().collect();
+    shape.extend([h as usize, w as usize]);
+    if c > 1 {
+        shape.push(c);
+    }
+    ArrayD::from_shape_vec(IxDyn(&shape), data)
+        .expect("the values fill the shape")
+        .into_pyarray(py)
+        .into_any()
+}

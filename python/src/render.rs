@@ -1,0 +1,472 @@
+//! `umbra.OffscreenRenderer`: pyrender's offscreen renderer, shaped the same (`render(scene,
+//! camera, camera_pose)` → colour and depth), with more outputs and umbra's shadow settings. A
+//! scene is uploaded once and kept while it only moves; the GIL is released while the GPU works.
+
+use crate::arrays::{image_out, matrix4, values};
+use crate::camera::engine_camera;
+use crate::scene::PyScene;
+use crate::settings::{self, Extras};
+use crate::{gpu_error, UmbraError};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use std::sync::Arc;
+use umbra::render::{Renderer, SceneOptions, View, ViewMode};
+use umbra::scene::anim::Playing;
+use umbra::{Context, ContextDesc, Validation};
+
+/// What `render` can return.
+const OUTPUTS: [&str; 5] = ["color", "depth", "segmentation", "normals", "shadow"];
+
+/// A scene's upload, kept for the frames that follow.
+struct Cached {
+    scene: u64,
+    geometry: u64,
+    poses: u64,
+    renderer: Renderer,
+}
+
+/// Renders scenes offscreen into numpy arrays.
+#[pyclass(module = "umbra")]
+pub struct OffscreenRenderer {
+    width: u32,
+    height: u32,
+    options: SceneOptions,
+    // Dropped before the context.
+    cached: Option<Cached>,
+    ctx: Option<Arc<Context>>,
+}
+
+/// One frame's outputs: name → (values, channels), in `OUTPUTS` order.
+enum Data {
+    U8(Vec<u8>),
+    F32(Vec<f32>),
+    U32(Vec<u32>),
+}
+
+impl Data {
+    fn u8(self) -> Vec<u8> {
+        match self {
+            Data::U8(v) => v,
+            _ => unreachable!("an output keeps its type across frames"),
+        }
+    }
+    fn f32(self) -> Vec<f32> {
+        match self {
+            Data::F32(v) => v,
+            _ => unreachable!("an output keeps its type across frames"),
+        }
+    }
+    fn u32(self) -> Vec<u32> {
+        match self {
+            Data::U32(v) => v,
+            _ => unreachable!("an output keeps its type across frames"),
+        }
+    }
+}
+
+struct Output {
+    name: &'static str,
+    data: Data,
+    channels: usize,
+}
+
+impl OffscreenRenderer {
+    fn ctx(&self) -> PyResult<Arc<Context>> {
+        self.ctx
+            .clone()
+            .ok_or_else(|| UmbraError::new_err("this renderer was closed"))
+    }
+
+    /// The renderer for `scene`, uploaded again only when meshes or lights were added, posed
+    /// again when instances moved.
+    fn renderer_for(&mut self, scene: &PyScene) -> PyResult<&mut Renderer> {
+        let ctx = self.ctx()?;
+        let keep = self
+            .cached
+            .as_ref()
+            .is_some_and(|c| c.scene == scene.id && c.geometry == scene.geometry);
+        if !keep {
+            self.cached = None;
+            let renderer =
+                Renderer::with_options(&ctx, &scene.scene, &self.options).map_err(gpu_error)?;
+            self.cached = Some(Cached {
+                scene: scene.id,
+                geometry: scene.geometry,
+                poses: scene.poses,
+                renderer,
+            });
+        }
+        let c = self.cached.as_mut().expect("made above");
+        if c.poses != scene.poses {
+            c.renderer.set_pose(&scene.scene).map_err(gpu_error)?;
+            c.poses = scene.poses;
+        }
+        Ok(&mut c.renderer)
+    }
+
+    /// Poses `scene` at the settings' time (`time`, `animation`).
+    fn pose(scene: &mut PyScene, extras: &Extras) -> PyResult<()> {
+        let Some(t) = extras.time else {
+            if extras.animation.is_some() {
+                return Err(PyValueError::new_err("animation needs a time"));
+            }
+            return Ok(());
+        };
+        let rig = scene.scene.rig.clone();
+        let playing = match &extras.animation {
+            Some(spec) => Playing::parse(spec, rig.as_deref())
+                .map_err(|e| PyValueError::new_err(format!("animation: {e}")))?,
+            None => Playing::first(rig.as_deref()),
+        };
+        scene.scene.pose_at(&playing, t);
+        scene.poses += 1;
+        Ok(())
+    }
+
+    /// Renders `view` of `scene` into the `outputs` asked for.
+    fn frame(
+        &mut self,
+        py: Python<'_>,
+        scene: &PyScene,
+        view: &View,
+        extras: &Extras,
+        outputs: &[&'static str],
+    ) -> PyResult<Vec<Output>> {
+        let (w, h) = (self.width, self.height);
+        let renderer = self.renderer_for(scene)?;
+        let mut view = view.clone();
+        if let Some(b) = extras.budget {
+            choose_budget(renderer, &scene.scene, &mut view, (w, h), b)?;
+        }
+        // The GPU's work, without the GIL.
+        py.detach(|| render_outputs(renderer, &view, (w, h), outputs))
+            .map_err(gpu_error)
+    }
+}
+
+/// Sets `view`'s shadow settings to the cheapest within `budget` (`analysis::budget::choose`).
+fn choose_budget(
+    renderer: &mut Renderer,
+    scene: &umbra::Scene,
+    view: &mut View,
+    size: (u32, u32),
+    budget: f64,
+) -> PyResult<()> {
+    let reference = umbra_lab::reference::ReferenceScene::new(scene);
+    let c =
+        umbra_lab::analysis::budget::choose(renderer, &reference, scene, view, size, budget, None)
+            .map_err(gpu_error)?;
+    if let Some(c) = c {
+        view.shadow = c.chosen.config.shadow;
+    }
+    Ok(())
+}
+
+/// The frames `outputs` need: the lit image, the AOV pass, the shadow view.
+fn render_outputs(
+    r: &mut Renderer,
+    view: &View,
+    (w, h): (u32, u32),
+    outputs: &[&'static str],
+) -> Result<Vec<Output>, umbra::GpuError> {
+    let wants = |n: &str| outputs.contains(&n);
+    let mut out = Vec::new();
+    if wants("color") {
+        let f = r.render(view, w, h)?;
+        let rgb: Vec<u8> = f.image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
+        out.push(Output {
+            name: "color",
+            data: Data::U8(rgb),
+            channels: 3,
+        });
+    }
+    if wants("depth") || wants("segmentation") || wants("normals") {
+        let a = r.render_aovs(view, w, h)?;
+        if wants("depth") {
+            out.push(Output {
+                name: "depth",
+                data: Data::F32(a.depth),
+                channels: 1,
+            });
+        }
+        if wants("segmentation") {
+            out.push(Output {
+                name: "segmentation",
+                data: Data::U32(a.instance),
+                channels: 1,
+            });
+        }
+        if wants("normals") {
+            out.push(Output {
+                name: "normals",
+                data: Data::F32(a.normal.into_iter().flatten().collect()),
+                channels: 3,
+            });
+        }
+    }
+    if wants("shadow") {
+        let mut v = view.clone();
+        v.mode = ViewMode::Shadow;
+        let f = r.render(&v, w, h)?;
+        out.push(Output {
+            name: "shadow",
+            data: Data::F32(f.image.pixels().map(|p| p[0] as f32 / 255.0).collect()),
+            channels: 1,
+        });
+    }
+    Ok(out)
+}
+
+/// The outputs asked for, checked, in `OUTPUTS` order.
+fn parse_outputs(outputs: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<&'static str>> {
+    let Some(o) = outputs else {
+        return Ok(vec!["color", "depth"]);
+    };
+    let names: Vec<String> = if let Ok(s) = o.extract::<String>() {
+        vec![s]
+    } else {
+        o.extract()?
+    };
+    for n in &names {
+        if !OUTPUTS.contains(&n.as_str()) {
+            return Err(PyValueError::new_err(format!(
+                "unknown output '{n}' (one of {})",
+                OUTPUTS.join(", ")
+            )));
+        }
+    }
+    Ok(OUTPUTS
+        .into_iter()
+        .filter(|o| names.iter().any(|n| n == o))
+        .collect())
+}
+
+/// A frame's outputs as arrays of (`frames` stacked) (h, w[, c]).
+fn to_arrays<'py>(
+    py: Python<'py>,
+    frames: Vec<Vec<Output>>,
+    (w, h): (u32, u32),
+    stacked: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let n = frames.len();
+    let mut per_output: Vec<Vec<Output>> = Vec::new();
+    for f in frames {
+        for (k, o) in f.into_iter().enumerate() {
+            if per_output.len() <= k {
+                per_output.push(Vec::new());
+            }
+            per_output[k].push(o);
+        }
+    }
+    for outs in per_output {
+        let (name, c) = (outs[0].name, outs[0].channels);
+        let frames = stacked.then_some(n);
+        let array = match outs[0].data {
+            Data::U8(_) => image_out(py, concat(outs, Data::u8), (w, h), c, frames),
+            Data::F32(_) => image_out(py, concat(outs, Data::f32), (w, h), c, frames),
+            Data::U32(_) => image_out(py, concat(outs, Data::u32), (w, h), c, frames),
+        };
+        d.set_item(name, array)?;
+    }
+    Ok(d)
+}
+
+/// The values of `outs`, one after another.
+fn concat<T>(outs: Vec<Output>, take: impl Fn(Data) -> Vec<T>) -> Vec<T> {
+    outs.into_iter().flat_map(|o| take(o.data)).collect()
+}
+
+#[pymethods]
+impl OffscreenRenderer {
+    /// A renderer of `width`×`height` images on `device` (a substring of its name; None: the
+    /// `UMBRA_DEVICE` variable, else a GPU before a CPU device), with `msaa` samples a pixel
+    /// (None: 4 on GPUs, 1 on CPU devices); `validation` turns the Khronos layer on.
+    #[new]
+    #[pyo3(signature = (width, height, device = None, msaa = None, validation = false))]
+    fn new(
+        width: u32,
+        height: u32,
+        device: Option<String>,
+        msaa: Option<u32>,
+        validation: bool,
+    ) -> PyResult<Self> {
+        let max = umbra::render::MAX_SIDE;
+        if !(1..=max).contains(&width) || !(1..=max).contains(&height) {
+            return Err(PyValueError::new_err(format!(
+                "image size {width}x{height} is outside 1x1..{max}x{max}"
+            )));
+        }
+        if let Some(m) = msaa.filter(|m| ![1, 2, 4, 8].contains(m)) {
+            return Err(PyValueError::new_err(format!(
+                "msaa {m} is not 1, 2, 4 or 8"
+            )));
+        }
+        let ctx = Context::new(&ContextDesc {
+            validation: if validation {
+                Validation::Required
+            } else {
+                Validation::Off
+            },
+            device,
+            ..Default::default()
+        })
+        .map_err(gpu_error)?;
+        Ok(Self {
+            width,
+            height,
+            options: SceneOptions {
+                msaa,
+                ..Default::default()
+            },
+            cached: None,
+            ctx: Some(ctx),
+        })
+    }
+
+    /// Renders `scene` through `camera` placed at `camera_pose` (4×4 world-from-camera; the
+    /// camera looks down its −Z). Without `outputs`: `(color, depth)`, uint8 (H, W, 3) sRGB and
+    /// float32 (H, W) distance along the view axis (0 where nothing is hit). With `outputs` (any
+    /// of color, depth, segmentation, normals, shadow): a dict of those arrays
+    /// (`segmentation` uint32 (H, W), instance + 1, 0 for the background; `normals` float32
+    /// (H, W, 3) world space; `shadow` float32 (H, W), the first shadowed light's visibility, or
+    /// `shadow_light`'s). Keyword settings as the command line's options: `shadows`,
+    /// `shadow_map`, `shadow_format`, `pcf`, `cascades`, `depth_fit`, `fit`, `bias_constant`,
+    /// `bias_slope`, `normal_offset`, `shadow_budget` (%), `shadow_light`, `light_size`,
+    /// `exposure`, `tonemap`, `ambient`, `background`, `sun_direction`, `sun_intensity`, `time`,
+    /// `animation`.
+    #[pyo3(signature = (scene, camera, camera_pose, outputs = None, **settings))]
+    fn render<'py>(
+        &mut self,
+        py: Python<'py>,
+        scene: &Bound<'py, PyScene>,
+        camera: &Bound<'py, PyAny>,
+        camera_pose: &Bound<'py, PyAny>,
+        outputs: Option<&Bound<'py, PyAny>>,
+        settings: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let names = parse_outputs(outputs)?;
+        let aspect = self.width as f32 / self.height as f32;
+        let mut view = View::new(engine_camera(
+            camera,
+            matrix4(camera_pose, "camera_pose")?,
+            aspect,
+        )?);
+        let extras = settings::apply(&mut view, settings)?;
+        let mut s = scene.borrow_mut();
+        Self::pose(&mut s, &extras)?;
+        let frame = self.frame(py, &s, &view, &extras, &names)?;
+        let d = to_arrays(py, vec![frame], (self.width, self.height), false)?;
+        if outputs.is_none() {
+            let t = PyTuple::new(py, [d.get_item("color")?, d.get_item("depth")?])?;
+            return Ok(t.into_any());
+        }
+        Ok(d.into_any())
+    }
+
+    /// Renders `scene` from each of `poses` (an (N, 4, 4) array of camera poses) without
+    /// uploading it again: a dict of the `outputs` (default color and depth), each stacked
+    /// (N, H, W[, C]). Settings as `render`.
+    #[pyo3(signature = (scene, camera, poses, outputs = None, **settings))]
+    fn render_batch<'py>(
+        &mut self,
+        py: Python<'py>,
+        scene: &Bound<'py, PyScene>,
+        camera: &Bound<'py, PyAny>,
+        poses: &Bound<'py, PyAny>,
+        outputs: Option<&Bound<'py, PyAny>>,
+        settings: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let names = parse_outputs(outputs)?;
+        let (m, shape) = values::<f32>(poses, "float32", "poses")?;
+        if shape.len() != 3 || shape[1..] != [4, 4] {
+            return Err(PyValueError::new_err(format!(
+                "poses: shape {shape:?}, expected (n, 4, 4)"
+            )));
+        }
+        let aspect = self.width as f32 / self.height as f32;
+        let mut base = View::new(umbra::scene::Camera::look_at(
+            glam::Vec3::Z,
+            glam::Vec3::ZERO,
+            1.0,
+            0.1,
+        ));
+        let extras = settings::apply(&mut base, settings)?;
+        let mut s = scene.borrow_mut();
+        Self::pose(&mut s, &extras)?;
+        let mut frames = Vec::with_capacity(shape[0]);
+        for rows in m.chunks_exact(16) {
+            let pose = glam::Mat4::from_cols_slice(rows).transpose();
+            if !pose.is_finite() {
+                return Err(PyValueError::new_err(
+                    "poses: a pose holds a NaN or an infinity",
+                ));
+            }
+            let mut view = base.clone();
+            view.camera = engine_camera(camera, pose, aspect)?;
+            frames.push(self.frame(py, &s, &view, &extras, &names)?);
+        }
+        to_arrays(py, frames, (self.width, self.height), true)
+    }
+
+    /// Frees the device's resources (the renderer cannot render afterwards).
+    fn close(&mut self) {
+        self.cached = None;
+        self.ctx = None;
+    }
+
+    fn __enter__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    fn __exit__(
+        &mut self,
+        _exc_type: Option<&Bound<'_, PyAny>>,
+        _exc: Option<&Bound<'_, PyAny>>,
+        _tb: Option<&Bound<'_, PyAny>>,
+    ) {
+        self.close();
+    }
+
+    /// Image width.
+    #[getter]
+    fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Image height.
+    #[getter]
+    fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The Vulkan device's name.
+    #[getter]
+    fn device(&self) -> PyResult<String> {
+        Ok(self.ctx()?.device_name.clone())
+    }
+
+    /// Samples a pixel of the colour image on this device (`msaa` resolved).
+    #[getter]
+    fn samples(&self) -> PyResult<u32> {
+        Ok(self.options.resolved_samples(&*self.ctx()?))
+    }
+
+    /// Validation messages of warning or error severity so far (with `validation=True`).
+    #[getter]
+    fn validation_problems(&self) -> PyResult<usize> {
+        Ok(self.ctx()?.validation_log.problem_count())
+    }
+
+    fn __repr__(&self) -> String {
+        let device = self
+            .ctx
+            .as_ref()
+            .map_or("closed".to_string(), |c| c.device_name.clone());
+        format!(
+            "OffscreenRenderer({}x{}, {device})",
+            self.width, self.height
+        )
+    }
+}

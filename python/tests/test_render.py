@@ -1,0 +1,265 @@
+"""umbra from Python on lavapipe, validation on: shapes and dtypes, depth and segmentation read
+what the geometry says, the Python render equals the command line's to the byte, poses move the
+image, batches equal single renders, bad input raises, and the GIL is released while rendering."""
+
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import umbra
+from conftest import quad, write_glb
+
+W, H = 160, 120
+
+
+def head_on(distance):
+    """A 45° camera on the +Z axis at `distance`, looking at the origin."""
+    return umbra.PerspectiveCamera(np.pi / 4, znear=0.1), umbra.look_at((0, 0, distance), (0, 0, 0))
+
+
+def test_shapes_and_dtypes(renderer):
+    scene = umbra.Scene()
+    p, i = quad(2.0)
+    scene.add_mesh(p, i, base_color=(0.8, 0.3, 0.2, 1.0))
+    scene.add_directional_light((0.3, -1.0, -0.5))
+    camera, pose = head_on(3.0)
+    color, depth = renderer.render(scene, camera, pose)
+    assert color.shape == (H, W, 3) and color.dtype == np.uint8
+    assert depth.shape == (H, W) and depth.dtype == np.float32
+    out = renderer.render(
+        scene, camera, pose, outputs=("color", "depth", "segmentation", "normals", "shadow")
+    )
+    want = {
+        "color": ((H, W, 3), np.uint8),
+        "depth": ((H, W), np.float32),
+        "segmentation": ((H, W), np.uint32),
+        "normals": ((H, W, 3), np.float32),
+        "shadow": ((H, W), np.float32),
+    }
+    assert {k: (v.shape, v.dtype) for k, v in out.items()} == want
+    # The colour of both calls is the same frame.
+    assert np.array_equal(out["color"], color)
+
+
+@pytest.mark.parametrize("orthographic", [False, True])
+def test_depth_of_a_plane_is_its_distance(renderer, orthographic):
+    scene = umbra.Scene()
+    p, i = quad(1.0)
+    scene.add_mesh(p, i)
+    camera, pose = head_on(3.0)
+    if orthographic:
+        camera = umbra.OrthographicCamera(2.0, 1.5, 0.1, 10.0)
+    depth = renderer.render(scene, camera, pose, outputs=("depth",))["depth"]
+    centre = depth[H // 2, W // 2]
+    assert abs(centre - 3.0) <= 3.0 * 1e-4, centre
+    # Measured: the quad's pixels all read 3.0000 (perspective: largest deviation 1.2e-7
+    # relative); the corners, off the quad, 0.
+    on = depth[depth > 0]
+    assert np.max(np.abs(on - 3.0)) <= 3.0 * 1e-4
+    assert depth[0, 0] == 0.0 and depth[-1, -1] == 0.0
+
+
+def test_segmentation_ids_of_two_instances(renderer):
+    scene = umbra.Scene()
+    p, i = quad(0.8)
+    left = scene.add_mesh(p, i, pose=np.array([[1, 0, 0, -0.6], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]]))
+    right = scene.add_mesh(p, i, pose=np.array([[1, 0, 0, 0.6], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]]))
+    assert (left, right) == (0, 1)
+    camera, pose = head_on(3.0)
+    seg = renderer.render(scene, camera, pose, outputs=("segmentation",))["segmentation"]
+    # 45° from 3 units, 120 rows: 48.3 pixels a unit; the quads' centres at x = 80 ∓ 29.
+    assert seg[60, 80 - 29] == left + 1
+    assert seg[60, 80 + 29] == right + 1
+    assert seg[60, 80] == 0 and seg[5, 5] == 0
+    assert set(np.unique(seg)) == {0, 1, 2}
+    # Exact: each quad covers a solid block of its own id (no blend at their edges).
+    assert np.count_nonzero(seg == 1) == np.count_nonzero(seg == 2)
+
+
+def test_python_render_equals_the_command_line_to_the_byte(renderer, tmp_path, umbra_bin):
+    p, i = quad(1.0)
+    b = np.array([[-0.3, 0, -0.3], [0.3, 0, -0.3], [0.3, 0.6, -0.3], [-0.3, 0.6, -0.3]], np.float32)
+    model = write_glb(
+        tmp_path / "model.glb",
+        [(p, i, (0.9, 0.5, 0.2, 1.0), (0, 0.5, 0)), (b, i, (0.2, 0.5, 0.9, 1.0), (0.2, 0, 0.4))],
+        lights=[((-0.3826834, 0.0, 0.0, 0.9238795), 2.0)],
+    )
+    png = tmp_path / "cli.png"
+    subprocess.run(
+        [umbra_bin, "render", model, "--size", f"{W}x{H}", "-o", str(png)],
+        check=True,
+        capture_output=True,
+        env={"UMBRA_DEVICE": "llvmpipe", "PATH": "/usr/bin:/bin"},
+    )
+    cli = np.asarray(Image.open(png).convert("RGB"))
+    scene = umbra.load(model)
+    camera, pose = scene.default_view(W, H)
+    color, _ = renderer.render(scene, camera, pose)
+    assert np.array_equal(color, cli), f"{np.count_nonzero(color != cli)} values differ"
+
+
+def test_a_pose_change_moves_the_image(renderer):
+    scene = umbra.Scene()
+    p, i = quad(0.6)
+    k = scene.add_mesh(p, i)
+    camera, pose = head_on(3.0)
+    a = renderer.render(scene, camera, pose, outputs=("color", "segmentation"))
+    moved = np.eye(4)
+    moved[0, 3] = 0.5
+    scene.set_pose(k, moved)
+    b = renderer.render(scene, camera, pose, outputs=("color", "segmentation"))
+    assert not np.array_equal(a["color"], b["color"])
+    # The quad's pixels moved right by 0.5 units: 24 pixels at 48.3 a unit.
+    xa = np.nonzero(a["segmentation"][60])[0]
+    xb = np.nonzero(b["segmentation"][60])[0]
+    assert abs((xb.mean() - xa.mean()) - 0.5 * 48.3) < 1.0, (xa.mean(), xb.mean())
+
+
+def test_time_poses_an_animated_file(renderer, tmp_path):
+    # A quad that slides from x = 0 at 0 s to x = 1 at 2 s (linear): at 0.5 s it is at 0.25,
+    # at 1.5 s at 0.75, and past the end it holds at 1.
+    p, i = quad(0.6)
+    model = write_glb(
+        tmp_path / "slide.glb",
+        [(p, i, (0.8, 0.8, 0.8, 1.0), (0, 0, 0))],
+        animation=("Slide", 0, [0.0, 2.0], [[0, 0, 0], [1, 0, 0]]),
+    )
+    scene = umbra.load(model)
+    assert scene.animations == ["Slide"]
+    camera, pose = head_on(3.0)
+
+    def centre_x(**settings):
+        seg = renderer.render(scene, camera, pose, outputs=("segmentation",), **settings)
+        return np.nonzero(seg["segmentation"][60])[0].mean()
+
+    rest = centre_x()
+    # 48.3 pixels a unit (45° from 3 units, 120 rows); measured offsets within 0.5 px.
+    for t, x in [(0.5, 0.25), (1.5, 0.75), (9.0, 1.0)]:
+        got = centre_x(time=t, animation="Slide") - rest
+        assert abs(got - x * 48.3) < 1.0, (t, got)
+    assert abs(centre_x(time=0.5, animation=0) - rest - 0.25 * 48.3) < 1.0
+    with pytest.raises(ValueError, match="animation"):
+        renderer.render(scene, camera, pose, time=0.5, animation="Walk")
+
+
+def test_a_batch_equals_single_renders(renderer):
+    scene = umbra.Scene()
+    p, i = quad(1.0)
+    scene.add_mesh(p, i, base_color=(0.2, 0.7, 0.3, 1.0))
+    scene.add_ground()
+    camera = umbra.PerspectiveCamera(np.pi / 4, znear=0.1)
+    poses = np.stack([umbra.look_at((x, 1.0, 3.0), (0, 0, 0)) for x in (-1.0, 0.0, 1.0)])
+    batch = renderer.render_batch(scene, camera, poses, outputs=("color", "depth"))
+    assert batch["color"].shape == (3, H, W, 3) and batch["depth"].shape == (3, H, W)
+    for k in range(3):
+        one = renderer.render(scene, camera, poses[k], outputs=("color", "depth"))
+        assert np.array_equal(batch["color"][k], one["color"])
+        assert np.array_equal(batch["depth"][k], one["depth"])
+
+
+def test_bad_input_raises(tmp_path):
+    with pytest.raises(umbra.LoadError, match="cannot read"):
+        umbra.load(tmp_path / "missing.glb")
+    broken = tmp_path / "broken.glb"
+    broken.write_bytes(b"glTF not really")
+    with pytest.raises(umbra.LoadError):
+        umbra.load(broken)
+    s = umbra.Scene()
+    with pytest.raises(ValueError, match="index 7 is past the 4 positions"):
+        s.add_mesh(quad(1.0)[0], [[0, 1, 7]])
+    with pytest.raises(ValueError, match="expected \\(n, 3\\)"):
+        s.add_mesh(np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="expected \\(4, 4\\)"):
+        s.add_mesh(*quad(1.0), pose=np.eye(3))
+    with pytest.raises(ValueError, match="yfov"):
+        umbra.PerspectiveCamera(0.0)
+    r = umbra.OffscreenRenderer(16, 16)
+    s.add_mesh(*quad(1.0))
+    cam, pose = head_on(2.0)
+    with pytest.raises(TypeError, match="unknown setting 'shadowmap'"):
+        r.render(s, cam, pose, shadowmap=512)
+    with pytest.raises(ValueError, match="unknown output"):
+        r.render(s, cam, pose, outputs=("colour",))
+    with pytest.raises(ValueError, match="aspect"):
+        r.render(s, umbra.PerspectiveCamera(1.0, aspect=2.0), pose)
+    r.close()
+    with pytest.raises(umbra.UmbraError, match="closed"):
+        r.render(s, cam, pose)
+    with pytest.raises(ValueError):
+        umbra.OffscreenRenderer(0, 10)
+
+
+def test_settings_act_like_the_command_line_options(renderer):
+    scene = umbra.Scene()
+    scene.add_mesh(*quad(0.5, 0.3))
+    scene.add_ground()
+    scene.add_directional_light((0.4, -1.0, -0.3))
+    camera, pose = umbra.PerspectiveCamera(np.pi / 4, 0.1), umbra.look_at((0, 2, 3), (0, 0, 0))
+    base = renderer.render(scene, camera, pose, outputs=("color", "shadow"))
+    none = renderer.render(scene, camera, pose, outputs=("shadow",), shadows=False)["shadow"]
+    assert base["shadow"].min() == 0.0 and none.min() > 0.0  # facing-only without the map
+    dark = renderer.render(scene, camera, pose, exposure="x0.1")[0]
+    assert dark.mean() < base["color"].mean() * 0.5
+    white = renderer.render(scene, camera, pose, background="#ffffff")[0]
+    assert tuple(white[0, 0]) == (255, 255, 255)
+
+
+def test_the_gil_is_released_while_rendering():
+    scene = umbra.load(umbra_fixture_model())
+    camera, pose = scene.default_view(320, 240)
+    r = umbra.OffscreenRenderer(320, 240)
+    r.render(scene, camera, pose)  # compile the pipelines first
+    ticks, done = [0], threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks[0] += 1
+            time.sleep(0.0005)
+
+    t = threading.Thread(target=count)
+    t.start()
+    start = time.perf_counter()
+    for _ in range(5):
+        r.render(scene, camera, pose)
+    spent = time.perf_counter() - start
+    done.set()
+    t.join()
+    r.close()
+    # Another Python thread ran throughout (a held GIL would leave it at a handful of ticks).
+    assert ticks[0] > spent * 200, (ticks[0], spent)
+
+
+def umbra_fixture_model():
+    """A small model for timing: the demo-like boxes written once."""
+    import tempfile
+
+    path = f"{tempfile.gettempdir()}/umbra-gil-model.glb"
+    p, i = quad(1.0)
+    write_glb(path, [(p, i, (0.7, 0.7, 0.7, 1.0), (0, 0, 0))])
+    return path
+
+
+def test_trimesh_meshes_and_scenes():
+    import trimesh
+    box = trimesh.creation.box((1.0, 1.0, 1.0))
+    box.visual.vertex_colors = [200, 30, 30, 255]
+    s = umbra.Scene.from_trimesh(box)
+    assert s.instances == 1 and s.triangles == 12
+    ts = trimesh.Scene()
+    ts.add_geometry(box, transform=trimesh.transformations.translation_matrix((2, 0, 0)))
+    ts.add_geometry(trimesh.creation.icosphere())
+    s2 = umbra.Scene.from_trimesh(ts)
+    assert s2.instances == 2
+    lo, hi = s2.bounds
+    assert hi[0] == pytest.approx(2.5) and lo[0] == pytest.approx(-1.0, abs=1e-3)
+    r = umbra.OffscreenRenderer(64, 48)
+    camera, pose = s.default_view(64, 48)
+    color, _ = r.render(s, camera, pose)
+    # The red box fills the middle of the frame.
+    mid = color[24, 32].astype(int)
+    assert mid[0] > mid[1] + 40, mid
+    r.close()
