@@ -37,32 +37,11 @@ pub struct OffscreenRenderer {
     ctx: Option<Arc<Context>>,
 }
 
-/// One frame's outputs: name → (values, channels), in `OUTPUTS` order.
+/// An output's values.
 enum Data {
     U8(Vec<u8>),
     F32(Vec<f32>),
     U32(Vec<u32>),
-}
-
-impl Data {
-    fn u8(self) -> Vec<u8> {
-        match self {
-            Data::U8(v) => v,
-            _ => unreachable!("an output keeps its type across frames"),
-        }
-    }
-    fn f32(self) -> Vec<f32> {
-        match self {
-            Data::F32(v) => v,
-            _ => unreachable!("an output keeps its type across frames"),
-        }
-    }
-    fn u32(self) -> Vec<u32> {
-        match self {
-            Data::U32(v) => v,
-            _ => unreachable!("an output keeps its type across frames"),
-        }
-    }
 }
 
 struct Output {
@@ -172,16 +151,34 @@ fn render_outputs(
 ) -> Result<Vec<Output>, umbra::GpuError> {
     let wants = |n: &str| outputs.contains(&n);
     let mut out = Vec::new();
+    // At one sample a pixel, the lit frame's own depth buffer is the AOV pass's (the same
+    // rasterisation of the same depth-writing draws): read it instead of drawing the scene again.
+    let depth_from_frame = wants("color")
+        && wants("depth")
+        && !wants("segmentation")
+        && !wants("normals")
+        && r.samples() == 1;
     if wants("color") {
-        let f = r.render(view, w, h)?;
+        r.set_read_depth(depth_from_frame);
+        let f = r.render(view, w, h);
+        r.set_read_depth(false);
+        let f = f?;
         let rgb: Vec<u8> = f.image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
         out.push(Output {
             name: "color",
             data: Data::U8(rgb),
             channels: 3,
         });
+        if let Some(d) = f.depth.filter(|_| depth_from_frame) {
+            let proj = umbra::plan::camera_projection(&view.camera, w as f32 / h as f32);
+            out.push(Output {
+                name: "depth",
+                data: Data::F32(umbra::render::view_axis_depths(&d, &proj)),
+                channels: 1,
+            });
+        }
     }
-    if wants("depth") || wants("segmentation") || wants("normals") {
+    if !depth_from_frame && (wants("depth") || wants("segmentation") || wants("normals")) {
         let a = r.render_aovs(view, w, h)?;
         if wants("depth") {
             out.push(Output {
@@ -242,40 +239,67 @@ fn parse_outputs(outputs: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<&'static st
         .collect())
 }
 
-/// A frame's outputs as arrays of (`frames` stacked) (h, w[, c]).
-fn to_arrays<'py>(
-    py: Python<'py>,
-    frames: Vec<Vec<Output>>,
-    (w, h): (u32, u32),
-    stacked: bool,
-) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    let n = frames.len();
-    let mut per_output: Vec<Vec<Output>> = Vec::new();
-    for f in frames {
-        for (k, o) in f.into_iter().enumerate() {
-            if per_output.len() <= k {
-                per_output.push(Vec::new());
-            }
-            per_output[k].push(o);
-        }
-    }
-    for outs in per_output {
-        let (name, c) = (outs[0].name, outs[0].channels);
-        let frames = stacked.then_some(n);
-        let array = match outs[0].data {
-            Data::U8(_) => image_out(py, concat(outs, Data::u8), (w, h), c, frames),
-            Data::F32(_) => image_out(py, concat(outs, Data::f32), (w, h), c, frames),
-            Data::U32(_) => image_out(py, concat(outs, Data::u32), (w, h), c, frames),
-        };
-        d.set_item(name, array)?;
-    }
-    Ok(d)
+/// Outputs of one or more frames, each output's values one frame after another.
+struct Stack {
+    frames: usize,
+    /// Frames expected (room is made for them at the first).
+    expected: usize,
+    outputs: Vec<Output>,
 }
 
-/// The values of `outs`, one after another.
-fn concat<T>(outs: Vec<Output>, take: impl Fn(Data) -> Vec<T>) -> Vec<T> {
-    outs.into_iter().flat_map(|o| take(o.data)).collect()
+impl Stack {
+    fn new(expected: usize) -> Self {
+        Self {
+            frames: 0,
+            expected,
+            outputs: Vec::new(),
+        }
+    }
+
+    /// Appends one frame's outputs (in the order of the first frame's).
+    fn push(&mut self, frame: Vec<Output>) {
+        if self.frames == 0 {
+            self.outputs = frame;
+            let more = self.expected.saturating_sub(1);
+            for o in &mut self.outputs {
+                match &mut o.data {
+                    Data::U8(v) => v.reserve_exact(v.len() * more),
+                    Data::F32(v) => v.reserve_exact(v.len() * more),
+                    Data::U32(v) => v.reserve_exact(v.len() * more),
+                }
+            }
+        } else {
+            for (acc, o) in self.outputs.iter_mut().zip(frame) {
+                match (&mut acc.data, o.data) {
+                    (Data::U8(a), Data::U8(b)) => a.extend(b),
+                    (Data::F32(a), Data::F32(b)) => a.extend(b),
+                    (Data::U32(a), Data::U32(b)) => a.extend(b),
+                    _ => unreachable!("an output keeps its type across frames"),
+                }
+            }
+        }
+        self.frames += 1;
+    }
+
+    /// The outputs as arrays (h, w[, c]), or with `stacked` (frames, h, w[, c]).
+    fn into_arrays<'py>(
+        self,
+        py: Python<'py>,
+        (w, h): (u32, u32),
+        stacked: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let frames = stacked.then_some(self.frames);
+        for o in self.outputs {
+            let array = match o.data {
+                Data::U8(v) => image_out(py, v, (w, h), o.channels, frames),
+                Data::F32(v) => image_out(py, v, (w, h), o.channels, frames),
+                Data::U32(v) => image_out(py, v, (w, h), o.channels, frames),
+            };
+            d.set_item(o.name, array)?;
+        }
+        Ok(d)
+    }
 }
 
 #[pymethods]
@@ -356,8 +380,9 @@ impl OffscreenRenderer {
         let extras = settings::apply(&mut view, settings)?;
         let mut s = scene.borrow_mut();
         Self::pose(&mut s, &extras)?;
-        let frame = self.frame(py, &s, &view, &extras, &names)?;
-        let d = to_arrays(py, vec![frame], (self.width, self.height), false)?;
+        let mut stack = Stack::new(1);
+        stack.push(self.frame(py, &s, &view, &extras, &names)?);
+        let d = stack.into_arrays(py, (self.width, self.height), false)?;
         if outputs.is_none() {
             let t = PyTuple::new(py, [d.get_item("color")?, d.get_item("depth")?])?;
             return Ok(t.into_any());
@@ -380,9 +405,9 @@ impl OffscreenRenderer {
     ) -> PyResult<Bound<'py, PyDict>> {
         let names = parse_outputs(outputs)?;
         let (m, shape) = values::<f32>(poses, "float32", "poses")?;
-        if shape.len() != 3 || shape[1..] != [4, 4] {
+        if shape.len() != 3 || shape[1..] != [4, 4] || shape[0] == 0 {
             return Err(PyValueError::new_err(format!(
-                "poses: shape {shape:?}, expected (n, 4, 4)"
+                "poses: shape {shape:?}, expected (n, 4, 4) with n ≥ 1"
             )));
         }
         let aspect = self.width as f32 / self.height as f32;
@@ -395,7 +420,7 @@ impl OffscreenRenderer {
         let extras = settings::apply(&mut base, settings)?;
         let mut s = scene.borrow_mut();
         Self::pose(&mut s, &extras)?;
-        let mut frames = Vec::with_capacity(shape[0]);
+        let mut stack = Stack::new(shape[0]);
         for rows in m.chunks_exact(16) {
             let pose = glam::Mat4::from_cols_slice(rows).transpose();
             if !pose.is_finite() {
@@ -405,9 +430,9 @@ impl OffscreenRenderer {
             }
             let mut view = base.clone();
             view.camera = engine_camera(camera, pose, aspect)?;
-            frames.push(self.frame(py, &s, &view, &extras, &names)?);
+            stack.push(self.frame(py, &s, &view, &extras, &names)?);
         }
-        to_arrays(py, frames, (self.width, self.height), true)
+        stack.into_arrays(py, (self.width, self.height), true)
     }
 
     /// Frees the device's resources (the renderer cannot render afterwards).

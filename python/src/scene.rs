@@ -6,8 +6,8 @@ use glam::{Mat4, Vec3, Vec4};
 use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
-use umbra::scene::shapes::{add_object, primitive_from_arrays, MeshArrays};
-use umbra::scene::{Light, LightKind, Material, Scene};
+use umbra::scene::shapes::{add_object, add_texture, primitive_from_arrays, MeshArrays};
+use umbra::scene::{AlphaMode, Light, LightKind, Material, Scene, Texture, TextureRef};
 
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
@@ -117,6 +117,9 @@ impl PyScene {
                 0.6,
                 true,
                 false,
+                &get("alpha_mode")?.extract::<String>()?,
+                0.5,
+                Some(&get("texture")?),
             )?;
         }
         Ok(s)
@@ -126,10 +129,13 @@ impl PyScene {
     /// `segmentation` reports, plus 1). `positions` float32 (N, 3); `indices` uint32 (M, 3) or
     /// None (every three positions a triangle); `normals` (N, 3) (smooth normals are computed
     /// without); `uvs` (N, 2); `colors` (N, 3) or (N, 4) linear values within 0..1 (uint8: /255)
-    /// multiplying `base_color` (linear RGBA); `pose` 4×4 world-from-model.
+    /// multiplying `base_color` (linear RGBA); `texture` uint8 (H, W, 3|4) sRGB base-colour
+    /// image read at `uvs`; `pose` 4×4 world-from-model. `alpha_mode` as glTF's: "OPAQUE" (alpha
+    /// ignored), "MASK" (cut out below `alpha_cutoff`) or "BLEND".
     #[pyo3(signature = (positions, indices = None, normals = None, uvs = None, colors = None,
         base_color = vec![1.0, 1.0, 1.0, 1.0], pose = None, name = None, metallic = 0.0,
-        roughness = 0.6, double_sided = false, unlit = false))]
+        roughness = 0.6, double_sided = false, unlit = false, alpha_mode = "OPAQUE",
+        alpha_cutoff = 0.5, texture = None))]
     #[allow(clippy::too_many_arguments)] // Python keyword arguments
     fn add_mesh(
         &mut self,
@@ -145,7 +151,21 @@ impl PyScene {
         roughness: f32,
         double_sided: bool,
         unlit: bool,
+        alpha_mode: &str,
+        alpha_cutoff: f32,
+        texture: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<usize> {
+        let alpha_mode = match alpha_mode.to_ascii_uppercase().as_str() {
+            "OPAQUE" => AlphaMode::Opaque,
+            "MASK" if alpha_cutoff.is_finite() => AlphaMode::Mask(alpha_cutoff),
+            "BLEND" => AlphaMode::Blend,
+            "MASK" => return Err(PyValueError::new_err("alpha_cutoff must be finite")),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "alpha_mode '{other}' is not OPAQUE, MASK or BLEND"
+                )))
+            }
+        };
         let positions = rows::<3>(positions, "positions")?;
         let indices = match indices {
             Some(i) => Some(values::<u32>(i, "uint32", "indices")?.0),
@@ -154,6 +174,15 @@ impl PyScene {
         let normals = normals.map(|n| rows::<3>(n, "normals")).transpose()?;
         let uvs = uvs.map(|u| rows::<2>(u, "uvs")).transpose()?;
         let colors = colors.map(read_colors).transpose()?;
+        let texture = match texture {
+            Some(t) if !t.is_none() => {
+                if uvs.is_none() {
+                    return Err(PyValueError::new_err("texture: needs uvs"));
+                }
+                Some(read_texture(t, name.as_deref().unwrap_or("texture"))?)
+            }
+            _ => None,
+        };
         let prim = primitive_from_arrays(&MeshArrays {
             positions: &positions,
             indices: indices.as_deref(),
@@ -166,13 +195,16 @@ impl PyScene {
             Some(p) if !p.is_none() => matrix4(p, "pose")?,
             _ => Mat4::IDENTITY,
         };
+        let base_color_texture = texture.map(|t| TextureRef::new(add_texture(&mut self.scene, t)));
         let material = Material {
             name: name.clone().unwrap_or_else(|| "mesh".into()),
+            base_color_texture,
             base_color: rgba(&base_color)?,
             metallic: metallic.clamp(0.0, 1.0),
             roughness: roughness.clamp(0.0, 1.0),
             double_sided,
             unlit,
+            alpha_mode,
             ..Default::default()
         };
         let n = self.scene.instances.len();
@@ -379,6 +411,29 @@ impl PyScene {
 }
 
 /// Vertex colours: (N, 3) or (N, 4), floats within 0..1 or uint8 (/255).
+/// An sRGB uint8 (H, W, 3|4) image as a texture.
+fn read_texture(t: &Bound<'_, PyAny>, name: &str) -> PyResult<Texture> {
+    let (v, shape) = values::<u8>(t, "uint8", "texture")?;
+    let (h, w, k) = match shape.as_slice() {
+        [h, w, k @ (3 | 4)] if *h > 0 && *w > 0 => (*h, *w, *k),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "texture: shape {shape:?}, expected (h, w, 3) or (h, w, 4)"
+            )))
+        }
+    };
+    let rgba = v
+        .chunks_exact(k)
+        .flat_map(|c| [c[0], c[1], c[2], if k == 4 { c[3] } else { 255 }])
+        .collect();
+    Ok(Texture {
+        name: name.to_string(),
+        width: w as u32,
+        height: h as u32,
+        rgba,
+    })
+}
+
 fn read_colors(c: &Bound<'_, PyAny>) -> PyResult<Vec<[f32; 4]>> {
     let dtype: String = c
         .getattr("dtype")

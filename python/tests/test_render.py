@@ -45,6 +45,30 @@ def test_shapes_and_dtypes(renderer):
     assert np.array_equal(out["color"], color)
 
 
+def test_the_frame_depth_equals_the_aov_depth():
+    # At one sample a pixel render() reads the lit frame's own depth buffer; it must equal the
+    # AOV pass's bit for bit, sky, blended (no depth) and masked surfaces included.
+    scene = umbra.Scene()
+    p, i = quad(1.0)
+    scene.add_mesh(p, i, base_color=(0.8, 0.8, 0.8, 1.0))
+    scene.add_mesh(*quad(0.6, 0.4), base_color=(0.2, 0.4, 0.9, 0.5), alpha_mode="BLEND",
+                   pose=np.array([[1, 0, 0, 0.5], [0, 1, 0, 0.3], [0, 0, 1, 0], [0, 0, 0, 1.0]]))
+    uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32)
+    colors = np.array([[1, 1, 1, 0.0], [1, 1, 1, 1.0], [1, 1, 1, 1.0], [1, 1, 1, 0.0]], np.float32)
+    scene.add_mesh(*quad(0.6, 0.2), uvs=uv, colors=colors, alpha_mode="MASK", alpha_cutoff=0.5,
+                   pose=np.array([[1, 0, 0, -0.5], [0, 1, 0, -0.3], [0, 0, 1, 0], [0, 0, 0, 1.0]]))
+    scene.add_ground()
+    scene.add_directional_light((0.3, -1.0, -0.5))
+    r = umbra.OffscreenRenderer(W, H, msaa=1, validation=True)
+    camera, pose = umbra.PerspectiveCamera(np.pi / 4, 0.1), umbra.look_at((0.5, 1.5, 3), (0, 0, 0))
+    _, depth = r.render(scene, camera, pose)
+    aov = r.render(scene, camera, pose, outputs=("depth",))["depth"]
+    assert np.array_equal(depth, aov), np.count_nonzero(depth != aov)
+    assert np.count_nonzero(depth == 0) > 0 and np.count_nonzero(depth > 0) > W * H // 4
+    assert r.validation_problems == 0
+    r.close()
+
+
 @pytest.mark.parametrize("orthographic", [False, True])
 def test_depth_of_a_plane_is_its_distance(renderer, orthographic):
     scene = umbra.Scene()
@@ -184,6 +208,12 @@ def test_bad_input_raises(tmp_path):
         r.render(s, cam, pose, shadowmap=512)
     with pytest.raises(ValueError, match="unknown output"):
         r.render(s, cam, pose, outputs=("colour",))
+    with pytest.raises(ValueError, match="expected \\(n, 4, 4\\)"):
+        r.render_batch(s, cam, np.zeros((0, 4, 4)))
+    with pytest.raises(ValueError, match="alpha_mode 'GLASS'"):
+        s.add_mesh(*quad(1.0), alpha_mode="glass")
+    with pytest.raises(ValueError, match="texture: needs uvs"):
+        s.add_mesh(*quad(1.0), texture=np.zeros((2, 2, 3), np.uint8))
     with pytest.raises(ValueError, match="aspect"):
         r.render(s, umbra.PerspectiveCamera(1.0, aspect=2.0), pose)
     r.close()
@@ -263,3 +293,32 @@ def test_trimesh_meshes_and_scenes():
     mid = color[24, 32].astype(int)
     assert mid[0] > mid[1] + 40, mid
     r.close()
+
+
+def test_trimesh_textures_keep_their_orientation():
+    import trimesh
+    from PIL import Image as PILImage
+
+    # A 2x2 image: red top-left, green top-right, blue bottom-left, white bottom-right, on a
+    # quad whose UVs follow trimesh's convention (v = 0 at the image's bottom).
+    img = PILImage.fromarray(
+        np.array([[[255, 0, 0], [0, 255, 0]], [[0, 0, 255], [255, 255, 255]]], np.uint8)
+    )
+    p, i = quad(2.0)
+    uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float64)
+    mesh = trimesh.Trimesh(p, i, process=False)
+    mesh.visual = trimesh.visual.TextureVisuals(uv=uv, image=img)
+    scene = umbra.Scene.from_trimesh(mesh)
+    r = umbra.OffscreenRenderer(W, H, validation=True)
+    camera, pose = head_on(3.0)
+    color = r.render(scene, camera, pose, background="#000000", ambient=1.0)[0].astype(int)
+    # The quad spans 48.3 px a unit around (80, 60): sample each quarter's middle.
+    tl, tr = color[60 - 24, 80 - 24], color[60 - 24, 80 + 24]
+    bl, br = color[60 + 24, 80 - 24], color[60 + 24, 80 + 24]
+    assert tl[0] > 2 * max(tl[1], tl[2]), tl
+    assert tr[1] > 2 * max(tr[0], tr[2]), tr
+    assert bl[2] > 2 * max(bl[0], bl[1]), bl
+    assert min(br) > 100, br
+    assert r.validation_problems == 0
+    r.close()
+

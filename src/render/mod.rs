@@ -20,7 +20,7 @@ pub use crate::plan::{
     Pcf, SceneOptions, ScenePlanner, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings,
     ShadowView, Tonemap, View, ViewMode, MAX_CASCADES, MAX_LIGHTS, MAX_SHADOW_VIEWS, UNIT_AMBIENT,
 };
-pub use renderer::{Aovs, FrameStats, RenderedFrame, Renderer, MAX_SIDE};
+pub use renderer::{view_axis_depths, Aovs, FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 #[cfg(feature = "viewer")]
 pub use window::{
     surface_extensions, Capture, DrawResult, FrameSummary, Overlay, WindowRenderer,

@@ -393,7 +393,9 @@ impl Renderer {
                 .depth_readback
                 .mapped()
                 .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
-            Some(bytemuck::cast_slice::<u8, f32>(&bytes[..(width * height * 4) as usize]).to_vec())
+            Some(bytemuck::pod_collect_to_vec(
+                &bytes[..(width * height * 4) as usize],
+            ))
         } else {
             None
         };
@@ -438,6 +440,23 @@ pub fn visible_depths(depth: &[f32], proj: &Mat4) -> Option<(f32, f32)> {
     };
     // Reversed-z: the largest value is the nearest.
     Some((view_depth(hi), view_depth(lo)))
+}
+
+/// Each pixel's distance along the view axis (scene units) from a reversed-z depth buffer drawn
+/// with the camera projection `proj`; 0 where nothing was drawn (a depth of 0).
+pub fn view_axis_depths(depth: &[f32], proj: &Mat4) -> Vec<f32> {
+    let inv = proj.inverse();
+    depth
+        .iter()
+        .map(|&z| {
+            if z > 0.0 {
+                let p = inv * glam::Vec4::new(0.0, 0.0, z, 1.0);
+                -p.z / p.w
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 impl Drop for Renderer {

@@ -9,7 +9,7 @@ def _mesh_arrays(mesh, pose, name):
     normals = None
     if hasattr(mesh, "vertex_normals") and len(mesh.vertex_normals) == len(positions):
         normals = np.asarray(mesh.vertex_normals, dtype=np.float32)
-    colors, uvs, base = None, None, [1.0, 1.0, 1.0, 1.0]
+    colors, uvs, texture, base = None, None, None, [1.0, 1.0, 1.0, 1.0]
     visual = getattr(mesh, "visual", None)
     kind = getattr(visual, "kind", None)
     if kind == "vertex":
@@ -23,6 +23,16 @@ def _mesh_arrays(mesh, pose, name):
         uv = getattr(visual, "uv", None)
         if uv is not None and len(uv) == len(positions):
             uvs = np.asarray(uv, dtype=np.float32)
+            # trimesh's UVs put v = 0 at the image's bottom (OpenGL); glTF's at its top.
+            uvs[:, 1] = 1.0 - uvs[:, 1]
+        material = getattr(visual, "material", None)
+        image = getattr(material, "baseColorTexture", None) or getattr(material, "image", None)
+        if image is not None and uvs is not None:
+            texture = np.asarray(image.convert("RGBA"), dtype=np.uint8)
+        factor = getattr(material, "baseColorFactor", None)
+        if factor is not None:
+            base = list(np.asarray(factor, dtype=np.float64) / 255.0)
+    translucent = base[3] < 1.0 or (colors is not None and colors.shape[1] == 4 and colors[:, 3].min() < 255)
     return {
         "positions": positions,
         "indices": indices,
@@ -30,6 +40,8 @@ def _mesh_arrays(mesh, pose, name):
         "uvs": uvs,
         "colors": colors,
         "base_color": [float(x) for x in base],
+        "texture": texture,
+        "alpha_mode": "BLEND" if translucent else "OPAQUE",
         "pose": np.asarray(pose, dtype=np.float64),
         "name": name,
     }

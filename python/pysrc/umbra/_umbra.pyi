@@ -86,12 +86,14 @@ class Scene:
         roughness: float = 0.6,
         double_sided: bool = False,
         unlit: bool = False,
+        alpha_mode: Literal["OPAQUE", "MASK", "BLEND"] = "OPAQUE",
+        alpha_cutoff: float = 0.5,
     ) -> int:
         """Adds a triangle mesh and one instance of it; returns the instance index
         (segmentation reports it plus 1). positions (N, 3); indices (M, 3) or None (every three
         positions a triangle); normals (N, 3) (computed when absent); uvs (N, 2); colors
         (N, 3|4) linear 0..1 (uint8: /255); base_color linear RGB(A); pose 4x4
-        world-from-model."""
+        world-from-model; alpha_mode as glTF's (MASK cuts out below alpha_cutoff)."""
     def add_directional_light(
         self,
         direction: Sequence[float],

@@ -128,38 +128,24 @@ impl Renderer {
         unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
         ctx.submit_and_wait_with(cmd, self.fence)?;
         let n = (width * height) as usize;
-        let read = |b: &mut Buffer, bytes: usize| -> Result<Vec<u8>, GpuError> {
+        fn read<T: bytemuck::Pod>(b: &mut Buffer, n: usize) -> Result<Vec<T>, GpuError> {
             let m = b
                 .mapped()
                 .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
-            Ok(m[..bytes].to_vec())
-        };
-        let ids = read(&mut t.ids.2, n * 4)?;
-        let normals = read(&mut t.normals.2, n * 16)?;
-        let depth = read(&mut t.depth.2, n * 4)?;
+            Ok(bytemuck::pod_collect_to_vec(&m[..n * size_of::<T>()]))
+        }
+        let ids: Vec<u32> = read(&mut t.ids.2, n)?;
+        let normals: Vec<[f32; 4]> = read(&mut t.normals.2, n)?;
+        let depth: Vec<f32> = read(&mut t.depth.2, n)?;
         let plan = prepared.plan;
         let aspect = width as f32 / height.max(1) as f32;
-        let inv = crate::plan::camera_projection(&view.camera, aspect).inverse();
-        let along = |z: f32| {
-            if z > 0.0 {
-                let p = inv * glam::Vec4::new(0.0, 0.0, z, 1.0);
-                -p.z / p.w
-            } else {
-                0.0
-            }
-        };
+        let proj = crate::plan::camera_projection(&view.camera, aspect);
         Ok(Aovs {
             width,
             height,
-            depth: bytemuck::cast_slice::<u8, f32>(&depth)
-                .iter()
-                .map(|&z| along(z))
-                .collect(),
-            instance: bytemuck::cast_slice::<u8, u32>(&ids).to_vec(),
-            normal: bytemuck::cast_slice::<u8, [f32; 4]>(&normals)
-                .iter()
-                .map(|n| [n[0], n[1], n[2]])
-                .collect(),
+            depth: super::view_axis_depths(&depth, &proj),
+            instance: ids,
+            normal: normals.iter().map(|n| [n[0], n[1], n[2]]).collect(),
             plan,
         })
     }
