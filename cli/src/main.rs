@@ -43,11 +43,7 @@ fn offscreen_context(
     device: Option<String>,
 ) -> anyhow::Result<std::sync::Arc<Context>> {
     Ok(Context::new(&ContextDesc {
-        validation: if validation {
-            Validation::Required
-        } else {
-            Validation::Off
-        },
+        validation: Validation::required_if(validation),
         device,
         pipeline_cache: app::pipeline_cache_path(),
         ..Default::default()

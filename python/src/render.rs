@@ -103,6 +103,33 @@ impl OffscreenRenderer {
         Ok(())
     }
 
+    /// Renders `scene` through `camera` from each of `poses` with `settings`, the `outputs`
+    /// stacked (`stacked`: with a leading frame axis).
+    #[allow(clippy::too_many_arguments)] // the Python call's arguments, passed on
+    fn render_poses<'py>(
+        &mut self,
+        py: Python<'py>,
+        scene: &Bound<'py, PyScene>,
+        camera: &Bound<'py, PyAny>,
+        poses: &[glam::Mat4],
+        outputs: &[&'static str],
+        settings: Option<&Bound<'py, PyDict>>,
+        stacked: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let aspect = self.width as f32 / self.height as f32;
+        let mut base = View::new(engine_camera(camera, poses[0], aspect)?);
+        let extras = settings::apply(&mut base, settings)?;
+        let mut s = scene.borrow_mut();
+        Self::pose(&mut s, &extras)?;
+        let mut stack = Stack::new(poses.len());
+        for &pose in poses {
+            let mut view = base.clone();
+            view.camera = engine_camera(camera, pose, aspect)?;
+            stack.push(self.frame(py, &s, &view, &extras, outputs)?);
+        }
+        stack.into_arrays(py, (self.width, self.height), stacked)
+    }
+
     /// Renders `view` of `scene` into the `outputs` asked for.
     fn frame(
         &mut self,
@@ -328,11 +355,7 @@ impl OffscreenRenderer {
             )));
         }
         let ctx = Context::new(&ContextDesc {
-            validation: if validation {
-                Validation::Required
-            } else {
-                Validation::Off
-            },
+            validation: Validation::required_if(validation),
             device,
             ..Default::default()
         })
@@ -371,18 +394,8 @@ impl OffscreenRenderer {
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let names = parse_outputs(outputs)?;
-        let aspect = self.width as f32 / self.height as f32;
-        let mut view = View::new(engine_camera(
-            camera,
-            matrix4(camera_pose, "camera_pose")?,
-            aspect,
-        )?);
-        let extras = settings::apply(&mut view, settings)?;
-        let mut s = scene.borrow_mut();
-        Self::pose(&mut s, &extras)?;
-        let mut stack = Stack::new(1);
-        stack.push(self.frame(py, &s, &view, &extras, &names)?);
-        let d = stack.into_arrays(py, (self.width, self.height), false)?;
+        let pose = matrix4(camera_pose, "camera_pose")?;
+        let d = self.render_poses(py, scene, camera, &[pose], &names, settings, false)?;
         if outputs.is_none() {
             let t = PyTuple::new(py, [d.get_item("color")?, d.get_item("depth")?])?;
             return Ok(t.into_any());
@@ -410,17 +423,7 @@ impl OffscreenRenderer {
                 "poses: shape {shape:?}, expected (n, 4, 4) with n ≥ 1"
             )));
         }
-        let aspect = self.width as f32 / self.height as f32;
-        let mut base = View::new(umbra::scene::Camera::look_at(
-            glam::Vec3::Z,
-            glam::Vec3::ZERO,
-            1.0,
-            0.1,
-        ));
-        let extras = settings::apply(&mut base, settings)?;
-        let mut s = scene.borrow_mut();
-        Self::pose(&mut s, &extras)?;
-        let mut stack = Stack::new(shape[0]);
+        let mut list = Vec::with_capacity(shape[0]);
         for rows in m.chunks_exact(16) {
             let pose = glam::Mat4::from_cols_slice(rows).transpose();
             if !pose.is_finite() {
@@ -428,11 +431,9 @@ impl OffscreenRenderer {
                     "poses: a pose holds a NaN or an infinity",
                 ));
             }
-            let mut view = base.clone();
-            view.camera = engine_camera(camera, pose, aspect)?;
-            stack.push(self.frame(py, &s, &view, &extras, &names)?);
+            list.push(pose);
         }
-        stack.into_arrays(py, (self.width, self.height), true)
+        self.render_poses(py, scene, camera, &list, &names, settings, true)
     }
 
     /// Frees the device's resources (the renderer cannot render afterwards).

@@ -66,6 +66,17 @@ pub enum Validation {
     Required,
 }
 
+impl Validation {
+    /// `Required` when `on`, else `Off` (a command line's `--validation`).
+    pub fn required_if(on: bool) -> Self {
+        if on {
+            Validation::Required
+        } else {
+            Validation::Off
+        }
+    }
+}
+
 /// How to create a context.
 #[derive(Clone, Debug)]
 pub struct ContextDesc {

@@ -452,6 +452,27 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
+    /// Binds `material`'s descriptor set as set `set` of `layout`.
+    pub fn bind_material(
+        &self,
+        d: &ash::Device,
+        cmd: vk::CommandBuffer,
+        layout: vk::PipelineLayout,
+        set: u32,
+        material: usize,
+    ) {
+        unsafe {
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                layout,
+                set,
+                &[self.material_sets[material]],
+                &[],
+            )
+        };
+    }
+
     /// Records draw `dr` of a pass seen from `eye` (`Draw::cull_mode`): its cull mode and front
     /// face, the pass's `immediates` (pushed to both stages of `layout`), and its triangles.
     pub fn record_draw(

@@ -45,11 +45,7 @@ impl BudgetWorker {
         let (out_tx, rx) = channel();
         let thread = std::thread::spawn(move || -> anyhow::Result<usize> {
             let ctx = Context::new(&ContextDesc {
-                validation: if validation {
-                    Validation::Required
-                } else {
-                    Validation::Off
-                },
+                validation: Validation::required_if(validation),
                 device,
                 pipeline_cache: super::pipeline_cache_path(),
                 ..Default::default()

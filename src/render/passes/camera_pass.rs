@@ -476,14 +476,7 @@ impl CameraPass {
                 let pieces = pieces(bits, split.clone());
                 drawn += 1;
                 if dr.material != bound_material {
-                    d.cmd_bind_descriptor_sets(
-                        cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        self.layout,
-                        1,
-                        &[scene.material_sets[dr.material]],
-                        &[],
-                    );
+                    scene.bind_material(d, cmd, self.layout, 1, dr.material);
                     bound_material = dr.material;
                 }
                 let mut imm = dr.immediates;
@@ -664,14 +657,7 @@ impl CameraPass {
             for r in &plan.resolved {
                 let pipeline = self.pipelines[&(r.material_bits | frame_bits, Entry::Resolve)];
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.layout,
-                    1,
-                    &[scene.material_sets[r.material]],
-                    &[],
-                );
+                scene.bind_material(d, cmd, self.layout, 1, r.material);
                 d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, r.mark);
                 d.cmd_set_scissor(cmd, 0, &[r.rect.scissor()]);
                 d.cmd_draw(cmd, 3, 1, 0, 0);
@@ -753,14 +739,7 @@ impl CameraPass {
             let dr = &scene.draws[i];
             unsafe {
                 if dr.material != bound_material {
-                    d.cmd_bind_descriptor_sets(
-                        cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        self.layout,
-                        1,
-                        &[scene.material_sets[dr.material]],
-                        &[],
-                    );
+                    scene.bind_material(d, cmd, self.layout, 1, dr.material);
                     bound_material = dr.material;
                 }
                 // Made by `ensure_aov_pipelines`.

@@ -595,14 +595,7 @@ impl ShadowPass {
                             bound = true;
                         }
                         if masked {
-                            d.cmd_bind_descriptor_sets(
-                                cmd,
-                                vk::PipelineBindPoint::GRAPHICS,
-                                layout,
-                                0,
-                                &[scene.material_sets[dr.material]],
-                                &[],
-                            );
+                            scene.bind_material(d, cmd, layout, 0, dr.material);
                         }
                         let pc = ShadowImmediates {
                             light_clip_from_world: *t.light_clip_from_world,

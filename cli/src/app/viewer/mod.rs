@@ -185,11 +185,7 @@ impl App {
             .as_raw();
         let instance_extensions = surface_extensions(display)?;
         let ctx = Context::new(&ContextDesc {
-            validation: if self.opts.validation {
-                Validation::Required
-            } else {
-                Validation::Off
-            },
+            validation: Validation::required_if(self.opts.validation),
             device: self.opts.device.clone(),
             instance_extensions,
             swapchain: true,
