@@ -121,3 +121,22 @@ fn depth_ids_and_normals_read_what_the_geometry_says() {
     drop(r);
     assert_validation_clean(&ctx);
 }
+
+/// The close-up stand-in (`--synthetic close-up`) is what it claims: at its own camera, 1280×720,
+/// its models (every instance but the ground) cover about a third of the frame, as the C++
+/// sample's models do at the sample's camera.
+#[test]
+fn close_up_models_cover_a_third_of_the_frame() {
+    let ctx = context();
+    let scene = umbra::scene::synthetic::close_up_scene();
+    let mut r = Renderer::new(&ctx, &scene).unwrap();
+    let (w, h) = (640, 360);
+    let view = View::new(scene.cameras[0]);
+    let a = r.render_aovs(&view, w, h).unwrap();
+    let models = a.instance.iter().filter(|&&i| i > 1).count();
+    let share = models as f64 / (w * h) as f64;
+    eprintln!("close-up: models cover {:.1} % of the frame", share * 100.0);
+    // Measured: 33.4 %.
+    assert!((0.30..0.37).contains(&share), "{:.3}", share);
+    drop(r);
+}

@@ -71,9 +71,10 @@ fn builtin_scene_meets_the_thresholds_at_the_defaults() {
         );
         assert!(g <= 2.0, "gap {g} texels at {}°", c.elevation_deg);
     }
-    // Shimmer: snapped single map 1.0e-7 flipped per frame (1 point in 59 frames); 4 snapped
-    // cascades 9.9e-5 fitted afresh each frame, 5.2e-5 held (the dithered blend bands move with
-    // the camera); unsnapped 1.0e-3 and 5.8e-4.
+    // Shimmer: snapped single map 1.9e-7 flipped per frame (2 points in 59 frames; 9.2e-8 with
+    // D32, 1.9e-6 with D16 before its depth lattice held still); 4 snapped cascades 9.9e-5
+    // fitted afresh each frame, 5.0e-5 held (the dithered blend bands move with the camera);
+    // unsnapped 1.0e-3 and 5.8e-4.
     for s in &r.shimmer {
         if s.snapped {
             assert!(

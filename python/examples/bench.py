@@ -3,7 +3,7 @@
 camera and sun as ../shared/peers/pyrender/bench_pyrender.py), for side-by-side runs in the
 same minutes. Prints one JSON line.
 
-  bench.py MODEL.gltf [--msaa 1|4] [--width 1280 --height 720] [--frames 15] [--warmup 3]
+  bench.py MODEL.gltf [--msaa 1|4] [--post-aa none|fxaa] [--width 1280 --height 720] [--frames 15] [--warmup 3]
   bench.py --gltf-scene EXPORTED.gltf ...   # bench_pyrender.py --synthetic 16 --export-gltf
   bench.py ... --batch 100                   # render_batch of N poses against N render calls
 
@@ -62,6 +62,7 @@ def main():
     ap.add_argument("--width", type=int, default=1280)
     ap.add_argument("--height", type=int, default=720)
     ap.add_argument("--msaa", type=int, default=1)
+    ap.add_argument("--post-aa", default="none", choices=["none", "fxaa"])
     ap.add_argument("--frames", type=int, default=15)
     ap.add_argument("--warmup", type=int, default=3)
     ap.add_argument("--batch", type=int, default=0)
@@ -76,20 +77,21 @@ def main():
     r = umbra.OffscreenRenderer(a.width, a.height, msaa=a.msaa)
     create_ms = (time.perf_counter() - t) * 1e3
     t = time.perf_counter()
-    color, _ = r.render(scene, camera, pose)
+    color, _ = r.render(scene, camera, pose, post_aa=a.post_aa)
     first_ms = (time.perf_counter() - t) * 1e3
     if a.png:
         from PIL import Image
 
         Image.fromarray(color).save(a.png)
-    timed(lambda: r.render(scene, camera, pose), a.warmup)
-    frames = timed(lambda: r.render(scene, camera, pose), a.frames)
+    timed(lambda: r.render(scene, camera, pose, post_aa=a.post_aa), a.warmup)
+    frames = timed(lambda: r.render(scene, camera, pose, post_aa=a.post_aa), a.frames)
     out = {
         "scene": scene.name,
         "triangles": scene.triangles,
         "device": r.device,
         "size": [a.width, a.height],
         "msaa": r.samples,
+        "post_aa": a.post_aa,
         "renderer_create_ms": round(create_ms, 1),
         "first_frame_ms": round(first_ms, 1),
         "frame_ms": {

@@ -6,7 +6,7 @@ use glam::Vec3;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use umbra::render::{Background, Exposure, ShadowFit, ShadowFormat, Tonemap, View};
+use umbra::render::{Background, Exposure, PostAa, ShadowFit, Tonemap, View};
 
 /// What a frame is rendered with besides the view: the error budget, the light whose visibility
 /// `shadow` holds, and the scene's time.
@@ -37,6 +37,7 @@ pub const NAMES: &[&str] = &[
     "light_size",
     "exposure",
     "tonemap",
+    "post_aa",
     "ambient",
     "background",
     "sun_direction",
@@ -70,11 +71,7 @@ pub fn apply(view: &mut View, settings: Option<&Bound<'_, PyDict>>) -> PyResult<
                 s.map_size = n;
             }
             "shadow_format" => {
-                s.format = match text()?.to_ascii_lowercase().as_str() {
-                    "d32" => ShadowFormat::D32,
-                    "d16" => ShadowFormat::D16,
-                    f => return Err(invalid(&name, format!("'{f}' is not d32 or d16"))),
-                }
+                s.format = text()?.parse().map_err(|e| invalid(&name, e))?;
             }
             "pcf" => s.pcf = text()?.parse().map_err(|e| invalid(&name, e))?,
             "cascades" => {
@@ -120,6 +117,7 @@ pub fn apply(view: &mut View, settings: Option<&Bound<'_, PyDict>>) -> PyResult<
             "tonemap" => {
                 view.tonemap = text()?.parse::<Tonemap>().map_err(|e| invalid(&name, e))?
             }
+            "post_aa" => view.post_aa = text()?.parse::<PostAa>().map_err(|e| invalid(&name, e))?,
             "ambient" => view.ambient = Some(rgb(&name, &v)?),
             "background" => {
                 view.background = match v.extract::<[f32; 3]>() {

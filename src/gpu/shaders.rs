@@ -101,7 +101,9 @@ pub fn set_layout(
 }
 
 // lavapipe (and the Vulkan minimum) allow 128 bytes of push constants.
-const _: () = assert!(scene::IMMEDIATE_SIZE <= 128 && shadow::IMMEDIATE_SIZE <= 128);
+const _: () = assert!(
+    scene::IMMEDIATE_SIZE <= 128 && shadow::IMMEDIATE_SIZE <= 128 && post::IMMEDIATE_SIZE <= 128
+);
 
 /// Creates a descriptor pool sized for `count` sets of `group` (descriptor counts taken from the
 /// reflected bindings) and allocates the sets with `layout`.

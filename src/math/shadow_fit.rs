@@ -404,6 +404,14 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
         lo_y = ((cy - 0.5 * extent) / texel).floor() * texel;
         zf = ((z_far / texel).floor() - 2.0) * texel;
         zn = ((z_near / texel).ceil() + 2.0) * texel;
+        // Depth on a lattice that holds still: the range on the extent's ladder, the near plane
+        // on a multiple of a 16-bit step of it, so a D16 map's stored depths (multiples of that
+        // step from the near plane) round the same way from frame to frame while the range
+        // stays on its rung.
+        let range = quantize_extent(zn - zf, input.extent_steps);
+        let step = range / 65535.0;
+        zn = (zn / step).ceil() * step;
+        zf = zn - range;
     } else {
         extent = raw;
         texel = extent / size;

@@ -5,7 +5,10 @@ use super::camera::camera_projection;
 use super::casters::{CasterPlan, Viewpoint};
 use super::input::{PlanScene, PlanTarget};
 use super::lights::{effective_lights, light_uniforms, metering};
-use super::settings::{Ambient, Background, Exposure, HeldLight, Pcf, ShadowHold, Tonemap, View};
+use super::settings::{
+    Ambient, Background, Exposure, HeldLight, Pcf, ShadowFormat, ShadowHold, ShadowSettings,
+    Tonemap, View,
+};
 use super::uniforms::{FrameUniform, MAX_LIGHTS};
 use super::views::{far_view_depth, shadow_views, view_uniforms, ShadowView};
 use crate::math::Aabb;
@@ -27,6 +30,8 @@ pub struct FramePlan {
     pub soft: bool,
     /// Side of the shadow map in texels.
     pub shadow_map_size: u32,
+    /// The shadow map's depth format (`ShadowFormat::Auto` resolved: never `Auto`).
+    pub shadow_format: ShadowFormat,
     /// The camera's world position.
     pub camera_position: Vec3,
     /// Whether the camera projects in parallel (every pixel seen along its forward direction).
@@ -280,6 +285,32 @@ impl ScenePlanner {
     }
 }
 
+/// The depth format `settings.format` asks for, `Auto` resolved for the shadow `views`: D16
+/// where every view is orthographic (a directional light's, whose depth is linear) and one D16
+/// step across its depth range is at most a quarter of the constant bias (which moves each lookup
+/// `constant_bias` texel widths towards the light), so rounding a stored depth can never undo
+/// more than a quarter of the bias; D32 otherwise (spot and point lights' perspective depth,
+/// depth ranges far deeper than a texel is wide, no constant bias).
+pub fn resolve_format(settings: &ShadowSettings, views: &[ShadowView]) -> ShadowFormat {
+    if settings.format != ShadowFormat::Auto {
+        return settings.format;
+    }
+    let fits = |v: &ShadowView| {
+        let m = v.light_clip_from_world;
+        let orthographic = m.row(3) == Vec4::W;
+        // Clip z is linear in world position: its gradient's length is 1 / the depth range.
+        let range = 1.0 / m.row(2).truncate().length();
+        orthographic
+            && range.is_finite()
+            && range / 65535.0 <= 0.25 * settings.constant_bias * v.texel_world
+    };
+    if !views.is_empty() && views.iter().all(fits) {
+        ShadowFormat::D16
+    } else {
+        ShadowFormat::D32
+    }
+}
+
 /// Plans a frame for `view` of `scene` rendered into `target`: pure, no GPU.
 pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FramePlan {
     let PlanTarget {
@@ -351,11 +382,13 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
     };
     // Soft where a shadowed light's uniform carries a size (set above).
     let soft = shadows_on && u.lights.iter().any(|l| l.direction.w > 0.0);
+    let shadow_format = resolve_format(&view.shadow, &views);
     FramePlan {
         uniform: u,
         shadows_on,
         soft,
         shadow_map_size: size,
+        shadow_format,
         camera_position: view.camera.position(),
         orthographic: view.camera.is_orthographic(),
         shader_variant: frame_variant_bits(
@@ -668,5 +701,52 @@ mod tests {
                 "face {k}: {ndc}"
             );
         }
+    }
+
+    #[test]
+    fn auto_format_takes_d16_only_where_its_step_is_under_a_quarter_of_the_bias() {
+        // A directional view 10 units deep: one D16 step is 10 / 65535 = 1.5e-4 units.
+        let ortho = |depth: f32| Mat4::orthographic_rh(-5.0, 5.0, -5.0, 5.0, 0.0, depth);
+        let view = |m: Mat4, texel: f32| ShadowView::whole(m, texel);
+        let auto = ShadowSettings::default();
+        assert_eq!(auto.format, ShadowFormat::Auto);
+        // 10 units on 2048 texels: texel 4.9e-3, a quarter of a 1-texel bias 1.2e-3 ≥ 1.5e-4.
+        let near = view(ortho(10.0), 10.0 / 2048.0);
+        assert_eq!(
+            resolve_format(&auto, std::slice::from_ref(&near)),
+            ShadowFormat::D16
+        );
+        // 1,000 units deep for the same texels: a step of 0.015 is past the quarter bias.
+        let deep = view(ortho(1000.0), 10.0 / 2048.0);
+        assert_eq!(
+            resolve_format(&auto, &[near.clone(), deep]),
+            ShadowFormat::D32
+        );
+        // The limit: depth ≤ 65535 × 0.25 × bias × texel = 80 units here.
+        assert_eq!(
+            resolve_format(&auto, &[view(ortho(79.0), 10.0 / 2048.0)]),
+            ShadowFormat::D16
+        );
+        assert_eq!(
+            resolve_format(&auto, &[view(ortho(81.0), 10.0 / 2048.0)]),
+            ShadowFormat::D32
+        );
+        // Perspective depth (a spot light) and no constant bias keep D32; explicit formats pass.
+        let spot = view(Mat4::perspective_rh(1.0, 1.0, 0.1, 10.0), 1e-3);
+        assert_eq!(resolve_format(&auto, &[spot]), ShadowFormat::D32);
+        let unbiased = ShadowSettings {
+            constant_bias: 0.0,
+            ..auto
+        };
+        assert_eq!(
+            resolve_format(&unbiased, std::slice::from_ref(&near)),
+            ShadowFormat::D32
+        );
+        let d32 = ShadowSettings {
+            format: ShadowFormat::D32,
+            ..auto
+        };
+        assert_eq!(resolve_format(&d32, &[near]), ShadowFormat::D32);
+        assert_eq!(resolve_format(&auto, &[]), ShadowFormat::D32);
     }
 }

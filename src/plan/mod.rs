@@ -18,11 +18,11 @@ pub(crate) mod views;
 
 pub use camera::{camera_projection, fitting_frustum};
 pub use casters::{flat_hides_nothing, CasterPlan, Viewpoint};
-pub use frame::{plan_frame, FramePlan, ScenePlanner, CLEAR_COLOR};
+pub use frame::{plan_frame, resolve_format, FramePlan, ScenePlanner, CLEAR_COLOR};
 pub use input::{PlanScene, PlanTarget};
 pub use lights::{effective_lights, exposure_scale, metered_illuminance};
 pub use settings::{
-    Ambient, Background, Exposure, HeldLight, Pcf, SceneOptions, ShadowFit, ShadowFormat,
+    Ambient, Background, Exposure, HeldLight, Pcf, PostAa, SceneOptions, ShadowFit, ShadowFormat,
     ShadowHold, ShadowSettings, Tonemap, View, ViewMode, AUTO_GROUND, AUTO_SKY, GROUND_TINT,
     MAX_CASCADES, SKY_TINT, UNIT_AMBIENT,
 };

@@ -100,10 +100,50 @@ impl Pcf {
 /// Depth format of the shadow map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShadowFormat {
-    /// 32-bit float (default).
+    /// 32-bit float.
     D32,
     /// 16-bit unorm.
     D16,
+    /// Per frame (the default): D16 where its depth step is too small to matter (every view
+    /// orthographic and its step at most a quarter of the constant bias, `plan::resolve_format`),
+    /// else D32. Half the bytes a texel to write and read.
+    Auto,
+}
+
+impl std::str::FromStr for ShadowFormat {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "d32" => Ok(Self::D32),
+            "d16" => Ok(Self::D16),
+            "auto" => Ok(Self::Auto),
+            _ => Err(format!("shadow format '{s}' is not auto, d16 or d32")),
+        }
+    }
+}
+
+/// Anti-aliasing applied to the finished lit image (after any MSAA resolve).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PostAa {
+    /// None (the default: pictures as drawn).
+    #[default]
+    None,
+    /// FXAA (Lottes 2009, the published "quality" algorithm): each pixel whose 3×3 luma range
+    /// marks an edge is resampled across the edge by its estimated coverage; flat pixels are
+    /// copied unchanged. One full-screen pass: the smooth-edge option a CPU device can afford
+    /// (docs/speed.md has its cost and edge error beside MSAA's).
+    Fxaa,
+}
+
+impl std::str::FromStr for PostAa {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "none" | "off" => Ok(Self::None),
+            "fxaa" => Ok(Self::Fxaa),
+            _ => Err(format!("post anti-aliasing '{s}' is not none or fxaa")),
+        }
+    }
 }
 
 /// How the directional light's frustum is fitted.
@@ -193,7 +233,7 @@ impl Default for ShadowSettings {
         Self {
             enabled: true,
             map_size: 2048,
-            format: ShadowFormat::D32,
+            format: ShadowFormat::Auto,
             pcf: Pcf::P2x2,
             constant_bias: 1.0,
             slope_bias: 1.5,
@@ -525,6 +565,8 @@ pub struct View {
     pub exposure_compensation: f32,
     /// Tone-mapping curve from exposed values to the display (the lit image only).
     pub tonemap: Tonemap,
+    /// Post-process anti-aliasing of the lit image ([`PostAa`]; debug views are not filtered).
+    pub post_aa: PostAa,
     /// Fit the light frustum to this camera instead of `camera` (for stability tests).
     pub shadow_fit_camera: Option<Camera>,
     /// Tint this (instance, primitive) orange in the lit image (the viewer's picked primitive).
@@ -612,6 +654,7 @@ impl View {
             exposure: Exposure::Auto,
             exposure_compensation: 0.0,
             tonemap: Tonemap::Neutral,
+            post_aa: PostAa::None,
             shadow_fit_camera: None,
             highlight: None,
             shown_light: None,

@@ -7,13 +7,16 @@ use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::scene as sh;
 use crate::math::shadow_fit::spot_near;
-use crate::plan::settings::{Background, SceneOptions, ShadowSettings, View, ViewMode};
+use crate::plan::settings::{
+    Background, PostAa, SceneOptions, ShadowFormat, ShadowSettings, View, ViewMode,
+};
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
 use crate::render::passes::camera_pass::{
     AovTargets, CameraFrame, CameraPass, CameraTargets, Resolve,
 };
 use crate::render::passes::cull::CameraCull;
+use crate::render::passes::post_aa::PostAaPass;
 use crate::render::passes::receivers::ShadowReach;
 use crate::render::passes::shadow_pass::{plan_casters, ShadowPass};
 use crate::render::targets::{Attachment, MsaaTargets};
@@ -33,6 +36,8 @@ pub struct FrameCore {
     pub shadow: ShadowPass,
     /// Camera pass.
     pub camera: CameraPass,
+    /// Post-process anti-aliasing (`View::post_aa`).
+    post: PostAaPass,
     /// Samples per pixel of the camera pass (`SceneOptions::msaa` resolved for the device).
     pub samples: u32,
     query_pool: vk::QueryPool,
@@ -71,6 +76,7 @@ impl FrameCore {
             options.resolved_deferred(ctx),
         )?;
         let receiver_split = options.resolved_receiver_split(ctx);
+        let post = PostAaPass::new(ctx, color_format)?;
         let query_pool = unsafe {
             ctx.device.create_query_pool(
                 &vk::QueryPoolCreateInfo::default()
@@ -87,6 +93,7 @@ impl FrameCore {
             gpu,
             shadow,
             camera,
+            post,
             samples,
             query_pool,
             timestamps_written: vec![false; slots],
@@ -123,27 +130,36 @@ impl FrameCore {
         } else {
             1
         };
-        let hw = self.shadow.hardware_filtering(view.shadow.format);
         let mut v = view.rebased(self.origin);
         v.shadow.map_size = map_size;
-        let plan = plan_frame(
-            &PlanScene {
-                lights: &self.lights,
-                bounds: &self.gpu.bounds,
-                receivers: &self.receiver_bounds,
-                origin: self.origin,
-            },
-            &v,
-            &PlanTarget {
-                aspect: width as f32 / height.max(1) as f32,
-                height_px: height,
-                hw_compare: hw,
-            },
-        );
+        let scene = PlanScene {
+            lights: &self.lights,
+            bounds: &self.gpu.bounds,
+            receivers: &self.receiver_bounds,
+            origin: self.origin,
+        };
+        let target = |hw_compare| PlanTarget {
+            aspect: width as f32 / height.max(1) as f32,
+            height_px: height,
+            hw_compare,
+        };
+        // An automatic format is resolved by the plan; planned again in the rare case that the
+        // chosen format filters differently from D32 (hardware comparison is a plan input).
+        let first = match v.shadow.format {
+            ShadowFormat::Auto => ShadowFormat::D32,
+            f => f,
+        };
+        let mut hw = self.shadow.hardware_filtering(first);
+        let mut plan = plan_frame(&scene, &v, &target(hw));
+        let format = plan.shadow_format;
+        if self.shadow.hardware_filtering(format) != hw {
+            hw = !hw;
+            v.shadow.format = format;
+            plan = plan_frame(&scene, &v, &target(hw));
+        }
         let layers = plan.shadow_views.len().max(1) as u32;
-        self.shadow
-            .ensure_map(map_size, view.shadow.format, layers)?;
-        self.shadow.ensure_masked(&self.gpu, view.shadow.format)?;
+        self.shadow.ensure_map(map_size, format, layers)?;
+        self.shadow.ensure_masked(&self.gpu, format)?;
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         self.camera.bind_shadow_map(slot, map_view, hw);
         let casters = if plan.shadows_on {
@@ -176,7 +192,12 @@ impl FrameCore {
             sky,
         );
         self.camera.ensure_pipelines(&self.gpu, &camera, extent)?;
+        let post_aa = view.mode == ViewMode::Lit && view.post_aa == PostAa::Fxaa;
+        if post_aa {
+            self.post.ensure(extent)?;
+        }
         Ok(Prepared {
+            post_aa,
             plan,
             camera,
             extent,
@@ -186,8 +207,10 @@ impl FrameCore {
         })
     }
 
-    /// Records the shadow pass and the camera pass of a prepared frame with timestamps; leaves
-    /// `targets.color` as a colour attachment and `targets.depth` as a depth attachment. Returns
+    /// Records the shadow pass and the camera pass of a prepared frame with timestamps (the
+    /// camera pass's time includes post-process anti-aliasing, which draws the camera pass's
+    /// image into `targets.color` when the frame has it); leaves `targets.color` as a colour
+    /// attachment and `targets.depth` as a depth attachment. Returns
     /// what was drawn.
     pub fn record(
         &mut self,
@@ -245,7 +268,13 @@ impl FrameCore {
                 );
             }
         }
-        color.transition(d, cmd, Access::ColorAttachment);
+        // With post-process AA the camera pass draws into the pass's source image.
+        let color_target: &mut Attachment = if frame.post_aa {
+            self.post.source().expect("post AA source made by prepare")
+        } else {
+            &mut *color
+        };
+        color_target.transition(d, cmd, Access::ColorAttachment);
         let (draw_color, draw_depth, resolve) = match msaa {
             Some(m) => {
                 m.color.transition(d, cmd, Access::ColorAttachment);
@@ -254,14 +283,14 @@ impl FrameCore {
                     depth.transition(d, cmd, Access::DepthResolve);
                 }
                 let resolve = Resolve {
-                    color: Some(color.view),
+                    color: Some(color_target.view),
                     depth: resolve_depth.then_some(depth.view),
                 };
                 (m.color.view, m.depth.view, resolve)
             }
             None => {
                 depth.transition(d, cmd, Access::DepthAttachment);
-                (color.view, depth.view, Resolve::default())
+                (color_target.view, depth.view, Resolve::default())
             }
         };
         let targets = CameraTargets {
@@ -276,6 +305,9 @@ impl FrameCore {
             },
         };
         let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
+        if frame.post_aa {
+            self.post.record(cmd, color);
+        }
         unsafe {
             if timestamps {
                 d.cmd_write_timestamp2(
@@ -424,6 +456,8 @@ pub struct Prepared {
     shadow: ShadowSettings,
     /// The view mode (clear colour, the map view).
     mode: ViewMode,
+    /// FXAA after the camera pass (`View::post_aa`, lit images only).
+    post_aa: bool,
 }
 
 /// The images one frame is recorded into. With `msaa` the camera pass draws into its

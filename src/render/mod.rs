@@ -17,7 +17,7 @@ pub(crate) mod window;
 
 pub use crate::plan::{
     effective_lights, metered_illuminance, Ambient, Background, Exposure, FramePlan, HeldLight,
-    Pcf, SceneOptions, ScenePlanner, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings,
+    Pcf, PostAa, SceneOptions, ScenePlanner, ShadowFit, ShadowFormat, ShadowHold, ShadowSettings,
     ShadowView, Tonemap, View, ViewMode, MAX_CASCADES, MAX_LIGHTS, MAX_SHADOW_VIEWS, UNIT_AMBIENT,
 };
 pub use renderer::{view_axis_depths, Aovs, FrameStats, RenderedFrame, Renderer, MAX_SIDE};

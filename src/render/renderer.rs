@@ -380,7 +380,7 @@ impl Renderer {
             unshadowed_draws: counts.unshadowed_draws,
             draws_total: self.core.gpu.draws.len(),
             triangles: self.core.gpu.triangles,
-            hardware_compare: self.core.shadow.hardware_filtering(view.shadow.format),
+            hardware_compare: self.core.shadow.hardware_filtering(plan.shadow_format),
         };
         let t = self.target.as_mut().expect("target");
         let bytes = t

@@ -61,9 +61,9 @@ pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
         LightKind::Spot { .. } => "spot",
         LightKind::Point => "point",
     };
-    let bytes_per_texel = match view.shadow.format {
+    let bytes_per_texel = match plan.shadow_format {
         ShadowFormat::D16 => 2u64,
-        ShadowFormat::D32 => 4,
+        _ => 4,
     };
     let size = view.shadow.map_size as u64;
     let mut near = view.camera.near;
@@ -85,7 +85,7 @@ pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
         "light": li,
         "light_type": kind,
         "map_texels": size,
-        "format": match view.shadow.format { ShadowFormat::D16 => "D16", ShadowFormat::D32 => "D32" },
+        "format": match plan.shadow_format { ShadowFormat::D16 => "D16", _ => "D32" },
         "cascades": plan.primary_views().len(),
         "views": views,
         "texel_world_nearest": plan.primary_views().first().map(|v| v.texel_world),

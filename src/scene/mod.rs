@@ -13,6 +13,7 @@ mod gltf_primitive;
 pub mod inspect;
 pub mod load_error;
 pub mod material;
+pub mod open_shapes;
 pub mod sampler;
 pub mod shapes;
 pub mod synthetic;

@@ -7,26 +7,35 @@ use super::shapes::{add_object, colored, cuboid, plane, torus, uv_sphere};
 use super::{Camera, Light, LightKind, Scene};
 use glam::{Mat4, Vec3};
 
-/// A ground plane and 11 spheres of 4,736 triangles (52,098 triangles, 12 primitives), every
-/// material double-sided (as exporters often mark them); the spheres are closed meshes, the
-/// ground is open. One sun at about 40° elevation, one camera.
-pub fn double_sided_scene() -> Scene {
+/// A colour material of `roughness` marked double-sided.
+fn two_sided(rgb: Vec3, roughness: f32) -> super::Material {
+    let mut m = colored(rgb, roughness);
+    m.double_sided = true;
+    m
+}
+
+/// A scene named `name` holding a grey double-sided ground 30 units across.
+fn on_double_sided_ground(name: &str, roughness: f32) -> Scene {
     let mut s = Scene {
-        name: "double-sided".into(),
+        name: name.into(),
         ..Default::default()
-    };
-    let two = |rgb: Vec3| {
-        let mut m = colored(rgb, 0.5);
-        m.double_sided = true;
-        m
     };
     add_object(
         &mut s,
         "ground",
         plane(30.0, 1.0),
-        two(Vec3::splat(0.5)),
+        two_sided(Vec3::splat(0.5), roughness),
         Mat4::IDENTITY,
     );
+    s
+}
+
+/// A ground plane and 11 spheres of 4,736 triangles (52,098 triangles, 12 primitives), every
+/// material double-sided (as exporters often mark them); the spheres are closed meshes, the
+/// ground is open. One sun at about 40° elevation, one camera.
+pub fn double_sided_scene() -> Scene {
+    let mut s = on_double_sided_ground("double-sided", 0.5);
+    let two = |rgb: Vec3| two_sided(rgb, 0.5);
     for i in 0..11 {
         let a = i as f32 / 11.0 * std::f32::consts::TAU;
         let r = if i % 2 == 0 { 5.0 } else { 8.0 };
@@ -49,6 +58,54 @@ pub fn double_sided_scene() -> Scene {
         Vec3::new(0.0, 9.0, 17.0),
         Vec3::new(0.0, 0.0, 0.0),
         50f32.to_radians(),
+        0.1,
+    ));
+    s
+}
+
+/// The stand-in for the C++ sample's scene at its own camera: a ground and 11 open, organic,
+/// double-sided models of 4,608 triangles each (vases, leaves, shells, ribbons: 50,690
+/// triangles, 12 primitives) seen from close by with a 60° lens, so that the models cover about
+/// a third of the frame and both faces of most of them are drawn. One sun about 40° high.
+pub fn close_up_scene() -> Scene {
+    use super::open_shapes::{leaf, ribbon, shell, vase};
+    let mut s = on_double_sided_ground("close-up", 0.45);
+    let two = |rgb: Vec3| two_sided(rgb, 0.45);
+    let models = [
+        ("vase", vase(0.9, 2.2, 5.0, 64, 36)),
+        ("leaf", leaf(2.4, 1.0, 0.9, 96, 24)),
+        ("shell", shell(1.0, 2.2, 14.0, 64, 36)),
+        ("ribbon", ribbon(1.1, 0.35, 4.6, 5.2, 128, 18)),
+    ];
+    for i in 0..11 {
+        let a = i as f32 / 11.0 * std::f32::consts::TAU + 0.3;
+        let r = if i % 2 == 0 { 1.7 } else { 3.4 };
+        let (name, prim) = &models[i % 4];
+        let hue = Vec3::new(
+            0.3 + 0.6 * (a.cos() * 0.5 + 0.5),
+            0.45,
+            0.3 + 0.6 * (a.sin() * 0.5 + 0.5),
+        );
+        let lift = match *name {
+            "leaf" => 1.0,
+            "shell" | "ribbon" => 0.4,
+            _ => 0.0,
+        };
+        let place = Mat4::from_translation(Vec3::new(r * a.cos(), lift, r * a.sin()))
+            * Mat4::from_rotation_y(a * 1.7);
+        add_object(
+            &mut s,
+            &format!("{name} {i}"),
+            prim.clone(),
+            two(hue),
+            place,
+        );
+    }
+    s.lights.push(Light::sun(Vec3::new(-0.6, -1.0, -0.4), 2.0));
+    s.cameras.push(Camera::look_at(
+        Vec3::new(0.0, 2.6, 5.4),
+        Vec3::new(0.0, 0.7, 0.0),
+        60f32.to_radians(),
         0.1,
     ));
     s
@@ -486,7 +543,7 @@ pub fn lux_yard_scene() -> Scene {
     )
 }
 
-/// The generated scene called `name`: `double-sided`, `town`, `grazing`, `stability`, `room`,
+/// The generated scene called `name`: `double-sided`, `close-up`, `town`, `grazing`, `stability`, `room`,
 /// `sun-and-spot`, `two-suns`, `lux-yard` or `spheres:N` (1 ≤ N ≤ 256); `None` for any other
 /// name.
 pub fn by_name(name: &str) -> Option<Scene> {
@@ -496,6 +553,7 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "two-suns" => Some(two_suns_scene()),
         "lux-yard" => Some(lux_yard_scene()),
         "double-sided" => Some(double_sided_scene()),
+        "close-up" => Some(close_up_scene()),
         "town" => Some(town_scene()),
         "town-mover" => Some(town_mover_scene()),
         "grazing" => Some(grazing_scene()),
@@ -526,5 +584,17 @@ mod tests {
             .count();
         assert_eq!(closed, 11, "the spheres are closed, the ground is not");
         assert_eq!(sphere_grid(4).instances.len(), 17);
+    }
+
+    #[test]
+    fn close_up_scene_is_open_and_sized_like_the_sample() {
+        let s = close_up_scene();
+        assert_eq!(s.instances.len(), 12);
+        assert_eq!(s.triangle_count(), 50_690);
+        assert!(s.materials.iter().all(|m| m.double_sided));
+        assert!(s
+            .meshes
+            .iter()
+            .all(|m| !is_closed(&m.primitives[0].positions, &m.primitives[0].indices)));
     }
 }

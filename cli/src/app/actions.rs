@@ -3,7 +3,7 @@
 //! widget that sets the same value leave the same view, so they draw the same frame.
 
 use glam::Vec3;
-use umbra::render::{Pcf, Tonemap, View, ViewMode, MAX_CASCADES};
+use umbra::render::{Pcf, PostAa, Tonemap, View, ViewMode, MAX_CASCADES};
 use umbra::scene::Light;
 
 /// What a key or a panel widget does to the view.
@@ -35,6 +35,8 @@ pub enum Action {
     CycleCascades,
     /// Next tone-mapping curve: PBR Neutral, ACES, none (`T`).
     CycleTonemap,
+    /// FXAA on/off (`Y`; `View::post_aa`).
+    ToggleFxaa,
     /// Exposure half a stop up (`.`).
     ExposureUp,
     /// Exposure half a stop down (`,`).
@@ -185,6 +187,20 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 Tonemap::None => Tonemap::Neutral,
             };
             apply(Action::SetTonemap(next), view, sun)
+        }
+        Action::ToggleFxaa => {
+            view.post_aa = match view.post_aa {
+                PostAa::None => PostAa::Fxaa,
+                PostAa::Fxaa => PostAa::None,
+            };
+            format!(
+                "FXAA: {}",
+                if view.post_aa == PostAa::Fxaa {
+                    "on"
+                } else {
+                    "off"
+                }
+            )
         }
         Action::ExposureUp | Action::ExposureDown => {
             let step = if a == Action::ExposureUp { 0.5 } else { -0.5 };
@@ -378,6 +394,10 @@ mod tests {
             })
             .collect();
         assert_eq!(curves, [Tonemap::Aces, Tonemap::None, Tonemap::Neutral]);
+        assert!(apply(Action::ToggleFxaa, &mut v, &mut sun).contains("on"));
+        assert_eq!(v.post_aa, PostAa::Fxaa);
+        apply(Action::ToggleFxaa, &mut v, &mut sun);
+        assert_eq!(v.post_aa, PostAa::None);
         apply(Action::ExposureUp, &mut v, &mut sun);
         apply(Action::ExposureUp, &mut v, &mut sun);
         apply(Action::ExposureDown, &mut v, &mut sun);

@@ -256,7 +256,7 @@ pub struct ViewArgsCmd {
     pub validation: bool,
     /// Automation: inputs to play, one every two frames, comma-separated, each optionally
     /// repeated with `*N`: `WxH` resizes (0x0 minimises), `key:NAME` presses a key (up down left
-    /// right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r f1), `wheel:N`
+    /// right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r y f1), `wheel:N`
     /// scrolls N lines (positive zooms in), `click:X:Y` picks at window pixel (X, Y), `ui:NAME`
     /// clicks the panel's widget NAME, `drop:PATH` drops a file on the window,
     /// `copy:SRC>DST` copies a file (a model changed on disk) and `wait:reload` waits for the
@@ -358,7 +358,8 @@ pub struct ViewArgs {
     #[arg(long)]
     pub no_culling: bool,
     /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided
-    /// primitives), `town` (2 km across, cameras at eye height and on a roof), `town-mover` (the town
+    /// primitives), `close-up` (51k triangles of open, organic double-sided models filling a
+    /// third of a close view), `town` (2 km across, cameras at eye height and on a roof), `town-mover` (the town
     /// with a person-sized box walking across the street: animation \"move\"), `grazing` (a sun 6° above the
     /// horizon over posts, spheres and crates), `stability` (a thin wall, a box, spheres and a
     /// torus: the stability suite's scene), `room` (a point light in a furnished room),
@@ -416,7 +417,9 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = 2048)]
     pub shadow_map: u32,
     /// Shadow-map depth format.
-    #[arg(long, value_parser = ["d32", "d16"], default_value = "d32")]
+    /// `auto` (the default) takes D16 where its depth step is under a quarter of the constant
+    /// bias (a directional light's maps, most scenes), else D32.
+    #[arg(long, value_parser = ["auto", "d32", "d16"], default_value = "auto")]
     pub shadow_format: String,
     /// PCF kernel (2x2 by default: on the demo, wider kernels cost more and measured no better
     /// against the ray-cast reference).
@@ -479,6 +482,11 @@ pub struct ViewArgs {
     /// warning.
     #[arg(long, value_parser = parse_msaa)]
     pub msaa: Option<u32>,
+    /// Post-process anti-aliasing of the lit image: `none` (the default) or `fxaa` (one
+    /// full-screen pass over the finished image, after any MSAA resolve: smooth edges for a
+    /// fraction of MSAA's cost on CPU devices; docs/speed.md).
+    #[arg(long, value_parser = ["none", "fxaa"], default_value = "none")]
+    pub post_aa: String,
     /// Shade draws of triangles smaller than a 4×4 pixel block deferred (a G-buffer, then each
     /// covered pixel shaded once: the same image, less work where llvmpipe would shade whole
     /// blocks per tiny triangle); default on for CPU devices at one sample per pixel, off on GPUs.
@@ -705,6 +713,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     v.ambient = a.ambient;
     v.background = a.background;
     v.tonemap = a.tonemap;
+    v.post_aa = a.post_aa.parse().unwrap_or_default();
     if let Some(i) = a.shadow_light {
         let n = umbra::render::effective_lights(&scene.lights, &v).len();
         if i >= n {
@@ -724,11 +733,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     v.shadow = ShadowSettings {
         enabled: !a.no_shadows,
         map_size: a.shadow_map,
-        format: if a.shadow_format == "d16" {
-            ShadowFormat::D16
-        } else {
-            ShadowFormat::D32
-        },
+        format: a.shadow_format.parse().unwrap_or(ShadowFormat::Auto),
         pcf: pcf_of(a.pcf),
         constant_bias: a.bias_constant,
         slope_bias: a.bias_slope,

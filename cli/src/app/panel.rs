@@ -107,7 +107,7 @@ const MAP_SIZES: [u32; 8] = [64, 128, 256, 512, 1024, 2048, 4096, 8192];
 const BUDGETS: [f64; 4] = [0.05, 0.1, 0.2, 0.5];
 
 /// The keys, for the legend.
-const KEYS: [(&str, &str); 22] = [
+const KEYS: [(&str, &str); 23] = [
     ("F1", "panel on/off"),
     ("left drag / right drag / wheel", "orbit / pan / zoom"),
     ("click", "pick"),
@@ -124,6 +124,7 @@ const KEYS: [(&str, &str); 22] = [
     ("L", "light shown"),
     ("+ -", "biases ×1.25 / ÷1.25"),
     ("T", "tone curve"),
+    ("Y", "FXAA on/off"),
     (", .", "exposure −½ / +½ stop"),
     ("V", "view mode"),
     ("H", "shadows on/off"),

@@ -66,11 +66,12 @@ pub fn method_of(fit: ShadowFit, cascades: u32) -> String {
     }
 }
 
-/// `d16` or `d32`.
+/// `d16`, `d32` or `auto`.
 pub fn format_name(f: ShadowFormat) -> &'static str {
     match f {
         ShadowFormat::D16 => "d16",
         ShadowFormat::D32 => "d32",
+        ShadowFormat::Auto => "auto",
     }
 }
 

@@ -255,7 +255,8 @@ fn run_batch(
         let gpu = median_split(&st);
         let bytes = match c.shadow.format {
             umbra::render::ShadowFormat::D16 => 2.0,
-            umbra::render::ShadowFormat::D32 => 4.0,
+            // `auto` may take either: its memory is D32's at most.
+            _ => 4.0,
         };
         on_row(Row {
             scene: scene.into(),

@@ -172,11 +172,11 @@ class OffscreenRenderer:
         (H, W) distance along the view axis, 0 where nothing is hit). With outputs: a dict of
         color, depth, segmentation (uint32 (H, W): instance + 1, 0 background), normals
         (float32 (H, W, 3), world) and shadow (float32 (H, W): the first shadowed light's
-        visibility, or shadow_light's). Settings: shadows, shadow_map, shadow_format ('d32',
-        'd16'), pcf ('none', '2x2', '3x3', '5x5'), cascades (0 = automatic), depth_fit, fit
+        visibility, or shadow_light's). Settings: shadows, shadow_map, shadow_format ('auto',
+        'd32', 'd16'), pcf ('none', '2x2', '3x3', '5x5'), cascades (0 = automatic), depth_fit, fit
         ('camera', 'sphere', 'scene'), bias_constant, bias_slope, normal_offset, shadow_budget
         (misclassified pixels, %), shadow_light, light_size, exposure ('auto', an EV100, or
-        'x1.5'), tonemap ('neutral', 'aces', 'none'), ambient, background ('sky', '#rrggbb' or an
+        'x1.5'), tonemap ('neutral', 'aces', 'none'), post_aa ('none', 'fxaa'), ambient, background ('sky', '#rrggbb' or an
         RGB triple within 0..1), sun_direction, sun_intensity, time (seconds), animation (a
         name, an index or 'all'). The GIL is released while the GPU works."""
     def render_batch(

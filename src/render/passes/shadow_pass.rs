@@ -20,10 +20,11 @@ use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use std::sync::Arc;
 
-/// Vulkan format of a shadow format.
+/// Vulkan format of a shadow format (`Auto` is resolved by the plan before it gets here; taken
+/// as D32 if not).
 pub fn vk_format(f: ShadowFormat) -> vk::Format {
     match f {
-        ShadowFormat::D32 => vk::Format::D32_SFLOAT,
+        ShadowFormat::D32 | ShadowFormat::Auto => vk::Format::D32_SFLOAT,
         ShadowFormat::D16 => vk::Format::D16_UNORM,
     }
 }

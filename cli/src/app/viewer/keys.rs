@@ -76,6 +76,7 @@ pub fn script_key(name: &str) -> Option<KeyCode> {
         "z" => KeyCode::KeyZ,
         "x" => KeyCode::KeyX,
         "r" => KeyCode::KeyR,
+        "y" => KeyCode::KeyY,
         "f1" => KeyCode::F1,
         _ => return None,
     })
@@ -100,6 +101,7 @@ pub fn key_action(code: KeyCode) -> Option<KeyAction> {
         KeyCode::KeyG => Setting(Action::ToggleDepthFit),
         KeyCode::KeyJ => Setting(Action::ToggleSoft),
         KeyCode::KeyT => Setting(Action::CycleTonemap),
+        KeyCode::KeyY => Setting(Action::ToggleFxaa),
         KeyCode::Period => Setting(Action::ExposureUp),
         KeyCode::Comma => Setting(Action::ExposureDown),
         KeyCode::KeyL => ShadowLight,
