@@ -20,7 +20,7 @@
 override HAS_BASE_TEX: bool = true;
 override HAS_NORMAL_MAP: bool = true;
 override HAS_OTHER_TEX: bool = true; // metallic-roughness, emissive or occlusion
-override SINGLE_LIGHT: bool = false;
+override ONE_SUN: bool = false; // the frame's only light is directional
 override SHADOWS: bool = true;
 override HW_COMPARE: bool = false; // requires SHADOWS
 override PCF_BIT0: bool = true; // requires SHADOWS

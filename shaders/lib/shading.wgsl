@@ -95,13 +95,14 @@ fn shade_texels(in: VsOut, front_facing: bool, base: vec4<f32>, texels: Texels) 
     var color = ka * ambient_at(n) * occlusion + emissive;
     var shadow_term = 1.0;
     var cascade = -1;
-    // One light: a constant trip count the driver unrolls (a uniform count costs a real loop).
-    let count = select(min(frame.modes.w, MAX_LIGHTS), 1u, SINGLE_LIGHT);
+    // One sun: a constant trip count the driver unrolls (a uniform count costs a real loop), and
+    // no point or spot code (llvmpipe runs both sides of a branch, masked, on every pixel).
+    let count = select(min(frame.modes.w, MAX_LIGHTS), 1u, ONE_SUN);
     for (var i = 0u; i < count; i++) {
         let light = frame.lights[i];
         var l: vec3<f32>;
         var radiance = light.color.rgb;
-        if light.position.w == LIGHT_DIRECTIONAL {
+        if ONE_SUN || light.position.w == LIGHT_DIRECTIONAL {
             l = -light.direction.xyz;
         } else {
             let d = light.position.xyz - p;

@@ -392,7 +392,7 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         camera_position: view.camera.position(),
         orthographic: view.camera.is_orthographic(),
         shader_variant: frame_variant_bits(
-            lights.len(),
+            lights.len() == 1 && lights[0].kind == LightKind::Directional,
             shadows_on,
             hw_compare,
             view.shadow.pcf,
@@ -414,10 +414,12 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
     }
 }
 
-/// The scene shader's frame variant bits: one light (a constant loop), shadows sampled, hardware
-/// comparison, and the PCF kernel (constant loops instead of per-frame uniforms).
+/// The scene shader's frame variant bits: one directional light and nothing else (a constant
+/// loop without the point and spot code, which llvmpipe would run masked for every pixel),
+/// shadows sampled, hardware comparison, and the PCF kernel (constant loops instead of
+/// per-frame uniforms).
 fn frame_variant_bits(
-    lights: usize,
+    one_sun: bool,
     shadows_on: bool,
     hw_compare: bool,
     pcf: Pcf,
@@ -426,8 +428,8 @@ fn frame_variant_bits(
 ) -> usize {
     use crate::gpu::shaders::scene as sh;
     let mut bits = 0;
-    if lights == 1 {
-        bits |= sh::BIT_SINGLE_LIGHT;
+    if one_sun {
+        bits |= sh::BIT_ONE_SUN;
     }
     // The filter, comparison path and cascades mean nothing without a map (one shader for all).
     if !shadows_on {
@@ -561,7 +563,7 @@ mod tests {
         assert_eq!(p.uniform.modes[3], 1);
         // One light, shadows on, PCF 2×2 by hand (hw_compare false).
         use crate::gpu::shaders::scene as sh;
-        let want = sh::BIT_SINGLE_LIGHT | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0;
+        let want = sh::BIT_ONE_SUN | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0;
         assert_eq!(p.shader_variant, want);
         // Cascades: four views, nearest first, each ending where the next blends in.
         v.shadow.cascades = 4;
@@ -576,7 +578,17 @@ mod tests {
         // Without shadows the filter, comparison and cascade bits mean nothing: one shader.
         v.shadow.enabled = false;
         let p = plan_at(&s.lights, &s.bounds(), &[], &v, 1.5, 720);
-        assert_eq!(p.shader_variant, sh::BIT_SINGLE_LIGHT);
+        assert_eq!(p.shader_variant, sh::BIT_ONE_SUN);
+        // One point light is not a sun: the general light loop.
+        let point = [Light {
+            kind: LightKind::Point,
+            position: Vec3::new(0.0, 3.0, 0.0),
+            ..Light::sun(Vec3::NEG_Y, 10.0)
+        }];
+        v.sun_direction = None;
+        let p = plan_at(&point, &s.bounds(), &[], &v, 1.5, 720);
+        assert_eq!(p.lights.len(), 1);
+        assert_eq!(p.shader_variant & sh::BIT_ONE_SUN, 0);
     }
     #[test]
     fn held_cascades_keep_their_splits_until_the_receivers_leave_them() {

@@ -1,4 +1,5 @@
-//! Deferred shading of draws made of triangles smaller than llvmpipe's shading block.
+//! Deferred shading of draws made of triangles smaller than llvmpipe's shading block, and of
+//! draws that hide their own triangles (open meshes drawn on both faces, [`overdraws_itself`]).
 //!
 //! llvmpipe rasterises in 4×4-pixel blocks and runs the fragment shader on every block a
 //! triangle touches (on 8 lanes at a time), so a mesh whose triangles cover a pixel or two on
@@ -57,17 +58,29 @@ const MAX_MARKS: usize = 255;
 
 /// Where `dr` is on screen, and its pixels per triangle, if it is shaded deferred in a frame
 /// seen through `clip_from_world` at `extent`: deferrable, at least `DEFER_MIN_TRIANGLES`,
-/// triangles under `DEFER_BELOW_PIXELS` each, and wholly in front of the eye.
+/// triangles under `DEFER_BELOW_PIXELS` each or [`overdraws_itself`], and wholly in front of the
+/// eye.
 fn is_micro(dr: &Draw, clip_from_world: &Mat4, extent: vk::Extent2D) -> Option<(PixelRect, f32)> {
     let triangles = dr.index_count / 3;
     if !dr.deferrable || dr.alpha != AlphaDraw::Opaque || triangles < DEFER_MIN_TRIANGLES {
         return None;
     }
     let ppt = pixels_per_triangle(dr, clip_from_world, extent);
-    if ppt >= DEFER_BELOW_PIXELS {
+    if ppt >= DEFER_BELOW_PIXELS && !overdraws_itself(dr) {
         return None;
     }
     Some((screen_rect(dr, clip_from_world, extent)?, ppt))
+}
+
+/// Whether a draw's own triangles hide one another wherever it is seen from, so that forward
+/// shading runs the material shader about twice for the pixels it keeps: both faces drawn
+/// (double-sided) of a mesh that is neither closed (whose back faces are culled) nor flat. An
+/// open vase's inside and outside, a bent leaf: the triangle order inside one draw is not
+/// front to back, so early depth rejects only part of the hidden fragments. On
+/// `--synthetic close-up` (11 such models of 4,608 triangles, 50-pixel triangles, 2.1 fragments
+/// per covered pixel) deferring them took the camera pass from 62 to 54 ms.
+fn overdraws_itself(dr: &Draw) -> bool {
+    dr.double_sided && !dr.closed && dr.world_plane.is_none()
 }
 
 /// With candidates of more materials than stencil marks, the `MAX_MARKS` materials whose draws
@@ -405,6 +418,42 @@ mod tests {
         assert!(plan((0..draws.len()).collect(), &draws, &c, extent, true)
             .deferred
             .is_empty());
+    }
+
+    #[test]
+    fn open_double_sided_meshes_defer_at_any_triangle_size() {
+        let (c, extent) = cull();
+        // Large triangles (40 pixels each at 10 units): forward, unless both faces of an open,
+        // curved mesh are drawn.
+        let big = |material, x| draw(material, 2500, 3.2, Vec3::new(x, 0.0, -10.0));
+        let open = Draw {
+            double_sided: true,
+            closed: false,
+            ..big(1, -2.0)
+        };
+        let closed = Draw {
+            double_sided: true,
+            ..big(2, -1.0)
+        };
+        let flat = Draw {
+            world_plane: Some(glam::Vec4::new(0.0, 1.0, 0.0, 0.0)),
+            ..open
+        };
+        let single = Draw {
+            closed: false,
+            ..big(4, 1.0)
+        };
+        let open_too = Draw {
+            material: 5,
+            source: (5, 0),
+            ..open
+        };
+        assert!(pixels_per_triangle(&closed, &c.clip_from_world, extent) > DEFER_BELOW_PIXELS);
+        let draws = [open, closed, flat, single, open_too];
+        let p = plan((0..draws.len()).collect(), &draws, &c, extent, true);
+        let deferred: Vec<usize> = p.deferred.iter().map(|&(d, _)| d).collect();
+        assert_eq!(deferred, [0, 4]);
+        assert_eq!(p.forward, [1, 2, 3]);
     }
 
     #[test]

@@ -378,7 +378,7 @@ mod tests {
 
     #[test]
     fn unshadowed_variant_clears_the_shadow_bits() {
-        let bits = sh::BIT_SINGLE_LIGHT | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0 | sh::BIT_SOFT;
-        assert_eq!(unshadowed(bits), sh::BIT_SINGLE_LIGHT);
+        let bits = sh::BIT_ONE_SUN | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0 | sh::BIT_SOFT;
+        assert_eq!(unshadowed(bits), sh::BIT_ONE_SUN);
     }
 }
