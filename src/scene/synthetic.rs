@@ -86,11 +86,18 @@ pub fn close_up_scene() -> Scene {
             0.45,
             0.3 + 0.6 * (a.sin() * 0.5 + 0.5),
         );
+        // Resting on the ground or above it, never sunk into it (as the sample's models stand).
+        let lowest = prim
+            .positions
+            .iter()
+            .map(|p| p.y)
+            .fold(f32::INFINITY, f32::min);
         let lift = match *name {
-            "leaf" => 1.0,
+            "leaf" => 1.0f32,
             "shell" | "ribbon" => 0.4,
             _ => 0.0,
-        };
+        }
+        .max(-lowest);
         let place = Mat4::from_translation(Vec3::new(r * a.cos(), lift, r * a.sin()))
             * Mat4::from_rotation_y(a * 1.7);
         add_object(
@@ -596,5 +603,7 @@ mod tests {
             .meshes
             .iter()
             .all(|m| !is_closed(&m.primitives[0].positions, &m.primitives[0].indices)));
+        // Nothing sinks below the ground (so, as in the sample, the ground shadows nothing).
+        assert!(s.bounds().min.y >= -1e-6, "{:?}", s.bounds());
     }
 }
