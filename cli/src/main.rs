@@ -391,6 +391,9 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
     }
     let mut grid = if a.quick { Grid::quick() } else { Grid::full() };
     grid.sdsm = a.depth_fit;
+    if !a.formats.is_empty() {
+        grid.formats = a.formats.iter().filter_map(|f| f.parse().ok()).collect();
+    }
     grid.pcss = a.light_size.is_some();
     let specs = if a.scenes.is_empty() {
         vec!["demo".to_string()]

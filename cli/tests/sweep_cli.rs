@@ -1,5 +1,6 @@
-//! `umbra sweep` end to end (lavapipe, validation on): the quick grid on the demo at a small size writes the CSV,
-//! the JSON and the charts, and a second run resumes from the CSV with nothing left to do.
+//! `umbra sweep` end to end (lavapipe, validation on): the quick grid on the demo at a small size
+//! (its format replaced by `--formats d16`) writes the CSV, the JSON and the charts, and a second
+//! run resumes from the CSV with nothing left to do.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -27,6 +28,8 @@ fn quick_sweep_writes_rows_and_charts_and_resumes() {
         "sweep",
         "demo",
         "--quick",
+        "--formats",
+        "d16",
         "--size",
         "96x54",
         "--repeat",
@@ -43,6 +46,12 @@ fn quick_sweep_writes_rows_and_charts_and_resumes() {
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     assert_eq!(csv.lines().count(), 49, "header + 48 rows");
     assert!(csv.starts_with("scene,view,config,method,filter,format,bias,map_texels"));
+    assert!(
+        csv.lines()
+            .skip(1)
+            .all(|l| l.split(',').nth(5) == Some("d16")),
+        "every row D16"
+    );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("sweep.json")).unwrap()).unwrap();
     assert_eq!(json["schema"], "umbra-sweep/1");

@@ -109,6 +109,10 @@ pub struct SweepArgs {
     /// The coarse grid (48 configurations instead of 576).
     #[arg(long)]
     pub quick: bool,
+    /// The map formats swept, comma-separated (`d16`, `d32`, `auto`); default: the grid's own
+    /// (D16 and D32, or D32 alone with --quick).
+    #[arg(long, value_delimiter = ',', value_parser = ["d16", "d32", "auto"])]
+    pub formats: Vec<String>,
     /// Also 4 cascades fitted to the depths each view sees (method `sdsm4`).
     #[arg(long)]
     pub depth_fit: bool,
