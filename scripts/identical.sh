@@ -11,7 +11,7 @@ out=${4:-$(mktemp -d)}
 export UMBRA_DEVICE="${UMBRA_DEVICE:-llvmpipe}"
 mkdir -p "$out/old" "$out/new"
 scenes=(demo)
-for s in double-sided town town-mover grazing stability room sun-and-spot two-suns lux-yard spheres:4; do
+for s in double-sided close-up town town-mover grazing stability room sun-and-spot two-suns lux-yard spheres:4; do
   scenes+=("--synthetic=$s")
 done
 if [ -n "$corpus" ]; then

@@ -381,8 +381,8 @@ impl OffscreenRenderer {
     /// `shadow_light`'s). Keyword settings as the command line's options: `shadows`,
     /// `shadow_map`, `shadow_format`, `pcf`, `cascades`, `depth_fit`, `fit`, `bias_constant`,
     /// `bias_slope`, `normal_offset`, `shadow_budget` (%), `shadow_light`, `light_size`,
-    /// `exposure`, `tonemap`, `ambient`, `background`, `sun_direction`, `sun_intensity`, `time`,
-    /// `animation`.
+    /// `exposure`, `tonemap`, `post_aa`, `ambient`, `background`, `sun_direction`,
+    /// `sun_intensity`, `time`, `animation`.
     #[pyo3(signature = (scene, camera, camera_pose, outputs = None, **settings))]
     fn render<'py>(
         &mut self,
