@@ -15,7 +15,9 @@ use crate::render::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
     PipelineDesc, Stencil,
 };
+use crate::render::samplers;
 use crate::render::targets::Attachment;
+use crate::scene::{Filter, Sampler, Wrap};
 use ash::vk;
 use std::sync::Arc;
 
@@ -51,18 +53,17 @@ impl PostAaPass {
         let set_layout = set_layout(ctx, sh::BINDINGS, 0, "post AA set layout")?;
         let layout = create_layout(ctx, &[set_layout], sh::IMMEDIATE_SIZE, "post AA layout")?;
         let module = create_module(ctx, sh::SPIRV, "post.wgsl")?;
+        // Bilinear, clamped to the edge, base level only: the glTF sampler of that meaning.
+        let filter = Sampler {
+            mag: Filter::Linear,
+            min: Filter::Linear,
+            mipmap: None,
+            wrap_u: Wrap::ClampToEdge,
+            wrap_v: Wrap::ClampToEdge,
+        };
         let sampler = unsafe {
-            ctx.device.create_sampler(
-                &vk::SamplerCreateInfo::default()
-                    .mag_filter(vk::Filter::LINEAR)
-                    .min_filter(vk::Filter::LINEAR)
-                    .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
-                    .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .max_lod(0.0),
-                None,
-            )
+            ctx.device
+                .create_sampler(&samplers::create_info(&filter, 1.0), None)
         }
         .vk("vkCreateSampler")?;
         Ok(Self {
@@ -184,9 +185,7 @@ impl PostAaPass {
             .attachment
             .transition(d, cmd, Access::FragmentSampled);
         let rcp = [1.0 / extent.width as f32, 1.0 / extent.height as f32];
-        let mut bytes = [0u8; 8];
-        bytes[..4].copy_from_slice(&rcp[0].to_le_bytes());
-        bytes[4..].copy_from_slice(&rcp[1].to_le_bytes());
+        let bytes: &[u8] = bytemuck::cast_slice(&rcp);
         // Pass 1 copies and marks (marks cleared to 0, so every pixel passes); pass 2 loads both.
         for (pipeline, first) in [(mark, true), (edges, false)] {
             target.transition(d, cmd, Access::ColorAttachment);
@@ -233,7 +232,7 @@ impl PostAaPass {
                     self.layout,
                     vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                     0,
-                    &bytes,
+                    bytes,
                 );
                 d.cmd_draw(cmd, 3, 1, 0, 0);
                 d.cmd_end_rendering(cmd);
