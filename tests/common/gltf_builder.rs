@@ -291,7 +291,7 @@ impl Builder {
                 )}),
                 Container::External => {
                     let file = format!("{name}_image{i}.png");
-                    std::fs::write(dir.join(&file), &png).unwrap();
+                    write_atomic(&dir.join(&file), &png);
                     json!({"uri": file})
                 }
             });
@@ -305,7 +305,7 @@ impl Builder {
             )}),
             Container::External => {
                 let file = format!("{name}.bin");
-                std::fs::write(dir.join(&file), &self.bin).unwrap();
+                write_atomic(&dir.join(&file), &self.bin);
                 json!({"byteLength": self.bin.len(), "uri": file})
             }
         };
@@ -355,16 +355,28 @@ impl Builder {
                 out.extend_from_slice(b"BIN\0");
                 out.extend_from_slice(&self.bin);
                 let p = dir.join(format!("{name}.glb"));
-                std::fs::write(&p, out).unwrap();
+                write_atomic(&p, &out);
                 p
             }
             _ => {
                 let p = dir.join(format!("{name}.gltf"));
-                std::fs::write(&p, text).unwrap();
+                write_atomic(&p, &text);
                 p
             }
         }
     }
+}
+
+/// Writes `bytes` to `path` through a uniquely named file and a rename, so a test that reads
+/// `path` while another test (run in parallel) writes the same model sees the old file or the
+/// new one, never a truncated one.
+fn write_atomic(path: &Path, bytes: &[u8]) {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    let tmp = path.with_extension(format!("tmp{}-{n}", std::process::id()));
+    std::fs::write(&tmp, bytes).unwrap();
+    std::fs::rename(&tmp, path).unwrap();
 }
 
 /// PNG bytes of an RGBA image.
