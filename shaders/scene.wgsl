@@ -241,7 +241,10 @@ fn heat(t: f32) -> vec3<f32> {
 @fragment
 fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let base = base_color(in.uv, in.color);
-    if material.extra.x > 0.0 && base.a < material.extra.x {
+    // The surfaces that cast and receive (the shadow pass's cutoff: a masked material's own, 0.5
+    // on a blended one, none on an opaque one): what lies behind a blended texel below the cutoff
+    // is judged, as the reference's receivers are.
+    if base.a < material.extra.y {
         discard;
     }
     let mode = frame.modes.x;

@@ -4,6 +4,7 @@
 pub mod anim;
 pub mod clusters;
 pub mod demo;
+pub mod foliage;
 pub mod framing;
 mod gltf_input;
 pub mod gltf_load;

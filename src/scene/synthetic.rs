@@ -550,7 +550,8 @@ pub fn lux_yard_scene() -> Scene {
     )
 }
 
-/// The generated scene called `name`: `double-sided`, `close-up`, `town`, `grazing`, `stability`, `room`,
+/// The generated scene called `name`: `double-sided`, `close-up`, `foliage`, `foliage-masked`,
+/// `town`, `grazing`, `stability`, `room`,
 /// `sun-and-spot`, `two-suns`, `lux-yard` or `spheres:N` (1 ≤ N ≤ 256); `None` for any other
 /// name.
 pub fn by_name(name: &str) -> Option<Scene> {
@@ -561,6 +562,8 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "lux-yard" => Some(lux_yard_scene()),
         "double-sided" => Some(double_sided_scene()),
         "close-up" => Some(close_up_scene()),
+        "foliage" => Some(super::foliage::foliage_scene(super::AlphaMode::Blend)),
+        "foliage-masked" => Some(super::foliage::foliage_scene(super::AlphaMode::Mask(0.5))),
         "town" => Some(town_scene()),
         "town-mover" => Some(town_mover_scene()),
         "grazing" => Some(grazing_scene()),

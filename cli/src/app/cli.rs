@@ -363,7 +363,9 @@ pub struct ViewArgs {
     pub no_culling: bool,
     /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided
     /// primitives), `close-up` (51k triangles of open, organic double-sided models filling a
-    /// third of a close view), `town` (2 km across, cameras at eye height and on a roof), `town-mover` (the town
+    /// third of a close view), `foliage` and `foliage-masked` (six trees of textured leaf cards,
+    /// blended or masked at 0.5, seen from a metre above the ground), `town` (2 km across,
+    /// cameras at eye height and on a roof), `town-mover` (the town
     /// with a person-sized box walking across the street: animation \"move\"), `grazing` (a sun 6° above the
     /// horizon over posts, spheres and crates), `stability` (a thin wall, a box, spheres and a
     /// torus: the stability suite's scene), `room` (a point light in a furnished room),

@@ -430,6 +430,17 @@ impl<'a> ReferenceScene<'a> {
             .intersect_where(ray, t_min, f32::INFINITY, &|h: &Hit| self.stops(h, false))
     }
 
+    /// The receiver seen through `h`, a blended texel below `BLEND_SHADOW_CUTOFF` (which
+    /// neither casts nor receives): the next surface along `ray` that would stop a shadow ray.
+    fn receiver_beyond(&self, ray: &Ray, h: &Hit) -> Option<Hit> {
+        self.bvh.intersect_where(
+            ray,
+            h.t * (1.0 + 1e-5) + self.eps,
+            f32::INFINITY,
+            &|h: &Hit| self.stops(h, true),
+        )
+    }
+
     /// The nearest surface along a primary ray.
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.intersect_from(ray, 0.0)
@@ -601,7 +612,11 @@ impl<'a> ReferenceScene<'a> {
             .par_iter()
             .map(|&(x, y)| {
                 let ray = primary_ray(plan, &inv, x, y, width, height);
-                let h = self.intersect(&ray)?;
+                // The receiver judged, as in `render`: blended texels below the cutoff let the
+                // ray through.
+                let h = self
+                    .bvh
+                    .intersect_where(&ray, 0.0, f32::INFINITY, &|h: &Hit| self.stops(h, true))?;
                 // The same normals, flips and facing test as `shade`.
                 let (ng, mut n_geo) = self.hit_normals(&h);
                 let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
@@ -659,6 +674,18 @@ impl<'a> ReferenceScene<'a> {
                         let (vis, cover, rgb) = self.shade(plan, &ray, &h, ambient);
                         let rgb = plan.display_surface(rgb, self.unlit(&h));
                         let rgb = self.blend_behind(plan, &ray, &h, rgb, ambient, 0);
+                        // The receiver judged: the first surface that would stop a shadow ray.
+                        let (h, vis, cover) = if self.stops(&h, true) {
+                            (h, vis, cover)
+                        } else {
+                            match self.receiver_beyond(&ray, &h) {
+                                None => return (None, f32::INFINITY, encode(rgb), false, 1.0),
+                                Some(r) => {
+                                    let (vis, cover, _) = self.shade(plan, &ray, &r, ambient);
+                                    (r, vis, cover)
+                                }
+                            }
+                        };
                         let (ng, n) = self.hit_normals(&h);
                         let incidence = plan.shadow_light.map_or(1.0, |i| {
                             let (_, flip) = face_viewer(ng, n, ray.dir);

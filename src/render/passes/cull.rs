@@ -53,7 +53,8 @@ pub enum Entry {
 
 impl Entry {
     /// The entry point for a draw of a material treating alpha as `alpha` in a lit or debug view
-    /// (debug views draw blended materials as opaque surfaces, like the reference's primary rays).
+    /// (debug views draw a blended material where it casts, alpha ≥ 0.5, as opaque: the receivers
+    /// the reference judges).
     pub fn of(alpha: AlphaDraw, debug_view: Option<Entry>) -> Entry {
         match (debug_view, alpha) {
             (Some(e), _) => e,
