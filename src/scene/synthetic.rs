@@ -550,6 +550,22 @@ pub fn lux_yard_scene() -> Scene {
     )
 }
 
+/// The names [`by_name`] knows, besides `spheres:N` (1 ≤ N ≤ 256).
+pub const NAMES: [&str; 12] = [
+    "double-sided",
+    "close-up",
+    "foliage",
+    "foliage-masked",
+    "town",
+    "town-mover",
+    "grazing",
+    "stability",
+    "room",
+    "sun-and-spot",
+    "two-suns",
+    "lux-yard",
+];
+
 /// The generated scene called `name`: `double-sided`, `close-up`, `foliage`, `foliage-masked`,
 /// `town`, `grazing`, `stability`, `room`,
 /// `sun-and-spot`, `two-suns`, `lux-yard` or `spheres:N` (1 ≤ N ≤ 256); `None` for any other
@@ -579,6 +595,14 @@ pub fn by_name(name: &str) -> Option<Scene> {
 mod tests {
     use super::*;
     use crate::scene::topology::is_closed;
+
+    #[test]
+    fn every_listed_name_builds_a_scene() {
+        for name in NAMES {
+            assert!(by_name(name).is_some(), "{name}");
+        }
+        assert!(by_name("spheres:3").is_some() && by_name("spheres:257").is_none());
+    }
 
     #[test]
     fn double_sided_scene_is_sized_like_the_sample() {

@@ -614,7 +614,8 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
         (None, None) => demo_scene(),
         (None, Some(name)) => umbra::scene::synthetic::by_name(name).ok_or_else(|| {
             anyhow!(
-                "--synthetic {name}: expected double-sided, town, town-mover, grazing, stability, room, sun-and-spot, two-suns, lux-yard or spheres:N with N in 1..=256"
+                "--synthetic {name}: expected {} or spheres:N with N in 1..=256",
+                umbra::scene::synthetic::NAMES.join(", ")
             )
         })?,
     };
