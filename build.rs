@@ -154,40 +154,44 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
         .iter()
         .map(|(_, o)| o.name.clone().unwrap_or_default())
         .collect();
-    if overrides.len() > 10 {
+    if overrides.len() > 11 {
         return Err(format!(
-            "{}:1:1: error: at most 10 boolean overrides (one SPIR-V per combination)",
+            "{}:1:1: error: at most 11 boolean overrides (one SPIR-V per combination)",
             path.display()
         ));
     }
-    // An override declared with a trailing `// requires OTHER` means nothing while OTHER is off:
-    // such combinations share the SPIR-V of the one with the override off too.
+    // An override declared with a trailing `// requires OTHER` means nothing while OTHER is off,
+    // and with `// requires OTHER; excludes A B` nothing while A or B is on either: such
+    // combinations share the SPIR-V of the one with the override off.
     let mut requires: Vec<Option<usize>> = vec![None; overrides.len()];
+    let mut excludes: Vec<Vec<usize>> = vec![Vec::new(); overrides.len()];
     for line in source.lines() {
         let l = line.trim_start();
-        let (Some(rest), Some((_, req))) =
+        let (Some(rest), Some((_, clause))) =
             (l.strip_prefix("override "), l.split_once("// requires "))
         else {
             continue;
         };
         let name = rest.split(':').next().unwrap_or("").trim();
+        let (req, excluded) = clause.split_once("; excludes ").unwrap_or((clause, ""));
         let req = req.split_whitespace().next().unwrap_or("");
-        let (Some(i), Some(r)) = (
-            overrides.iter().position(|o| o == name),
-            overrides.iter().position(|o| o == req),
-        ) else {
+        let position = |n: &str| overrides.iter().position(|o| o == n);
+        let excluded: Option<Vec<usize>> = excluded.split_whitespace().map(position).collect();
+        let (Some(i), Some(r), Some(x)) = (position(name), position(req), excluded) else {
             return Err(format!(
                 "{}:1:1: error: `{l}`: unknown override in a requires clause",
                 path.display()
             ));
         };
         requires[i] = Some(r);
+        excludes[i] = x;
     }
     let canonical = |mask: usize| {
         let mut m = mask;
         for (i, r) in requires.iter().enumerate() {
             if let Some(r) = r {
-                if (mask >> r) & 1 == 0 {
+                let off = (mask >> r) & 1 == 0 || excludes[i].iter().any(|x| (mask >> x) & 1 == 1);
+                if off {
                     m &= !(1 << i);
                 }
             }

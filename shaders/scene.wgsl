@@ -30,6 +30,9 @@ override PCF_BIT1: bool = false; // requires SHADOWS
 override MANY_VIEWS: bool = true; // requires SHADOWS
 // A shadowed light has a size (light.direction.w > 0): its lookups are PCSS soft shadows.
 override SOFT: bool = true; // requires SHADOWS
+// The shadowed light's visibility from the exact pass (shaders/exact.wgsl) where this fragment is
+// the receiver it judged; the map elsewhere (blended layers over it, MSAA edge samples).
+override EXACT: bool = false; // requires SHADOWS; excludes MANY_VIEWS SOFT
 
 // Bilinear taps per side of the PCF kernel (0 = one nearest comparison).
 fn pcf_taps() -> i32 {
@@ -52,6 +55,9 @@ struct Immediates {
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var shadow_map: texture_depth_2d_array;
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
+// Written by the exact pass (shaders/exact.wgsl `samples`): element 0 is (width, height, 0, 0),
+// element 1 + pixel the receiver's world position and verdict (1 lit, 0 blocked, -1 none).
+@group(0) @binding(3) var<storage, read> exact_samples: array<vec4<f32>>;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_color_tex: texture_2d<f32>;

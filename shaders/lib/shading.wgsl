@@ -41,6 +41,17 @@ struct Texels {
     emissive: vec3<f32>,
 }
 
+// The exact pass's verdict on the shadowed light at the pixel `frag` (1 lit, 0 blocked) when
+// the point `p` shaded there is the receiver it judged (the same position: the camera pass and the
+// receiver pass transform alike); -1 otherwise.
+fn exact_verdict(p: vec3<f32>, frag: vec2<f32>) -> f32 {
+    let size = exact_samples[0].xy;
+    let px = vec2<u32>(clamp(frag, vec2<f32>(0.0), max(size - vec2<f32>(1.0), vec2<f32>(0.0))));
+    let s = exact_samples[1u + px.y * u32(size.x) + px.x];
+    let tolerance = 1e-5 * distance(p, frame.camera_position.xyz) + 1e-7;
+    return select(-1.0, s.w, s.w >= 0.0 && distance(s.xyz, p) <= tolerance);
+}
+
 // Blinn-Phong with normal mapping and shadows for the fragment `in` of base colour `base`.
 fn shade(in: VsOut, front_facing: bool, base: vec4<f32>) -> Shaded {
     var t = Texels(vec3<f32>(0.5, 0.5, 1.0), vec4<f32>(1.0), vec3<f32>(1.0));
@@ -135,8 +146,16 @@ fn shade_texels(in: VsOut, front_facing: bool, base: vec4<f32>, texels: Texels) 
                     }
                 }
             } else if shown {
-                // The one shadowed light, view 0.
-                vis *= shadow_visibility(p, n_geo, l, light, 0, in.clip.xy);
+                // The one shadowed light, view 0; exactly where the exact pass judged this point.
+                var exact = -1.0;
+                if EXACT {
+                    exact = exact_verdict(p, in.clip.xy);
+                }
+                if exact >= 0.0 {
+                    vis *= exact;
+                } else {
+                    vis *= shadow_visibility(p, n_geo, l, light, 0, in.clip.xy);
+                }
                 cascade = 0;
             }
         }

@@ -22,6 +22,8 @@ pub enum Access {
     FragmentSampled,
     /// A depth image sampled in a fragment shader (shadow map lookups).
     DepthFragmentSampled,
+    /// Sampled (read with `textureLoad`) in a compute shader.
+    ComputeSampled,
     /// A swapchain image just acquired: its old contents are not needed, and the first use must
     /// wait at colour-attachment output, the stage the acquire semaphore is waited at.
     #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
@@ -71,6 +73,11 @@ pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk:
             S::FRAGMENT_SHADER,
             A::SHADER_SAMPLED_READ,
             vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
+        ),
+        Access::ComputeSampled => (
+            S::COMPUTE_SHADER,
+            A::SHADER_SAMPLED_READ,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
         ),
         Access::Acquired => (
             S::COLOR_ATTACHMENT_OUTPUT,
@@ -137,6 +144,23 @@ pub fn image_barrier(
         });
     let barriers = [barrier];
     let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+    unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
+}
+
+/// Records a global memory barrier: writes (and reads) of `src` stages before, accesses of
+/// `dst` after (storage buffers shared by passes, which have no layouts to track).
+pub fn memory_barrier(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(src.0)
+        .src_access_mask(src.1)
+        .dst_stage_mask(dst.0)
+        .dst_access_mask(dst.1)];
+    let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
     unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
 }
 

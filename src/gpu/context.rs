@@ -248,6 +248,9 @@ pub struct Context {
     pub anisotropy: bool,
     /// Valid bits of timestamps on the queue (0 = no timestamps).
     pub timestamp_valid_bits: u32,
+    /// Whether fragment shaders may write storage buffers (`fragmentStoresAndAtomics`, enabled
+    /// when the device has it): the exact shadow method needs it.
+    pub fragment_stores: bool,
     /// Validation messages (all zero when validation is off). Keep a clone to read the messages
     /// sent while the context is destroyed (leaks, destroy-time errors).
     pub validation_log: Arc<ValidationLog>,
@@ -313,11 +316,14 @@ impl Context {
         }
         let qf_props = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let timestamp_valid_bits = qf_props[queue_family as usize].timestamp_valid_bits;
+        let fragment_stores = unsafe { instance.get_physical_device_features(physical) }
+            .fragment_stores_and_atomics
+            == vk::TRUE;
         let device = create_device(
             &instance,
             physical,
             queue_family,
-            anisotropy,
+            (anisotropy, fragment_stores),
             desc.swapchain,
         )?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -370,6 +376,7 @@ impl Context {
             device_name,
             anisotropy,
             timestamp_valid_bits,
+            fragment_stores,
             validation_log: log,
             validation_enabled: enable_validation,
             pipeline_cache,
@@ -666,14 +673,16 @@ fn create_instance(
 }
 
 /// Creates the logical device with dynamic rendering, synchronization2 and depth clamp (and the
-/// swapchain extension when asked for).
+/// swapchain extension when asked for), and with sampler anisotropy and fragment-shader stores
+/// where `optional` says the device has them.
 fn create_device(
     instance: &InstanceOwner,
     physical: vk::PhysicalDevice,
     queue_family: u32,
-    anisotropy: bool,
+    optional: (bool, bool),
     swapchain: bool,
 ) -> Result<DeviceOwner, GpuError> {
+    let (anisotropy, fragment_stores) = optional;
     let priorities = [1.0f32];
     let queue_info = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(queue_family)
@@ -683,7 +692,8 @@ fn create_device(
         .synchronization2(true);
     let core = vk::PhysicalDeviceFeatures::default()
         .depth_clamp(true)
-        .sampler_anisotropy(anisotropy);
+        .sampler_anisotropy(anisotropy)
+        .fragment_stores_and_atomics(fragment_stores);
     let mut device_exts: Vec<*const i8> = Vec::new();
     if swapchain {
         device_exts.push(ash::khr::swapchain::NAME.as_ptr());

@@ -82,6 +82,18 @@ pub fn set_layout(
     group: u32,
     name: &str,
 ) -> Result<vk::DescriptorSetLayout, GpuError> {
+    let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+    set_layout_for(ctx, bindings, group, stages, name)
+}
+
+/// [`set_layout`] for the shader stages `stages`.
+pub fn set_layout_for(
+    ctx: &Context,
+    bindings: &[ReflectedBinding],
+    group: u32,
+    stages: vk::ShaderStageFlags,
+    name: &str,
+) -> Result<vk::DescriptorSetLayout, GpuError> {
     let vk_bindings: Vec<vk::DescriptorSetLayoutBinding> = bindings
         .iter()
         .filter(|b| b.group == group)
@@ -90,7 +102,7 @@ pub fn set_layout(
                 .binding(b.binding)
                 .descriptor_type(b.descriptor_type())
                 .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+                .stage_flags(stages)
         })
         .collect();
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&vk_bindings);
@@ -102,7 +114,10 @@ pub fn set_layout(
 
 // lavapipe (and the Vulkan minimum) allow 128 bytes of push constants.
 const _: () = assert!(
-    scene::IMMEDIATE_SIZE <= 128 && shadow::IMMEDIATE_SIZE <= 128 && post::IMMEDIATE_SIZE <= 128
+    scene::IMMEDIATE_SIZE <= 128
+        && shadow::IMMEDIATE_SIZE <= 128
+        && post::IMMEDIATE_SIZE <= 128
+        && exact::IMMEDIATE_SIZE <= 128
 );
 
 /// Creates a descriptor pool sized for `count` sets of `group` (descriptor counts taken from the

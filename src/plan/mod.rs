@@ -23,7 +23,7 @@ pub use input::{PlanScene, PlanTarget};
 pub use lights::{effective_lights, exposure_scale, metered_illuminance};
 pub use settings::{
     Ambient, Background, Exposure, HeldLight, Pcf, PostAa, SceneOptions, ShadowFit, ShadowFormat,
-    ShadowHold, ShadowSettings, Tonemap, View, ViewMode, AUTO_GROUND, AUTO_SKY, GROUND_TINT,
+    ShadowHold, ShadowMethod, ShadowSettings, Tonemap, View, ViewMode, AUTO_GROUND, AUTO_SKY, GROUND_TINT,
     MAX_CASCADES, SKY_TINT, UNIT_AMBIENT,
 };
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};

@@ -122,6 +122,31 @@ impl std::str::FromStr for ShadowFormat {
     }
 }
 
+/// How the shadowed light's visibility is decided.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ShadowMethod {
+    /// Shadow maps (the default): cascades, PCF or PCSS, bias.
+    #[default]
+    Map,
+    /// Exact hard shadows by an irregular z-buffer (`crate::render::passes::exact`): each pixel's
+    /// shadow ray tested against the caster triangles themselves, no bias, no texels. For one
+    /// shadowed directional or spot light with one view (the map's single cascade); frames where
+    /// that does not hold (a point light, several shadowed lights), and devices without
+    /// fragment-shader stores, use maps. Hard: a light's size is ignored.
+    Exact,
+}
+
+impl std::str::FromStr for ShadowMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "map" => Ok(Self::Map),
+            "exact" => Ok(Self::Exact),
+            _ => Err(format!("shadow method '{s}' is not map or exact")),
+        }
+    }
+}
+
 /// Anti-aliasing applied to the finished lit image (after any MSAA resolve).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum PostAa {
@@ -167,6 +192,8 @@ pub enum ShadowFit {
 pub struct ShadowSettings {
     /// Shadows on or off.
     pub enabled: bool,
+    /// Shadow maps or exact shadows.
+    pub method: ShadowMethod,
     /// Map size in texels (square), within [`ShadowSettings::MAP_SIZES`] (the renderer clamps
     /// other values into it).
     pub map_size: u32,
@@ -232,6 +259,7 @@ impl Default for ShadowSettings {
     fn default() -> Self {
         Self {
             enabled: true,
+            method: ShadowMethod::Map,
             map_size: 2048,
             format: ShadowFormat::Auto,
             pcf: Pcf::P2x2,

@@ -8,7 +8,7 @@ use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::scene as sh;
 use crate::math::shadow_fit::spot_near;
 use crate::plan::settings::{
-    Background, PostAa, SceneOptions, ShadowFormat, ShadowSettings, View, ViewMode,
+    Background, PostAa, SceneOptions, ShadowFormat, ShadowMethod, ShadowSettings, View, ViewMode,
 };
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
@@ -16,6 +16,7 @@ use crate::render::passes::camera_pass::{
     AovTargets, CameraFrame, CameraPass, CameraTargets, Resolve,
 };
 use crate::render::passes::cull::CameraCull;
+use crate::render::passes::exact::{ExactFrameInputs, ExactPass};
 use crate::render::passes::post_aa::PostAaPass;
 use crate::render::passes::receivers::ShadowReach;
 use crate::render::passes::shadow_pass::{plan_casters, ShadowPass};
@@ -38,6 +39,10 @@ pub struct FrameCore {
     pub camera: CameraPass,
     /// Post-process anti-aliasing (`View::post_aa`).
     post: PostAaPass,
+    /// Exact shadows (`ShadowMethod::Exact`), made by the first frame that asks for them.
+    exact: Option<ExactPass>,
+    /// Frames in flight (the exact pass's uniform slots).
+    slots: usize,
     /// Samples per pixel of the camera pass (`SceneOptions::msaa` resolved for the device).
     pub samples: u32,
     query_pool: vk::QueryPool,
@@ -94,6 +99,8 @@ impl FrameCore {
             shadow,
             camera,
             post,
+            exact: None,
+            slots,
             samples,
             query_pool,
             timestamps_written: vec![false; slots],
@@ -132,6 +139,15 @@ impl FrameCore {
         };
         let mut v = view.rebased(self.origin);
         v.shadow.map_size = map_size;
+        // Exact shadows judge every receiver pixel themselves: one view (the map's single
+        // cascade, for the pixels they do not judge) and hard.
+        let exact_asked = view.shadow.enabled
+            && view.shadow.method == ShadowMethod::Exact
+            && self.ctx.fragment_stores;
+        if exact_asked {
+            v.shadow.cascades = 1;
+            v.shadow.soft = false;
+        }
         let scene = PlanScene {
             lights: &self.lights,
             bounds: &self.gpu.bounds,
@@ -161,7 +177,6 @@ impl FrameCore {
         self.shadow.ensure_map(map_size, format, layers)?;
         self.shadow.ensure_masked(&self.gpu, format)?;
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
-        self.camera.bind_shadow_map(slot, map_view, hw);
         let casters = if plan.shadows_on {
             plan.shadow_views
                 .iter()
@@ -179,9 +194,17 @@ impl FrameCore {
         } else {
             Vec::new()
         };
-        let plan = plan.with_casters(casters);
-        self.camera.write_frame(slot, &plan.uniform)?;
+        let mut plan = plan.with_casters(casters);
         let extent = vk::Extent2D { width, height };
+        let exact = if exact_asked {
+            self.prepare_exact(slot, view, &mut plan, extent)?
+        } else {
+            None
+        };
+        let exact_samples = exact.as_ref().and(self.exact.as_ref().map(|e| e.samples()));
+        self.camera
+            .bind_shadow_map(slot, map_view, hw, exact_samples);
+        self.camera.write_frame(slot, &plan.uniform)?;
         let cull = camera_cull(view, &plan, extent, self.receiver_split);
         let sky = view.mode == ViewMode::Lit && plan.background == Background::Sky;
         let camera = self.camera.plan_frame(
@@ -198,6 +221,7 @@ impl FrameCore {
         }
         Ok(Prepared {
             post_aa,
+            exact,
             plan,
             camera,
             extent,
@@ -205,6 +229,53 @@ impl FrameCore {
             shadow: view.shadow,
             mode: view.mode,
         })
+    }
+
+    /// The exact pass's inputs for `plan` (and its shader bit set) when exact shadows apply: one
+    /// shadowed directional or spot light with one view. Makes the pass and its targets.
+    fn prepare_exact(
+        &mut self,
+        slot: usize,
+        view: &View,
+        plan: &mut FramePlan,
+        extent: vk::Extent2D,
+    ) -> Result<Option<ExactFrameInputs>, GpuError> {
+        if !plan.shadows_on
+            || plan.shadow_views.len() != 1
+            || plan.shader_variant & sh::BIT_SHADOWS == 0
+        {
+            return Ok(None);
+        }
+        let sv = &plan.shadow_views[0];
+        let (light, spot) = match plan.light_source(sv.light) {
+            Viewpoint::Eye(p) => (p, true),
+            Viewpoint::Along(d) => (d, false),
+        };
+        let cam = &view.camera;
+        let aspect = extent.width as f32 / extent.height.max(1) as f32;
+        let half = cam.half_extent_at(cam.near, aspect);
+        let inputs = ExactFrameInputs {
+            grid_from_world: sv.light_clip_from_world,
+            light,
+            spot,
+            // The CPU reference's ray offset: 2·10⁻⁵ of the scene's diagonal.
+            eps: (self.gpu.bounds.diagonal() * 2e-5).max(1e-6),
+            clip_from_world: plan.clip_from_world,
+            eye: (
+                plan.camera_position,
+                (cam.near * cam.near + half.length_squared()).sqrt(),
+            ),
+            receivers: (0..self.gpu.draws.len()).collect(),
+            casters: sv.casters.draws.clone(),
+        };
+        if self.exact.is_none() {
+            self.exact = Some(ExactPass::new(&self.ctx, &self.gpu, self.slots)?);
+        }
+        let pass = self.exact.as_mut().expect("made above");
+        pass.ensure(&self.gpu, extent)?;
+        pass.write_frame(slot, &inputs)?;
+        plan.shader_variant |= sh::BIT_EXACT;
+        Ok(Some(inputs))
     }
 
     /// Records the shadow pass and the camera pass of a prepared frame with timestamps (the
@@ -258,6 +329,9 @@ impl FrameCore {
         let casters = self
             .shadow
             .record(cmd, &self.gpu, &frame.shadow, &views, near);
+        if let (Some(inputs), Some(pass)) = (&frame.exact, self.exact.as_mut()) {
+            pass.record(cmd, slot, &self.gpu, inputs);
+        }
         unsafe {
             if timestamps {
                 d.cmd_write_timestamp2(
@@ -458,6 +532,8 @@ pub struct Prepared {
     mode: ViewMode,
     /// FXAA after the camera pass (`View::post_aa`, lit images only).
     post_aa: bool,
+    /// The exact shadow pass's inputs, when the frame runs it (`ShadowMethod::Exact`).
+    exact: Option<ExactFrameInputs>,
 }
 
 /// The images one frame is recorded into. With `msaa` the camera pass draws into its

@@ -593,7 +593,8 @@ impl GpuScene {
             draws.iter().map(|d| (d.material_bits, d.alpha)).collect();
         pipeline_keys.sort_unstable();
         pipeline_keys.dedup();
-        let vb = vk::BufferUsageFlags::VERTEX_BUFFER;
+        // Storage too: the exact shadow pass pulls caster triangles from them.
+        let vb = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
         // A scene that deforms rewrites its vertices each pose (`update_pose`): host-visible.
         let vertex_buffer = |name: &str, data: &[u8]| {
             if scene.deforms() {
@@ -610,7 +611,7 @@ impl GpuScene {
         let idx_buf = Buffer::device_local_with_data(
             ctx,
             "indices",
-            vk::BufferUsageFlags::INDEX_BUFFER,
+            vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
             bytemuck::cast_slice(&indices),
         )?;
 

@@ -427,6 +427,11 @@ pub struct ViewArgs {
     /// bias (a directional light's maps, most scenes), else D32.
     #[arg(long, value_parser = ["auto", "d32", "d16"], default_value = "auto")]
     pub shadow_format: String,
+    /// How shadows are decided: `map` (shadow maps, the default) or `exact` (each pixel's shadow
+    /// ray tested against the caster triangles on the device: exact hard shadows, no bias; one
+    /// shadowed directional or spot light, else maps).
+    #[arg(long, value_parser = ["map", "exact"], default_value = "map")]
+    pub shadow_method: String,
     /// PCF kernel (2x2 by default: on the demo, wider kernels cost more and measured no better
     /// against the ray-cast reference).
     #[arg(long, value_enum, default_value = "2x2")]
@@ -739,6 +744,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     }
     v.shadow = ShadowSettings {
         enabled: !a.no_shadows,
+        method: a.shadow_method.parse().unwrap_or_default(),
         map_size: a.shadow_map,
         format: a.shadow_format.parse().unwrap_or(ShadowFormat::Auto),
         pcf: pcf_of(a.pcf),

@@ -34,6 +34,10 @@ struct Slot {
     buffer: Buffer,
     set: vk::DescriptorSet,
     bound_map: vk::ImageView,
+    /// The exact pass's sample buffer bound (`exact_samples`), or the pass's empty one.
+    bound_exact: vk::Buffer,
+    /// An empty sample list (no exact pass has run), so the binding is always written.
+    no_exact: Buffer,
 }
 
 /// The camera pass for one colour format.
@@ -129,10 +133,20 @@ impl CameraPass {
                 vk::BufferUsageFlags::UNIFORM_BUFFER,
                 MemoryLocation::CpuToGpu,
             )?;
+            let mut no_exact = Buffer::new(
+                ctx,
+                &format!("exact samples (none) {i}"),
+                16,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?;
+            no_exact.write(0, bytemuck::cast_slice(&[0f32; 4]))?;
             slot_list.push(Slot {
                 buffer,
                 set,
                 bound_map: vk::ImageView::null(),
+                bound_exact: vk::Buffer::null(),
+                no_exact,
             });
         }
         // Comparison samplers: reversed-z, so "lit" is reference >= stored.
@@ -301,11 +315,23 @@ impl CameraPass {
 
     /// Points slot `slot`'s set at the shadow map. Every binding is written (lavapipe crashes on
     /// unwritten descriptors, used or not). The slot's previous frame must have completed.
-    pub fn bind_shadow_map(&mut self, slot: usize, view: vk::ImageView, hardware_filtering: bool) {
+    pub fn bind_shadow_map(
+        &mut self,
+        slot: usize,
+        view: vk::ImageView,
+        hardware_filtering: bool,
+        exact: Option<vk::Buffer>,
+    ) {
         let s = &mut self.slots[slot];
-        if view == s.bound_map {
+        let exact = exact.unwrap_or(s.no_exact.raw);
+        if view == s.bound_map && exact == s.bound_exact {
             return;
         }
+        let samples = [vk::DescriptorBufferInfo {
+            buffer: exact,
+            offset: 0,
+            range: vk::WHOLE_SIZE,
+        }];
         let buf = [vk::DescriptorBufferInfo {
             buffer: s.buffer.raw,
             offset: 0,
@@ -337,9 +363,11 @@ impl CameraPass {
             w(&sh::FRAME).buffer_info(&buf),
             w(&sh::SHADOW_MAP).image_info(&img),
             w(&sh::SHADOW_SAMPLER).image_info(&samp),
+            w(&sh::EXACT_SAMPLES).buffer_info(&samples),
         ];
         unsafe { self.ctx.device.update_descriptor_sets(&writes, &[]) };
         s.bound_map = view;
+        s.bound_exact = exact;
     }
 
     /// Writes slot `slot`'s frame uniforms (its previous frame must have completed).

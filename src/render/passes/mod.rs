@@ -4,6 +4,7 @@
 pub(crate) mod camera_pass;
 pub(crate) mod cull;
 pub(crate) mod deferred;
+pub(crate) mod exact;
 pub(crate) mod post_aa;
 pub(crate) mod receivers;
 pub(crate) mod screen;

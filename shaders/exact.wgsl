@@ -1,0 +1,339 @@
+// Exact hard shadows by an irregular z-buffer (Johnson et al. 2005; Wyman, Hoetzlein and Lefohn,
+// "Frustum-traced raster shadows", 2015), for the frame's shadowed light (src/render/passes/exact.rs).
+//
+// 1. vs_receiver / fs_receiver: the camera's receivers (what casts and is judged: the shadow
+//    pass's alpha cutoff) into two images, world position and face normal, one texel per pixel.
+// 2. cs_build: each covered pixel is one sample: its shadow ray's origin (off the surface on the
+//    light's side by `eps`, as the CPU reference starts its rays) is projected into the light's
+//    view and pushed onto that grid cell's list (a head per cell, a next per sample).
+// 3. vs_caster / fs_caster: every caster triangle, pulled from the scene's buffers, is drawn into
+//    the grid dilated by half a cell (so every cell it touches runs a fragment); each fragment
+//    walks its cell's samples and intersects each one's shadow ray with the exact triangle
+//    (Moller-Trumbore; the alpha texture at the hit for masked and blended casters), marking the
+//    samples it blocks. No bias, no texels in the answer: the grid only sorts the work.
+// The camera pass reads the result at its pixel where its fragment is the receiver (scene.wgsl).
+
+#include "lib/material.wgsl"
+
+struct ExactFrame {
+    // The grid: the shadowed light's view (clip space).
+    grid_from_world: mat4x4<f32>,
+    // xyz: the direction a directional light's rays travel, or a spot light's position;
+    // w: LIGHT_DIRECTIONAL or LIGHT_SPOT.
+    light: vec4<f32>,
+    // x: ray offset eps (world units), y: grid side in cells, z: image width, w: image height.
+    params: vec4<f32>,
+}
+
+const LIGHT_DIRECTIONAL: f32 = 0.0;
+const LIGHT_SPOT: f32 = 2.0;
+// Words per vertex of the scene's attribute stream (src/render/gpu_scene.rs VertexAttributes:
+// normal 3, uv 2, tangent 4, colour 2 (four u16), uv1 2).
+const ATTRIBUTE_WORDS: u32 = 13u;
+// A sample whose shadow ray a caster blocks (`samples[i].w`); 1 is lit, -1 no surface.
+const OCCLUDED: f32 = 0.0;
+
+@group(0) @binding(0) var<uniform> xf: ExactFrame;
+@group(0) @binding(1) var<storage, read_write> heads: array<atomic<u32>>;
+@group(0) @binding(2) var<storage, read_write> next: array<u32>;
+// Element 0: (width, height, 0, 0); element 1 + i: pixel i's (world position, verdict).
+@group(0) @binding(3) var<storage, read_write> samples: array<vec4<f32>>;
+// Per sample: (shadow ray origin, farthest hit distance).
+@group(0) @binding(4) var<storage, read_write> rays: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> positions: array<f32>;
+@group(0) @binding(6) var<storage, read> indices: array<u32>;
+@group(0) @binding(7) var<storage, read> attributes: array<u32>;
+@group(0) @binding(8) var receiver_position: texture_2d<f32>;
+@group(0) @binding(9) var receiver_normal: texture_2d<f32>;
+
+@group(1) @binding(0) var<uniform> material: Material;
+@group(1) @binding(1) var base_color_tex: texture_2d<f32>;
+@group(1) @binding(5) var base_color_sampler: sampler;
+
+// 128 bytes: the receiver pass's camera and model transforms; the caster pass reads the first
+// matrix as its model transform and the rest as `CasterImmediates`.
+struct ExactImmediates {
+    world_from_model: mat4x4<f32>,
+    // Receiver pass: the camera's clip_from_world. Caster pass: x = first index, y = vertex
+    // offset (bit-cast i32), z = 1 when the caster's alpha is tested, w unused.
+    extra: mat4x4<f32>,
+}
+
+var<immediate> pc: ExactImmediates;
+
+// ---- 1. Receivers ----
+
+struct ReceiverIn {
+    @location(0) position: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(4) color: vec4<f32>,
+    @location(5) uv1: vec2<f32>,
+}
+
+struct ReceiverOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) uv: vec4<f32>,
+    @location(2) alpha: f32,
+}
+
+// The camera pass's vs_main transform, operation for operation, so the positions agree.
+@vertex
+fn vs_receiver(v: ReceiverIn) -> ReceiverOut {
+    var out: ReceiverOut;
+    let world = pc.world_from_model * vec4<f32>(v.position, 1.0);
+    out.world_position = world.xyz;
+    out.clip = pc.extra * world;
+    out.uv = vec4<f32>(v.uv, v.uv1);
+    out.alpha = v.color.a;
+    return out;
+}
+
+struct ReceiverTargets {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+}
+
+@fragment
+fn fs_receiver(in: ReceiverOut) -> ReceiverTargets {
+    // The face's normal: the gradient of the interpolated position across the triangle.
+    let ng = normalize(cross(dpdx(in.world_position), dpdy(in.world_position)));
+    // The camera pass's base colour alpha (mipmapped), against the shadow cutoff (fs_debug).
+    let alpha = in.alpha * material.base_color.a * textureSample(base_color_tex, base_color_sampler, slot_uv(0u, in.uv)).a;
+    if alpha < material.extra.y {
+        discard;
+    }
+    var out: ReceiverTargets;
+    out.position = vec4<f32>(in.world_position, 1.0);
+    out.normal = vec4<f32>(ng, 0.0);
+    return out;
+}
+
+// ---- 2. Binning ----
+
+// The grid cell of world point `p`, or the cell count (none) outside the light's view.
+fn cell_of(p: vec3<f32>) -> u32 {
+    let g = u32(xf.params.y);
+    let c = xf.grid_from_world * vec4<f32>(p, 1.0);
+    if c.w <= 0.0 {
+        return g * g;
+    }
+    let ndc = c.xy / c.w;
+    if abs(ndc.x) > 1.0 || abs(ndc.y) > 1.0 {
+        return g * g;
+    }
+    // Framebuffer rows run down (naga flips clip y on the way out of a vertex shader).
+    let t = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * f32(g);
+    let cell = min(vec2<u32>(t), vec2<u32>(g - 1u));
+    return cell.y * g + cell.x;
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = u32(xf.params.z);
+    let h = u32(xf.params.w);
+    if id.x >= w || id.y >= h {
+        return;
+    }
+    let i = id.y * w + id.x;
+    if i == 0u {
+        samples[0] = vec4<f32>(f32(w), f32(h), 0.0, 0.0);
+    }
+    let pos = textureLoad(receiver_position, vec2<i32>(id.xy), 0);
+    if pos.w <= 0.0 {
+        samples[i + 1u] = vec4<f32>(pos.xyz, -1.0);
+        return;
+    }
+    let p = pos.xyz;
+    var dir = -xf.light.xyz;
+    var reach = 3.0e38;
+    if xf.light.w == LIGHT_SPOT {
+        let d = xf.light.xyz - p;
+        reach = length(d);
+        dir = d / max(reach, 1e-20);
+    }
+    // Off the surface, on the light's side of the face (the reference's shadow ray origin).
+    let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
+    let side = select(-ng, ng, dot(ng, dir) >= 0.0);
+    let eps = xf.params.x;
+    let origin = p + side * eps;
+    samples[i + 1u] = vec4<f32>(p, 1.0);
+    rays[i] = vec4<f32>(origin, reach - eps);
+    let cell = cell_of(origin);
+    let g = u32(xf.params.y);
+    if cell < g * g {
+        next[i] = atomicExchange(&heads[cell], i + 1u);
+    }
+}
+
+// ---- 3. Casters ----
+
+struct CasterOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) @interpolate(flat) v0: vec3<f32>,
+    @location(1) @interpolate(flat) v1: vec3<f32>,
+    @location(2) @interpolate(flat) v2: vec3<f32>,
+    // The triangle's cells (x0, y0, x1, y1), inclusive: fragments of the dilated triangle
+    // outside them have nothing to test.
+    @location(3) @interpolate(flat) cells: vec4<f32>,
+    @location(4) @interpolate(flat) uv0: vec4<f32>,
+    @location(5) @interpolate(flat) uv1: vec4<f32>,
+    @location(6) @interpolate(flat) uv2: vec4<f32>,
+    @location(7) @interpolate(flat) alpha: vec3<f32>,
+}
+
+fn vertex_index_of(tri: u32, k: u32) -> u32 {
+    let first = bitcast<u32>(pc.extra[0].x);
+    let offset = bitcast<i32>(pc.extra[0].y);
+    return u32(i32(indices[first + tri * 3u + k]) + offset);
+}
+
+fn world_vertex(v: u32) -> vec3<f32> {
+    let p = vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
+    return (pc.world_from_model * vec4<f32>(p, 1.0)).xyz;
+}
+
+// TEXCOORD_0 and TEXCOORD_1 of vertex `v`.
+fn vertex_uvs(v: u32) -> vec4<f32> {
+    let a = ATTRIBUTE_WORDS * v;
+    return vec4<f32>(
+        bitcast<f32>(attributes[a + 3u]),
+        bitcast<f32>(attributes[a + 4u]),
+        bitcast<f32>(attributes[a + 11u]),
+        bitcast<f32>(attributes[a + 12u]),
+    );
+}
+
+// COLOR_0's alpha of vertex `v` (the high 16 bits of the colour's second word, unorm).
+fn vertex_alpha(v: u32) -> f32 {
+    return f32(attributes[ATTRIBUTE_WORDS * v + 10u] >> 16u) / 65535.0;
+}
+
+// Where the lines n_a·x = d_a and n_b·x = d_b meet.
+fn meet(na: vec2<f32>, da: f32, nb: vec2<f32>, db: f32) -> vec2<f32> {
+    let det = na.x * nb.y - na.y * nb.x;
+    return vec2<f32>(da * nb.y - db * na.y, na.x * db - nb.x * da) / det;
+}
+
+@vertex
+fn vs_caster(@builtin(vertex_index) vi: u32) -> CasterOut {
+    var out: CasterOut;
+    let tri = vi / 3u;
+    let corner = vi % 3u;
+    let i0 = vertex_index_of(tri, 0u);
+    let i1 = vertex_index_of(tri, 1u);
+    let i2 = vertex_index_of(tri, 2u);
+    out.v0 = world_vertex(i0);
+    out.v1 = world_vertex(i1);
+    out.v2 = world_vertex(i2);
+    out.uv0 = vertex_uvs(i0);
+    out.uv1 = vertex_uvs(i1);
+    out.uv2 = vertex_uvs(i2);
+    out.alpha = vec3<f32>(vertex_alpha(i0), vertex_alpha(i1), vertex_alpha(i2));
+    let g = xf.params.y;
+    let c0 = xf.grid_from_world * vec4<f32>(out.v0, 1.0);
+    let c1 = xf.grid_from_world * vec4<f32>(out.v1, 1.0);
+    let c2 = xf.grid_from_world * vec4<f32>(out.v2, 1.0);
+    if min(c0.w, min(c1.w, c2.w)) <= 1e-6 {
+        // Crossing a spot light's plane: the whole grid tests it (one triangle covering the
+        // viewport), which is slow but exact.
+        let full = array<vec2<f32>, 3>(vec2<f32>(-1.0, -1.0), vec2<f32>(3.0, -1.0), vec2<f32>(-1.0, 3.0));
+        out.clip = vec4<f32>(full[corner], 0.5, 1.0);
+        out.cells = vec4<f32>(0.0, 0.0, g - 1.0, g - 1.0);
+        return out;
+    }
+    let p = array<vec2<f32>, 3>(c0.xy / c0.w, c1.xy / c1.w, c2.xy / c2.w);
+    let area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+    if abs(area) < 1e-12 {
+        // Edge-on to the light: it blocks no ray (the ray test's determinant is 0 too).
+        out.clip = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return out;
+    }
+    // Each edge's line moved outwards by half a cell's support along its normal (the Minkowski
+    // sum with a cell is inside the triangle these lines bound), in NDC (a cell is 2/g).
+    let half = 1.0 / g;
+    var n: array<vec2<f32>, 3>;
+    var d: array<f32, 3>;
+    for (var e = 0u; e < 3u; e++) {
+        let a = p[e];
+        let b = p[(e + 1u) % 3u];
+        var ne = normalize(vec2<f32>(b.y - a.y, a.x - b.x));
+        if area < 0.0 {
+            ne = -ne;
+        }
+        n[e] = ne;
+        d[e] = dot(ne, a) + half * (abs(ne.x) + abs(ne.y));
+    }
+    // Corner k lies where the lines of edges k - 1 and k meet.
+    let prev = (corner + 2u) % 3u;
+    let q = meet(n[prev], d[prev], n[corner], d[corner]);
+    out.clip = vec4<f32>(q, 0.5, 1.0);
+    // Cells of the undilated triangle's box (rows down, as cell_of).
+    let lo = min(p[0], min(p[1], p[2]));
+    let hi = max(p[0], max(p[1], p[2]));
+    let x0 = floor((lo.x * 0.5 + 0.5) * g);
+    let x1 = floor((hi.x * 0.5 + 0.5) * g);
+    let y0 = floor((0.5 - hi.y * 0.5) * g);
+    let y1 = floor((0.5 - lo.y * 0.5) * g);
+    out.cells = vec4<f32>(x0, y0, x1, y1);
+    return out;
+}
+
+@fragment
+fn fs_caster(in: CasterOut) {
+    let g = u32(xf.params.y);
+    let cell = vec2<f32>(floor(in.clip.xy));
+    if cell.x < in.cells.x || cell.y < in.cells.y || cell.x > in.cells.z || cell.y > in.cells.w {
+        return;
+    }
+    let e1 = in.v1 - in.v0;
+    let e2 = in.v2 - in.v0;
+    let tested = pc.extra[0].z > 0.5;
+    var s = atomicLoad(&heads[u32(cell.y) * g + u32(cell.x)]);
+    loop {
+        if s == 0u {
+            break;
+        }
+        let i = s - 1u;
+        s = next[i];
+        if samples[i + 1u].w == OCCLUDED {
+            continue;
+        }
+        let ray = rays[i];
+        var dir = -xf.light.xyz;
+        if xf.light.w == LIGHT_SPOT {
+            dir = normalize(xf.light.xyz - ray.xyz);
+        }
+        // Moller-Trumbore, as the reference's BVH intersects.
+        let pv = cross(dir, e2);
+        let det = dot(e1, pv);
+        if abs(det) < 1e-20 {
+            continue;
+        }
+        let inv = 1.0 / det;
+        let tv = ray.xyz - in.v0;
+        let u = dot(tv, pv) * inv;
+        if u < 0.0 || u > 1.0 {
+            continue;
+        }
+        let qv = cross(tv, e1);
+        let v = dot(dir, qv) * inv;
+        if v < 0.0 || u + v > 1.0 {
+            continue;
+        }
+        let t = dot(e2, qv) * inv;
+        if t <= xf.params.x || t >= ray.w {
+            continue;
+        }
+        if tested {
+            let w0 = 1.0 - u - v;
+            let uv = in.uv0 * w0 + in.uv1 * u + in.uv2 * v;
+            let a = (in.alpha.x * w0 + in.alpha.y * u + in.alpha.z * v) * material.base_color.a
+                * textureSampleLevel(base_color_tex, base_color_sampler, slot_uv(0u, uv), 0.0).a;
+            if a < material.extra.y {
+                continue;
+            }
+        }
+        samples[i + 1u].w = OCCLUDED;
+    }
+}

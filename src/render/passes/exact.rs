@@ -1,0 +1,542 @@
+//! Exact hard shadows by an irregular z-buffer ([`crate::plan::ShadowMethod::Exact`]): the
+//! shadowed light's visibility at each pixel's receiver, decided by intersecting its shadow ray
+//! with the caster triangles themselves, on the device (`shaders/exact.wgsl`).
+//!
+//! Three steps after the shadow pass: the camera's receivers (what casts and is judged: the
+//! alpha cutoff of the shadow pass) are drawn into a position and a face-normal image; a compute
+//! pass makes each covered pixel a sample and links it into the list of the light-view grid cell
+//! its shadow ray starts in; every caster triangle is drawn into that grid, dilated by half a
+//! cell so that each cell it touches runs a fragment, and each fragment tests the cell's samples
+//! against the exact triangle (and its alpha texture). The camera pass then reads the verdict at
+//! its pixel where its fragment is that receiver, and the shadow map elsewhere (blended layers
+//! over the receiver, MSAA's edge samples). The grid only sorts the work: its size changes the
+//! cost, not the answer.
+//!
+//! The images and buffers are made on first use and remade when the image size changes; they are
+//! shared by the frames in flight (each frame's barriers order it after the previous one's use).
+
+use crate::gpu::barrier::{memory_barrier, Access};
+use crate::gpu::context::{Context, GpuError};
+use crate::gpu::resources::Buffer;
+use crate::gpu::shaders::{allocate_sets, create_module, exact as sh, set_layout_for};
+use crate::gpu::Image;
+use crate::plan::Viewpoint;
+use crate::render::gpu_scene::{vertex_layout, GpuScene};
+use crate::render::pipeline::{
+    create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
+    PipelineDesc, Stencil,
+};
+use crate::render::targets::Attachment;
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3, Vec4};
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+/// Cells per side of the light-view grid the samples are sorted into.
+pub const GRID: u32 = 1024;
+
+const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// `ExactFrame` of `shaders/exact.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ExactFrame {
+    grid_from_world: Mat4,
+    light: Vec4,
+    params: Vec4,
+}
+
+/// `ExactImmediates` of `shaders/exact.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ExactImmediates {
+    world_from_model: Mat4,
+    extra: Mat4,
+}
+
+/// What one frame's exact pass needs from its plan.
+pub struct ExactFrameInputs {
+    /// The light's view (clip from world) the grid covers.
+    pub grid_from_world: Mat4,
+    /// The direction a directional light's rays travel, or a spot light's position.
+    pub light: Vec3,
+    /// A spot light (else directional).
+    pub spot: bool,
+    /// Shadow rays start this far off the surface and ignore hits nearer (world units).
+    pub eps: f32,
+    /// The camera's clip from world.
+    pub clip_from_world: Mat4,
+    /// The camera's position and near-plane reach (back-face culling, as the camera pass).
+    pub eye: (Vec3, f32),
+    /// Draws the receivers pass draws (the camera pass's visible draws).
+    pub receivers: Vec<usize>,
+    /// Draws that cast.
+    pub casters: Vec<usize>,
+}
+
+/// The images and buffers of one image size.
+struct Targets {
+    extent: vk::Extent2D,
+    _position: Image,
+    _normal: Image,
+    _depth: Image,
+    position: Attachment,
+    normal: Attachment,
+    depth: Attachment,
+    heads: Buffer,
+    next: Buffer,
+    samples: Buffer,
+    rays: Buffer,
+}
+
+/// The exact shadow pass.
+pub struct ExactPass {
+    ctx: Arc<Context>,
+    set_layout: vk::DescriptorSetLayout,
+    layout: vk::PipelineLayout,
+    module: vk::ShaderModule,
+    receiver: vk::Pipeline,
+    build: vk::Pipeline,
+    caster: vk::Pipeline,
+    pool: vk::DescriptorPool,
+    sets: Vec<vk::DescriptorSet>,
+    uniforms: Vec<Buffer>,
+    targets: Option<Targets>,
+    /// A buffer the camera pass binds when no frame has run the pass (its binding must be
+    /// written); shaped like an empty sample list.
+    empty: Buffer,
+}
+
+impl ExactPass {
+    /// The pass for `scene` (its material set layout at set 1) with `slots` frames in flight.
+    pub fn new(ctx: &Arc<Context>, scene: &GpuScene, slots: usize) -> Result<Self, GpuError> {
+        let stages = vk::ShaderStageFlags::VERTEX
+            | vk::ShaderStageFlags::FRAGMENT
+            | vk::ShaderStageFlags::COMPUTE;
+        let set_layout = set_layout_for(ctx, sh::BINDINGS, 0, stages, "exact set layout")?;
+        let layout = create_layout(
+            ctx,
+            &[set_layout, scene.material_layout],
+            sh::IMMEDIATE_SIZE,
+            "exact layout",
+        )?;
+        let module = create_module(ctx, sh::SPIRV, "exact.wgsl")?;
+        let (bindings, all) = vertex_layout();
+        let attributes = [all[0], all[2], all[4], all[5]];
+        let receiver = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "exact receivers",
+                layout,
+                vertex: (module, sh::ENTRY_VS_RECEIVER),
+                fragment: Some((module, sh::ENTRY_FS_RECEIVER)),
+                bindings: &bindings,
+                attributes: &attributes,
+                color_formats: &[POSITION_FORMAT, POSITION_FORMAT],
+                depth_format: DEPTH_FORMAT,
+                stencil: Stencil::Off,
+                depth_clamp: false,
+                depth_bias: false,
+                depth: Depth::Test,
+                blend: ColorBlend::Off,
+                samples: 1,
+            },
+        )?;
+        let caster = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "exact casters",
+                layout,
+                vertex: (module, sh::ENTRY_VS_CASTER),
+                fragment: Some((module, sh::ENTRY_FS_CASTER)),
+                bindings: &[],
+                attributes: &[],
+                color_formats: &[],
+                depth_format: vk::Format::UNDEFINED,
+                stencil: Stencil::Off,
+                depth_clamp: false,
+                depth_bias: false,
+                depth: Depth::Off,
+                blend: ColorBlend::Off,
+                samples: 1,
+            },
+        )?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(sh::ENTRY_CS_BUILD);
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(layout);
+        let build = unsafe {
+            ctx.device
+                .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
+        }
+        .map_err(|(_, e)| GpuError::Vk {
+            call: "vkCreateComputePipelines",
+            result: e,
+        })?[0];
+        ctx.set_name(build, "exact build");
+        let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, set_layout, slots)?;
+        let uniforms = (0..slots)
+            .map(|i| {
+                Buffer::new(
+                    ctx,
+                    &format!("exact frame {i}"),
+                    std::mem::size_of::<ExactFrame>() as u64,
+                    vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    MemoryLocation::CpuToGpu,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut empty = Buffer::new(
+            ctx,
+            "exact samples (none)",
+            16,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        empty.write(0, bytemuck::cast_slice(&[0f32; 4]))?;
+        Ok(Self {
+            ctx: ctx.clone(),
+            set_layout,
+            layout,
+            module,
+            receiver,
+            build,
+            caster,
+            pool,
+            sets,
+            uniforms,
+            targets: None,
+            empty,
+        })
+    }
+
+    /// The sample buffer the camera pass reads (the empty one before the first exact frame).
+    pub fn samples(&self) -> vk::Buffer {
+        self.targets
+            .as_ref()
+            .map_or(self.empty.raw, |t| t.samples.raw)
+    }
+
+    /// Makes the images and buffers for `extent` (and writes every slot's set), if not made yet.
+    pub fn ensure(&mut self, scene: &GpuScene, extent: vk::Extent2D) -> Result<(), GpuError> {
+        if self.targets.as_ref().is_some_and(|t| t.extent == extent) {
+            return Ok(());
+        }
+        self.targets = None;
+        let ctx = &self.ctx;
+        let image = |name: &str, format, usage| Image::new(ctx, name, format, extent, 1, usage);
+        let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let position = image("exact receiver positions", POSITION_FORMAT, color)?;
+        let normal = image("exact receiver normals", POSITION_FORMAT, color)?;
+        let depth = image(
+            "exact receiver depth",
+            DEPTH_FORMAT,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        )?;
+        let pixels = (extent.width * extent.height) as u64;
+        let storage = |name: &str, size: u64| {
+            Buffer::new(
+                ctx,
+                name,
+                size,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )
+        };
+        let t = Targets {
+            extent,
+            position: Attachment::of(&position),
+            normal: Attachment::of(&normal),
+            depth: Attachment::of(&depth),
+            _position: position,
+            _normal: normal,
+            _depth: depth,
+            heads: storage("exact grid heads", (GRID * GRID) as u64 * 4)?,
+            next: storage("exact sample links", pixels * 4)?,
+            samples: storage("exact samples", (pixels + 1) * 16)?,
+            rays: storage("exact shadow rays", pixels * 16)?,
+        };
+        for (slot, &set) in self.sets.iter().enumerate() {
+            let buffer = |b: &Buffer| {
+                [vk::DescriptorBufferInfo {
+                    buffer: b.raw,
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                }]
+            };
+            let image = |view| {
+                [vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }]
+            };
+            let buffers = [
+                (sh::XF, buffer(&self.uniforms[slot])),
+                (sh::HEADS, buffer(&t.heads)),
+                (sh::NEXT, buffer(&t.next)),
+                (sh::SAMPLES, buffer(&t.samples)),
+                (sh::RAYS, buffer(&t.rays)),
+                (sh::POSITIONS, buffer(&scene.positions)),
+                (sh::INDICES, buffer(&scene.indices)),
+                (sh::ATTRIBUTES, buffer(&scene.attributes)),
+            ];
+            let images = [
+                (sh::RECEIVER_POSITION, image(t.position.view)),
+                (sh::RECEIVER_NORMAL, image(t.normal.view)),
+            ];
+            let mut writes: Vec<vk::WriteDescriptorSet> = buffers
+                .iter()
+                .map(|(b, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(b.binding)
+                        .descriptor_type(b.descriptor_type())
+                        .buffer_info(info)
+                })
+                .collect();
+            writes.extend(images.iter().map(|(b, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(b.binding)
+                    .descriptor_type(b.descriptor_type())
+                    .image_info(info)
+            }));
+            unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        }
+        self.targets = Some(t);
+        Ok(())
+    }
+
+    /// Writes slot `slot`'s frame uniform (its previous frame must have completed).
+    pub fn write_frame(&mut self, slot: usize, f: &ExactFrameInputs) -> Result<(), GpuError> {
+        let extent = self.targets.as_ref().map_or(vk::Extent2D::default(), |t| t.extent);
+        let u = ExactFrame {
+            grid_from_world: f.grid_from_world,
+            light: f.light.extend(if f.spot {
+                crate::gpu::shaders::scene::LIGHT_SPOT
+            } else {
+                crate::gpu::shaders::scene::LIGHT_DIRECTIONAL
+            }),
+            params: Vec4::new(
+                f.eps,
+                GRID as f32,
+                extent.width as f32,
+                extent.height as f32,
+            ),
+        };
+        self.uniforms[slot].write(0, bytemuck::bytes_of(&u))
+    }
+
+    /// Records the three steps for slot `slot` (after [`ExactPass::ensure`] and
+    /// [`ExactPass::write_frame`]); the samples are then ready for the camera pass's fragment
+    /// shaders.
+    pub fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        scene: &GpuScene,
+        f: &ExactFrameInputs,
+    ) {
+        let ctx = self.ctx.clone();
+        let d = &ctx.device;
+        let set = self.sets[slot];
+        let t = self.targets.as_mut().expect("exact targets made by ensure");
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        // The previous frame's reads and writes of the lists and samples come first.
+        memory_barrier(
+            d,
+            cmd,
+            (
+                S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ),
+            (
+                S::ALL_TRANSFER | S::COMPUTE_SHADER,
+                A::TRANSFER_WRITE | A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ),
+        );
+        unsafe { d.cmd_fill_buffer(cmd, t.heads.raw, 0, vk::WHOLE_SIZE, 0) };
+        // 1. Receivers.
+        t.position.transition(d, cmd, Access::ColorAttachment);
+        t.normal.transition(d, cmd, Access::ColorAttachment);
+        t.depth.transition(d, cmd, Access::DepthAttachment);
+        let clear = |view| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: [0.0; 4] },
+                })
+        };
+        let colors = [clear(t.position.view), clear(t.normal.view)];
+        let depth = depth_clear_attachment(t.depth.view, false);
+        let area = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: t.extent,
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&colors)
+            .depth_attachment(&depth);
+        unsafe {
+            d.cmd_begin_rendering(cmd, &info);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.receiver);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout,
+                0,
+                &[set],
+                &[],
+            );
+            set_viewport(&ctx, cmd, t.extent);
+            d.cmd_bind_vertex_buffers(
+                cmd,
+                0,
+                &[scene.positions.raw, scene.attributes.raw],
+                &[0, 0],
+            );
+            d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
+        }
+        for &i in &f.receivers {
+            let dr = &scene.draws[i];
+            scene.bind_material(d, cmd, self.layout, 1, dr.material);
+            let pc = ExactImmediates {
+                world_from_model: dr.world_from_model,
+                extra: f.clip_from_world,
+            };
+            scene.record_draw(
+                cmd,
+                self.layout,
+                dr,
+                Some(f.eye),
+                Viewpoint::Eye(f.eye.0),
+                bytemuck::bytes_of(&pc),
+            );
+        }
+        unsafe { d.cmd_end_rendering(cmd) };
+        // 2. Binning.
+        t.position.transition(d, cmd, Access::ComputeSampled);
+        t.normal.transition(d, cmd, Access::ComputeSampled);
+        memory_barrier(
+            d,
+            cmd,
+            (S::ALL_TRANSFER, A::TRANSFER_WRITE),
+            (
+                S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ),
+        );
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.build);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.layout,
+                0,
+                &[set],
+                &[],
+            );
+            d.cmd_dispatch(cmd, t.extent.width.div_ceil(8), t.extent.height.div_ceil(8), 1);
+        }
+        memory_barrier(
+            d,
+            cmd,
+            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+            (
+                S::VERTEX_SHADER | S::FRAGMENT_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ),
+        );
+        // 3. Casters, into the grid (no attachments: the fragments only test and mark).
+        let grid = vk::Extent2D {
+            width: GRID,
+            height: GRID,
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: grid,
+            })
+            .layer_count(1);
+        unsafe {
+            d.cmd_begin_rendering(cmd, &info);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.caster);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout,
+                0,
+                &[set],
+                &[],
+            );
+            set_viewport(&ctx, cmd, grid);
+            d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
+            d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
+        }
+        for &i in &f.casters {
+            let dr = &scene.draws[i];
+            scene.bind_material(d, cmd, self.layout, 1, dr.material);
+            let mut extra = Mat4::ZERO;
+            extra.x_axis = Vec4::new(
+                f32::from_bits(dr.first_index),
+                f32::from_bits(dr.vertex_offset as u32),
+                if dr.alpha.tests_alpha_in_shadow() {
+                    1.0
+                } else {
+                    0.0
+                },
+                0.0,
+            );
+            let pc = ExactImmediates {
+                world_from_model: dr.world_from_model,
+                extra,
+            };
+            unsafe {
+                d.cmd_push_constants(
+                    cmd,
+                    self.layout,
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    0,
+                    bytemuck::bytes_of(&pc),
+                );
+                d.cmd_draw(cmd, dr.index_count, 1, 0, 0);
+            }
+        }
+        unsafe { d.cmd_end_rendering(cmd) };
+        // The verdicts, for the camera pass's fragments.
+        memory_barrier(
+            d,
+            cmd,
+            (S::FRAGMENT_SHADER, A::SHADER_STORAGE_WRITE),
+            (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
+        );
+    }
+}
+
+impl Drop for ExactPass {
+    fn drop(&mut self) {
+        unsafe {
+            let d = &self.ctx.device;
+            let _ = d.device_wait_idle();
+            self.targets = None;
+            d.destroy_pipeline(self.receiver, None);
+            d.destroy_pipeline(self.build, None);
+            d.destroy_pipeline(self.caster, None);
+            d.destroy_shader_module(self.module, None);
+            d.destroy_pipeline_layout(self.layout, None);
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
