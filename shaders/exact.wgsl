@@ -7,10 +7,11 @@
 //    light's side by `eps`, as the CPU reference starts its rays) is projected into the light's
 //    view and pushed onto that grid cell's list (a head per cell, a next per sample).
 // 3. vs_caster / fs_caster: every caster triangle, pulled from the scene's buffers, is drawn into
-//    the grid dilated by half a cell (so every cell it touches runs a fragment); each fragment
-//    walks its cell's samples and intersects each one's shadow ray with the exact triangle
-//    (Moller-Trumbore; the alpha texture at the hit for masked and blended casters), marking the
-//    samples it blocks. No bias, no texels in the answer: the grid only sorts the work.
+//    the grid as its light-view box grown by half a cell (so every cell it touches runs a
+//    fragment; a dilated triangle's corners run away for slivers); each fragment walks its cell's
+//    samples and intersects each one's shadow ray with the exact triangle (Moller-Trumbore; the
+//    alpha texture at the hit for masked and blended casters), marking the samples it blocks. No
+//    bias, no texels in the answer: the grid only sorts the work.
 // The camera pass reads the result at its pixel where its fragment is the receiver (scene.wgsl).
 
 #include "lib/material.wgsl"
@@ -34,6 +35,8 @@ const ATTRIBUTE_WORDS: u32 = 13u;
 const OCCLUDED: f32 = 0.0;
 
 @group(0) @binding(0) var<uniform> xf: ExactFrame;
+// Cells 0..g²: each cell's list head (sample + 1, 0 for none); cells g²..2g²: the farthest of
+// its samples' shadow ray origins from the light (`ordered` light depth, 0 for none).
 @group(0) @binding(1) var<storage, read_write> heads: array<atomic<u32>>;
 @group(0) @binding(2) var<storage, read_write> next: array<u32>;
 // Element 0: (width, height, 0, 0); element 1 + i: pixel i's (world position, verdict).
@@ -111,6 +114,12 @@ fn fs_receiver(in: ReceiverOut) -> ReceiverTargets {
 
 // ---- 2. Binning ----
 
+// A light depth as an unsigned integer of the same order (atomicMax on floats).
+fn ordered(f: f32) -> u32 {
+    let b = bitcast<u32>(f);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
 // The grid cell of world point `p`, or the cell count (none) outside the light's view.
 fn cell_of(p: vec3<f32>) -> u32 {
     let g = u32(xf.params.y);
@@ -163,6 +172,9 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
     let g = u32(xf.params.y);
     if cell < g * g {
         next[i] = atomicExchange(&heads[cell], i + 1u);
+        if xf.light.w == LIGHT_DIRECTIONAL {
+            atomicMax(&heads[g * g + cell], ordered(dot(origin, xf.light.xyz)));
+        }
     }
 }
 
@@ -180,6 +192,8 @@ struct CasterOut {
     @location(5) @interpolate(flat) uv1: vec4<f32>,
     @location(6) @interpolate(flat) uv2: vec4<f32>,
     @location(7) @interpolate(flat) alpha: vec3<f32>,
+    // The nearest the triangle comes to a directional light, along its rays.
+    @location(8) @interpolate(flat) depth: f32,
 }
 
 fn vertex_index_of(tri: u32, k: u32) -> u32 {
@@ -209,17 +223,12 @@ fn vertex_alpha(v: u32) -> f32 {
     return f32(attributes[ATTRIBUTE_WORDS * v + 10u] >> 16u) / 65535.0;
 }
 
-// Where the lines n_a·x = d_a and n_b·x = d_b meet.
-fn meet(na: vec2<f32>, da: f32, nb: vec2<f32>, db: f32) -> vec2<f32> {
-    let det = na.x * nb.y - na.y * nb.x;
-    return vec2<f32>(da * nb.y - db * na.y, na.x * db - nb.x * da) / det;
-}
-
 @vertex
 fn vs_caster(@builtin(vertex_index) vi: u32) -> CasterOut {
     var out: CasterOut;
-    let tri = vi / 3u;
-    let corner = vi % 3u;
+    // Six vertices a triangle: two triangles over the cells its light-view box touches.
+    let tri = vi / 6u;
+    let corner = vi % 6u;
     let i0 = vertex_index_of(tri, 0u);
     let i1 = vertex_index_of(tri, 1u);
     let i2 = vertex_index_of(tri, 2u);
@@ -231,65 +240,59 @@ fn vs_caster(@builtin(vertex_index) vi: u32) -> CasterOut {
     out.uv2 = vertex_uvs(i2);
     out.alpha = vec3<f32>(vertex_alpha(i0), vertex_alpha(i1), vertex_alpha(i2));
     let g = xf.params.y;
+    // The box's corners: (0, 0) (1, 0) (1, 1), (0, 0) (1, 1) (0, 1) of (low, high).
+    let pick = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
+    )[corner];
     let c0 = xf.grid_from_world * vec4<f32>(out.v0, 1.0);
     let c1 = xf.grid_from_world * vec4<f32>(out.v1, 1.0);
     let c2 = xf.grid_from_world * vec4<f32>(out.v2, 1.0);
     if min(c0.w, min(c1.w, c2.w)) <= 1e-6 {
-        // Crossing a spot light's plane: the whole grid tests it (one triangle covering the
-        // viewport), which is slow but exact.
-        let full = array<vec2<f32>, 3>(vec2<f32>(-1.0, -1.0), vec2<f32>(3.0, -1.0), vec2<f32>(-1.0, 3.0));
-        out.clip = vec4<f32>(full[corner], 0.5, 1.0);
+        // Crossing a spot light's plane: the whole grid tests it (slow but exact).
+        out.clip = vec4<f32>(mix(vec2<f32>(-1.0), vec2<f32>(1.0), pick), 0.5, 1.0);
         out.cells = vec4<f32>(0.0, 0.0, g - 1.0, g - 1.0);
+        out.depth = -3.0e38;
         return out;
     }
-    let p = array<vec2<f32>, 3>(c0.xy / c0.w, c1.xy / c1.w, c2.xy / c2.w);
-    let area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
-    if abs(area) < 1e-12 {
-        // Edge-on to the light: it blocks no ray (the ray test's determinant is 0 too).
-        out.clip = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-        return out;
-    }
-    // Each edge's line moved outwards by half a cell's support along its normal (the Minkowski
-    // sum with a cell is inside the triangle these lines bound), in NDC (a cell is 2/g).
-    let half = 1.0 / g;
-    var n: array<vec2<f32>, 3>;
-    var d: array<f32, 3>;
-    for (var e = 0u; e < 3u; e++) {
-        let a = p[e];
-        let b = p[(e + 1u) % 3u];
-        var ne = normalize(vec2<f32>(b.y - a.y, a.x - b.x));
-        if area < 0.0 {
-            ne = -ne;
-        }
-        n[e] = ne;
-        d[e] = dot(ne, a) + half * (abs(ne.x) + abs(ne.y));
-    }
-    // Corner k lies where the lines of edges k - 1 and k meet.
-    let prev = (corner + 2u) % 3u;
-    let q = meet(n[prev], d[prev], n[corner], d[corner]);
-    out.clip = vec4<f32>(q, 0.5, 1.0);
-    // Cells of the undilated triangle's box (rows down, as cell_of).
-    let lo = min(p[0], min(p[1], p[2]));
-    let hi = max(p[0], max(p[1], p[2]));
-    let x0 = floor((lo.x * 0.5 + 0.5) * g);
-    let x1 = floor((hi.x * 0.5 + 0.5) * g);
-    let y0 = floor((0.5 - hi.y * 0.5) * g);
-    let y1 = floor((0.5 - lo.y * 0.5) * g);
-    out.cells = vec4<f32>(x0, y0, x1, y1);
+    let p0 = c0.xy / c0.w;
+    let p1 = c1.xy / c1.w;
+    let p2 = c2.xy / c2.w;
+    // The box grown by half a cell (a cell is 2/g in NDC): every cell the triangle touches has its
+    // centre inside.
+    let lo = min(p0, min(p1, p2));
+    let hi = max(p0, max(p1, p2));
+    let half = vec2<f32>(1.0 / g);
+    out.clip = vec4<f32>(mix(lo - half, hi + half, pick), 0.5, 1.0);
+    // Cells of the box (rows down, as cell_of).
+    out.cells = vec4<f32>(
+        floor((lo.x * 0.5 + 0.5) * g),
+        floor((0.5 - hi.y * 0.5) * g),
+        floor((hi.x * 0.5 + 0.5) * g),
+        floor((0.5 - lo.y * 0.5) * g),
+    );
+    // The nearest any point of the triangle comes to a directional light.
+    out.depth = min(dot(out.v0, xf.light.xyz), min(dot(out.v1, xf.light.xyz), dot(out.v2, xf.light.xyz)));
     return out;
 }
 
 @fragment
 fn fs_caster(in: CasterOut) {
+    let nearest = in.depth;
     let g = u32(xf.params.y);
     let cell = vec2<f32>(floor(in.clip.xy));
     if cell.x < in.cells.x || cell.y < in.cells.y || cell.x > in.cells.z || cell.y > in.cells.w {
         return;
     }
+    let c = u32(cell.y) * g + u32(cell.x);
+    // Behind every sample of the cell (farther from the light): it blocks none of their rays.
+    if xf.light.w == LIGHT_DIRECTIONAL && ordered(nearest) > atomicLoad(&heads[g * g + c]) {
+        return;
+    }
     let e1 = in.v1 - in.v0;
     let e2 = in.v2 - in.v0;
     let tested = pc.extra[0].z > 0.5;
-    var s = atomicLoad(&heads[u32(cell.y) * g + u32(cell.x)]);
+    var s = atomicLoad(&heads[c]);
     loop {
         if s == 0u {
             break;

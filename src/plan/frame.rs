@@ -187,6 +187,12 @@ impl FramePlan {
         }
     }
 
+    /// Whether the frame's shadowed light is judged by the exact pass
+    /// ([`crate::plan::ShadowMethod::Exact`]) rather than its map.
+    pub fn exact_shadows(&self) -> bool {
+        self.shader_variant & crate::gpu::shaders::scene::BIT_EXACT != 0
+    }
+
     /// Whether light `i` is shadowed by the map this frame (shadows on and it has views).
     pub fn is_shadowed(&self, i: usize) -> bool {
         self.shadows_on && self.shadow_views.iter().any(|v| v.light == i)

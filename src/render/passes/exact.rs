@@ -5,9 +5,10 @@
 //! Three steps after the shadow pass: the camera's receivers (what casts and is judged: the
 //! alpha cutoff of the shadow pass) are drawn into a position and a face-normal image; a compute
 //! pass makes each covered pixel a sample and links it into the list of the light-view grid cell
-//! its shadow ray starts in; every caster triangle is drawn into that grid, dilated by half a
-//! cell so that each cell it touches runs a fragment, and each fragment tests the cell's samples
-//! against the exact triangle (and its alpha texture). The camera pass then reads the verdict at
+//! its shadow ray starts in; every caster triangle is drawn into that grid as its light-view box
+//! grown by half a cell, so that each cell it touches runs a fragment, and each fragment tests the
+//! cell's samples against the exact triangle (and its alpha texture), unless the triangle lies
+//! wholly farther from a directional light than every sample of the cell. The camera pass then reads the verdict at
 //! its pixel where its fragment is that receiver, and the shadow map elsewhere (blended layers
 //! over the receiver, MSAA's edge samples). The grid only sorts the work: its size changes the
 //! cost, not the answer.
@@ -34,7 +35,9 @@ use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
 /// Cells per side of the light-view grid the samples are sorted into.
-pub const GRID: u32 = 1024;
+/// (At 1280×720 against 1024 cells: 0.76× the pass on the close-up stand-in, 0.69× on
+/// FlightHelmet close by; 32 MiB of heads and depths, cleared every frame.)
+pub const GRID: u32 = 2048;
 
 const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -256,7 +259,7 @@ impl ExactPass {
             _position: position,
             _normal: normal,
             _depth: depth,
-            heads: storage("exact grid heads", (GRID * GRID) as u64 * 4)?,
+            heads: storage("exact grid heads", 2 * (GRID * GRID) as u64 * 4)?,
             next: storage("exact sample links", pixels * 4)?,
             samples: storage("exact samples", (pixels + 1) * 16)?,
             rays: storage("exact shadow rays", pixels * 16)?,
@@ -315,7 +318,10 @@ impl ExactPass {
 
     /// Writes slot `slot`'s frame uniform (its previous frame must have completed).
     pub fn write_frame(&mut self, slot: usize, f: &ExactFrameInputs) -> Result<(), GpuError> {
-        let extent = self.targets.as_ref().map_or(vk::Extent2D::default(), |t| t.extent);
+        let extent = self
+            .targets
+            .as_ref()
+            .map_or(vk::Extent2D::default(), |t| t.extent);
         let u = ExactFrame {
             grid_from_world: f.grid_from_world,
             light: f.light.extend(if f.spot {
@@ -447,7 +453,12 @@ impl ExactPass {
                 &[set],
                 &[],
             );
-            d.cmd_dispatch(cmd, t.extent.width.div_ceil(8), t.extent.height.div_ceil(8), 1);
+            d.cmd_dispatch(
+                cmd,
+                t.extent.width.div_ceil(8),
+                t.extent.height.div_ceil(8),
+                1,
+            );
         }
         memory_barrier(
             d,
@@ -510,7 +521,8 @@ impl ExactPass {
                     0,
                     bytemuck::bytes_of(&pc),
                 );
-                d.cmd_draw(cmd, dr.index_count, 1, 0, 0);
+                // Six vertices a triangle: the two halves of its box in the grid.
+                d.cmd_draw(cmd, 2 * dr.index_count, 1, 0, 0);
             }
         }
         unsafe { d.cmd_end_rendering(cmd) };
