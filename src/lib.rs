@@ -38,6 +38,6 @@ pub mod table;
 pub use gpu::{Context, ContextDesc, GpuError, Validation, ValidationLog};
 pub use render::{
     FramePlan, FrameStats, Pcf, RenderedFrame, Renderer, SceneOptions, ShadowFit, ShadowFormat,
-    ShadowHold, ShadowSettings, View, ViewMode,
+    ShadowHold, ShadowMethod, ShadowSettings, View, ViewMode,
 };
 pub use scene::{demo::demo_scene, load_gltf, Camera, Light, LightKind, LoadError, Scene};

@@ -18,14 +18,20 @@ fn viewer_screenshot_matches_offscreen_render() {
     // into the swapchain image, the renderer into its own).
     // And with cascades fitted to the depths seen on the town's street: the viewer reads each
     // frame's depth back for a later frame, the offscreen renderer measures first.
+    // And with exact shadows (two frames in flight sharing the exact pass's buffers).
     for (msaa, extra) in [
         ("1", &[][..]),
         ("4", &[][..]),
         ("1", &["--depth-fit", "--synthetic", "town"][..]),
+        ("1", &["--shadow-method", "exact"][..]),
     ] {
         let tag = format!(
             "msaa{msaa}{}",
-            if extra.is_empty() { "" } else { "_depth_fit" }
+            match extra.first() {
+                Some(&"--depth-fit") => "_depth_fit",
+                Some(_) => "_exact",
+                None => "",
+            }
         );
         let shot = out(&format!("viewer_shot_{tag}.png"));
         let offscreen = out(&format!("viewer_offscreen_{tag}.png"));
@@ -61,7 +67,11 @@ fn viewer_screenshot_matches_offscreen_render() {
         // Same passes, same plan: identical up to the camera reconstructed by the controller.
         // With depth fitting the viewer's read-back depths must match the renderer's measured
         // ones: 97.0 dB measured; fitted to the boxes instead the viewer gives 51.3 dB.
-        let bound = if extra.is_empty() { 40.0 } else { 70.0 };
+        let bound = if extra.first() == Some(&"--depth-fit") {
+            70.0
+        } else {
+            40.0
+        };
         assert!(
             p > bound && f < 0.01,
             "viewer and offscreen differ ({tag}): PSNR {p:.1} dB, FLIP {f:.4}"

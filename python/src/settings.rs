@@ -1,5 +1,5 @@
-//! `render`'s keyword settings, mirroring the command line's options: shadows (map size, format,
-//! filter, cascades, depth fit, biases, budget, the light shown), image (exposure, tone curve,
+//! `render`'s keyword settings, mirroring the command line's options: shadows (method, map size,
+//! format, filter, cascades, depth fit, biases, budget, the light shown), image (exposure, tone curve,
 //! ambient, background), the sun, and time.
 
 use glam::Vec3;
@@ -25,6 +25,7 @@ pub const NAMES: &[&str] = &[
     "shadows",
     "shadow_map",
     "shadow_format",
+    "shadow_method",
     "pcf",
     "cascades",
     "depth_fit",
@@ -72,6 +73,9 @@ pub fn apply(view: &mut View, settings: Option<&Bound<'_, PyDict>>) -> PyResult<
             }
             "shadow_format" => {
                 s.format = text()?.parse().map_err(|e| invalid(&name, e))?;
+            }
+            "shadow_method" => {
+                s.method = text()?.parse().map_err(|e| invalid(&name, e))?;
             }
             "pcf" => s.pcf = text()?.parse().map_err(|e| invalid(&name, e))?,
             "cascades" => {

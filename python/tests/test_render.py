@@ -242,6 +242,19 @@ def test_settings_act_like_the_command_line_options(renderer):
     assert 0.01 < moved < 0.04, moved
     with pytest.raises(ValueError, match="post_aa: post anti-aliasing 'smaa'"):
         renderer.render(scene, camera, pose, post_aa="smaa")
+    # Exact shadows: hard (0 or 1 only, where the map's filter leaves greys on edges), and the
+    # same verdict as the map away from its edges (measured: no pixel differs at 0.5).
+    out = renderer.render(scene, camera, pose, outputs=("shadow", "depth"), shadow_method="exact")
+    exact, surface = out["shadow"], out["depth"] > 0.0
+    assert set(np.unique(exact[surface])) <= {0.0, 1.0}, np.unique(exact[surface])
+    assert len(np.unique(base["shadow"][surface])) > 2
+    differ = ((exact > 0.5) != (base["shadow"] > 0.5)).mean()
+    assert differ < 0.01, differ
+    shadowed = ((exact == 0.0) & surface).sum(), ((base["shadow"] < 0.5) & surface).sum()
+    # Measured: 11 pixels in shadow in both (the card's thin shadow at this distance).
+    assert shadowed[0] >= 8 and abs(shadowed[0] - shadowed[1]) <= 2, shadowed
+    with pytest.raises(ValueError, match="shadow_method: shadow method 'rays'"):
+        renderer.render(scene, camera, pose, shadow_method="rays")
 
 
 def test_the_gil_is_released_while_rendering():

@@ -3,7 +3,7 @@
 //! widget that sets the same value leave the same view, so they draw the same frame.
 
 use glam::Vec3;
-use umbra::render::{Pcf, PostAa, Tonemap, View, ViewMode, MAX_CASCADES};
+use umbra::render::{Pcf, PostAa, ShadowMethod, Tonemap, View, ViewMode, MAX_CASCADES};
 use umbra::scene::Light;
 
 /// What a key or a panel widget does to the view.
@@ -37,6 +37,8 @@ pub enum Action {
     CycleTonemap,
     /// FXAA on/off (`Y`; `View::post_aa`).
     ToggleFxaa,
+    /// Shadow maps ↔ exact shadows (`M`; `ShadowSettings::method`).
+    ToggleMethod,
     /// Exposure half a stop up (`.`).
     ExposureUp,
     /// Exposure half a stop down (`,`).
@@ -51,6 +53,8 @@ pub enum Action {
     SetMapSize(u32),
     /// This PCF kernel.
     SetPcf(Pcf),
+    /// This shadow method.
+    SetMethod(ShadowMethod),
     /// This cascade count (0: automatic).
     SetCascades(u32),
     /// This debug view.
@@ -188,6 +192,13 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
             };
             apply(Action::SetTonemap(next), view, sun)
         }
+        Action::ToggleMethod => {
+            let next = match view.shadow.method {
+                ShadowMethod::Map => ShadowMethod::Exact,
+                ShadowMethod::Exact => ShadowMethod::Map,
+            };
+            apply(Action::SetMethod(next), view, sun)
+        }
         Action::ToggleFxaa => {
             view.post_aa = match view.post_aa {
                 PostAa::None => PostAa::Fxaa,
@@ -238,6 +249,16 @@ fn apply_set(a: Action, view: &mut View, sun: &mut SunAngles) -> Option<String> 
         Action::SetPcf(k) => {
             s.pcf = k;
             format!("PCF: {:?}", s.pcf)
+        }
+        Action::SetMethod(m) => {
+            s.method = m;
+            match m {
+                ShadowMethod::Map => "shadows: maps".to_string(),
+                ShadowMethod::Exact => {
+                    "shadows: exact (one shadowed directional or spot light; maps otherwise)"
+                        .to_string()
+                }
+            }
         }
         Action::SetCascades(n) => {
             s.cascades = n.min(MAX_CASCADES);
@@ -398,6 +419,10 @@ mod tests {
         assert_eq!(v.post_aa, PostAa::Fxaa);
         apply(Action::ToggleFxaa, &mut v, &mut sun);
         assert_eq!(v.post_aa, PostAa::None);
+        assert!(apply(Action::ToggleMethod, &mut v, &mut sun).contains("exact"));
+        assert_eq!(v.shadow.method, ShadowMethod::Exact);
+        apply(Action::ToggleMethod, &mut v, &mut sun);
+        assert_eq!(v.shadow.method, ShadowMethod::Map);
         apply(Action::ExposureUp, &mut v, &mut sun);
         apply(Action::ExposureUp, &mut v, &mut sun);
         apply(Action::ExposureDown, &mut v, &mut sun);

@@ -260,7 +260,7 @@ pub struct ViewArgsCmd {
     pub validation: bool,
     /// Automation: inputs to play, one every two frames, comma-separated, each optionally
     /// repeated with `*N`: `WxH` resizes (0x0 minimises), `key:NAME` presses a key (up down left
-    /// right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r y f1), `wheel:N`
+    /// right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r y m f1), `wheel:N`
     /// scrolls N lines (positive zooms in), `click:X:Y` picks at window pixel (X, Y), `ui:NAME`
     /// clicks the panel's widget NAME, `drop:PATH` drops a file on the window,
     /// `copy:SRC>DST` copies a file (a model changed on disk) and `wait:reload` waits for the

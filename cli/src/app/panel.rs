@@ -6,7 +6,7 @@
 use super::actions::{Action, SunAngles, VIEW_CYCLE};
 use super::scene_tree::SceneTree;
 use std::collections::HashMap;
-use umbra::render::{FrameSummary, Pcf, Tonemap, View, MAX_CASCADES};
+use umbra::render::{FrameSummary, Pcf, ShadowMethod, Tonemap, View, MAX_CASCADES};
 
 /// Frame figures, averaged over the last quarter second.
 #[derive(Clone, Debug, Default)]
@@ -107,7 +107,7 @@ const MAP_SIZES: [u32; 8] = [64, 128, 256, 512, 1024, 2048, 4096, 8192];
 const BUDGETS: [f64; 4] = [0.05, 0.1, 0.2, 0.5];
 
 /// The keys, for the legend.
-const KEYS: [(&str, &str); 23] = [
+const KEYS: [(&str, &str); 24] = [
     ("F1", "panel on/off"),
     ("left drag / right drag / wheel", "orbit / pan / zoom"),
     ("click", "pick"),
@@ -117,6 +117,7 @@ const KEYS: [(&str, &str); 23] = [
     ("O", "perspective / orthographic"),
     ("arrows", "sun azimuth / elevation"),
     ("[ ]", "shadow map ½ / ×2"),
+    ("M", "shadow maps / exact shadows"),
     ("K", "PCF kernel"),
     ("N", "cascades"),
     ("G", "depth fit"),
@@ -223,6 +224,13 @@ fn shadow_section(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: 
             let sizes = MAP_SIZES.map(|n| (n, n.to_string()));
             if let Some(n) = choice(ui, w, "map size ([ ])", "map", s.map_size, &sizes) {
                 out.push(Command::Set(Action::SetMapSize(n)));
+            }
+            let methods = [
+                (ShadowMethod::Map, "maps".to_string()),
+                (ShadowMethod::Exact, "exact".into()),
+            ];
+            if let Some(m) = choice(ui, w, "shadow method (M)", "method", s.method, &methods) {
+                out.push(Command::Set(Action::SetMethod(m)));
             }
             let kernels = [
                 (Pcf::None, "none".to_string()),

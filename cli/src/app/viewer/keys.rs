@@ -77,6 +77,7 @@ pub fn script_key(name: &str) -> Option<KeyCode> {
         "x" => KeyCode::KeyX,
         "r" => KeyCode::KeyR,
         "y" => KeyCode::KeyY,
+        "m" => KeyCode::KeyM,
         "f1" => KeyCode::F1,
         _ => return None,
     })
@@ -102,6 +103,7 @@ pub fn key_action(code: KeyCode) -> Option<KeyAction> {
         KeyCode::KeyJ => Setting(Action::ToggleSoft),
         KeyCode::KeyT => Setting(Action::CycleTonemap),
         KeyCode::KeyY => Setting(Action::ToggleFxaa),
+        KeyCode::KeyM => Setting(Action::ToggleMethod),
         KeyCode::Period => Setting(Action::ExposureUp),
         KeyCode::Comma => Setting(Action::ExposureDown),
         KeyCode::KeyL => ShadowLight,
