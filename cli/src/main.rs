@@ -391,6 +391,7 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
     }
     let mut grid = if a.quick { Grid::quick() } else { Grid::full() };
     grid.sdsm = a.depth_fit;
+    grid.exact = a.exact;
     if !a.formats.is_empty() {
         grid.formats = a.formats.iter().filter_map(|f| f.parse().ok()).collect();
     }

@@ -105,8 +105,8 @@ pub fn apply(view: &mut View, settings: Option<&Bound<'_, PyDict>>) -> PyResult<
             "shadow_budget" => {
                 // A percentage, as the command line takes `0.1%`.
                 let p: f64 = v.extract()?;
-                if !(p > 0.0 && p < 100.0) {
-                    return Err(invalid(&name, format!("{p} % must be within (0, 100)")));
+                if !(0.0..100.0).contains(&p) {
+                    return Err(invalid(&name, format!("{p} % must be within [0, 100)")));
                 }
                 extras.budget = Some(p / 100.0);
             }

@@ -116,6 +116,10 @@ pub struct SweepArgs {
     /// Also 4 cascades fitted to the depths each view sees (method `sdsm4`).
     #[arg(long)]
     pub depth_fit: bool,
+    /// Also exact shadows (`--shadow-method exact`: method and filter `exact`), one
+    /// configuration.
+    #[arg(long)]
+    pub exact: bool,
     /// Give every light this size (as for render: degrees of a directional light, radius of
     /// a point or spot light) and add PCSS (filter `pcss`); the reference is the area light,
     /// the other filters cast hard shadows from it.

@@ -91,8 +91,8 @@ pub(crate) fn parse_budget(s: &str) -> Result<f64, String> {
         None => t.parse::<f64>(),
     }
     .map_err(|_| format!("'{s}' is not a fraction or a percentage"))?;
-    if !(v.is_finite() && v > 0.0 && v < 1.0) {
-        return Err(format!("budget {s} must be above 0 and below 100%"));
+    if !(v.is_finite() && (0.0..1.0).contains(&v)) {
+        return Err(format!("budget {s} must be at least 0 and below 100%"));
     }
     Ok(v)
 }

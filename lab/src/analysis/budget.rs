@@ -342,8 +342,26 @@ pub fn predict_all(
             relative_cost: cost,
         });
     }
+    // Exact shadows: nothing to predict but the residue on exact shadow edges, at their cost.
+    if !out.is_empty() {
+        let (cam, shadow) = EXACT_COST;
+        out.push(Prediction {
+            config: super::grid::Config::exact(EXACT_MAP),
+            predicted: 0.0,
+            relative_cost: (bc * cam + bs * shadow) / (bc + bs),
+        });
+    }
     out
 }
+
+/// The map size of the exact candidate (read only where the exact pass does not judge).
+pub const EXACT_MAP: u32 = 2048;
+
+/// The exact candidate's camera-pass and shadow-pass time (exact pass included) relative to
+/// `COST_BASE`'s: geometric means over the demo, foliage, close-up and FlightHelmet + ground
+/// sweeps' first views (`umbra sweep demo foliage close-up FlightHelmet.gltf --ground --quick
+/// --exact --views 1`, lavapipe, 1280×720).
+pub const EXACT_COST: (f64, f64) = (1.0, 20.0);
 
 /// The cheapest prediction within `budget` (a fraction), else the most accurate one.
 pub fn cheapest_within(predictions: &[Prediction], budget: f64) -> Option<&Prediction> {

@@ -16,13 +16,14 @@ pub const ZERO_ERROR_FLOOR: f64 = 1e-6;
 /// Chart size in pixels.
 pub const SIZE: (u32, u32) = (1100, 720);
 
-const METHODS: [(&str, RGBColor); 6] = [
+const METHODS: [(&str, RGBColor); 7] = [
     ("scene", RGBColor(150, 150, 150)),
     ("camera", RGBColor(31, 119, 180)),
     ("cascades2", RGBColor(44, 160, 44)),
     ("cascades4", RGBColor(214, 39, 40)),
     ("auto", RGBColor(148, 103, 189)),
     ("sdsm4", RGBColor(255, 127, 14)),
+    ("exact", RGBColor(0, 0, 0)),
 ];
 
 /// A chart that could not be drawn or written.
@@ -272,6 +273,13 @@ where
             )
             .map_err(e)?;
         chart
+            .draw_series(
+                of("exact")
+                    .into_iter()
+                    .map(|p| EmptyElement::at(p) + Rectangle::new([(-6, -6), (6, 6)], fill)),
+            )
+            .map_err(e)?;
+        chart
             .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
             .map_err(e)?
             .label(method)
@@ -284,6 +292,7 @@ where
         ("PCF 3x3", 2),
         ("PCF 5x5", 3),
         ("PCSS", 4),
+        ("exact", 5),
     ] {
         chart
             .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
@@ -295,7 +304,8 @@ where
                     1 => Circle::new((x, y), 3, grey.filled()).into_dyn(),
                     2 => TriangleMarker::new((x, y), 5, grey.filled()).into_dyn(),
                     3 => Circle::new((x, y), 6, grey.stroke_width(2)).into_dyn(),
-                    _ => TriangleMarker::new((x, y), 8, grey.stroke_width(2)).into_dyn(),
+                    4 => TriangleMarker::new((x, y), 8, grey.stroke_width(2)).into_dyn(),
+                    _ => Rectangle::new([(x - 6, y - 6), (x + 6, y + 6)], grey.filled()).into_dyn(),
                 }
             });
     }

@@ -1,7 +1,7 @@
 //! What a sweep runs: the shadow configurations of a grid, and the views of a scene.
 
 use glam::Vec3;
-use umbra::render::{Pcf, ShadowFit, ShadowFormat, ShadowSettings};
+use umbra::render::{Pcf, ShadowFit, ShadowFormat, ShadowMethod, ShadowSettings};
 use umbra::scene::{Camera, Scene};
 
 /// Bias presets: (name, constant texels, slope, normal offset texels).
@@ -23,8 +23,27 @@ pub struct Config {
 }
 
 impl Config {
+    /// Exact shadows (`ShadowMethod::Exact`) with a `map_size`² map for the pixels the exact
+    /// pass does not judge.
+    pub fn exact(map_size: u32) -> Self {
+        Config {
+            shadow: ShadowSettings {
+                method: ShadowMethod::Exact,
+                map_size,
+                cascades: 1,
+                soft: false,
+                ..ShadowSettings::default()
+            },
+            bias: "default",
+            pcss: false,
+        }
+    }
+
     /// The fitting method, the chart's colour: `scene`, `camera`, `cascades2`, `cascades4`…
     pub fn method(&self) -> String {
+        if self.shadow.method == ShadowMethod::Exact {
+            return "exact".into();
+        }
         if self.shadow.depth_fit {
             return format!("sdsm{}", self.shadow.cascades);
         }
@@ -33,7 +52,9 @@ impl Config {
 
     /// The filter: `pcss`, or the PCF kernel's name (`filter_name`).
     pub fn filter(&self) -> &'static str {
-        if self.pcss {
+        if self.shadow.method == ShadowMethod::Exact {
+            "exact"
+        } else if self.pcss {
             "pcss"
         } else {
             filter_name(self.shadow.pcf)
@@ -105,6 +126,9 @@ pub struct Grid {
     /// Also PCSS (filter `pcss`, for every map, format, bias and fitting), the other
     /// configurations then hard whatever the lights' sizes.
     pub pcss: bool,
+    /// Also exact shadows (`ShadowMethod::Exact`, method and filter `exact`): one configuration,
+    /// at the largest map of `maps` (which only the pixels the exact pass does not judge read).
+    pub exact: bool,
 }
 
 impl Grid {
@@ -124,6 +148,7 @@ impl Grid {
             ],
             sdsm: false,
             pcss: false,
+            exact: false,
         }
     }
 
@@ -185,6 +210,11 @@ impl Grid {
                     }
                 }
             }
+        }
+        if self.exact {
+            out.push(Config::exact(
+                self.maps.iter().copied().max().unwrap_or(2048),
+            ));
         }
         out
     }
@@ -275,6 +305,21 @@ mod tests {
         assert!(all
             .iter()
             .any(|c| c.name() == "2048-d32-pcss-sdsm4-default"));
+    }
+
+    #[test]
+    fn exact_shadows_join_the_grid_as_one_configuration() {
+        let g = Grid {
+            exact: true,
+            ..Grid::quick()
+        };
+        let all = g.configs();
+        assert_eq!(all.len(), Grid::quick().configs().len() + 1);
+        let exact: Vec<_> = all.iter().filter(|c| c.method() == "exact").collect();
+        assert_eq!(exact.len(), 1);
+        assert_eq!(exact[0].filter(), "exact");
+        assert_eq!(exact[0].shadow.method, ShadowMethod::Exact);
+        assert_eq!(exact[0].name(), "4096-auto-exact-exact-default");
     }
 
     #[test]
