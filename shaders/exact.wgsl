@@ -223,6 +223,18 @@ fn vertex_alpha(v: u32) -> f32 {
     return f32(attributes[ATTRIBUTE_WORDS * v + 10u] >> 16u) / 65535.0;
 }
 
+// Corners of a grown triangle farther than this many cells from the triangle's own: a sliver.
+const MITER_CELLS: f32 = 4.0;
+
+// Edge `e` of triangle `p` (signed area `area`) as the line n·x = d moved outwards by `half`
+// cell's support along its unit normal n: (n, d).
+fn grown_line(p: array<vec2<f32>, 3>, e: u32, area: f32, half: f32) -> vec3<f32> {
+    let a = p[e];
+    let b = p[(e + 1u) % 3u];
+    let n = normalize(vec2<f32>(b.y - a.y, a.x - b.x)) * select(-1.0, 1.0, area > 0.0);
+    return vec3<f32>(n, dot(n, a) + half * (abs(n.x) + abs(n.y)));
+}
+
 @vertex
 fn vs_caster(@builtin(vertex_index) vi: u32) -> CasterOut {
     var out: CasterOut;
@@ -264,6 +276,27 @@ fn vs_caster(@builtin(vertex_index) vi: u32) -> CasterOut {
     let hi = max(p0, max(p1, p2));
     let half = vec2<f32>(1.0 / g);
     out.clip = vec4<f32>(mix(lo - half, hi + half, pick), 0.5, 1.0);
+    // A well-shaped triangle is drawn as itself grown by half a cell (fewer cells than its box,
+    // a diagonal card's half): its edges' lines moved out by a cell's support along their
+    // normals, each corner where two of them meet; the second three vertices then draw nothing.
+    // A sliver, whose grown corners would run more than `MITER_CELLS` away, keeps its box.
+    let p = array<vec2<f32>, 3>(p0, p1, p2);
+    let area = (p1.x - p0.x) * (p2.y - p0.y) - (p1.y - p0.y) * (p2.x - p0.x);
+    var grown: array<vec2<f32>, 3>;
+    var shaped = abs(area) > 0.0;
+    for (var k = 0u; k < 3u; k++) {
+        let prev = grown_line(p, (k + 2u) % 3u, area, half.x);
+        let next = grown_line(p, k, area, half.x);
+        let det = prev.x * next.y - prev.y * next.x;
+        grown[k] = vec2<f32>(prev.z * next.y - next.z * prev.y, prev.x * next.z - next.x * prev.z) / det;
+        shaped = shaped && abs(det) > 1e-6 && distance(grown[k], p[k]) <= MITER_CELLS * 2.0 * half.x;
+    }
+    if shaped {
+        out.clip = vec4<f32>(grown[min(corner, 2u)], 0.5, 1.0);
+        if corner >= 3u {
+            out.clip = vec4<f32>(grown[0], 0.5, 1.0);
+        }
+    }
     // Cells of the box (rows down, as cell_of).
     out.cells = vec4<f32>(
         floor((lo.x * 0.5 + 0.5) * g),

@@ -48,8 +48,12 @@ fn register_font() {
 }
 
 /// A configuration's short label: map size, filter, fitting, and format and bias when not the
-/// defaults (`2048 pcf2x2 cascades4`, `4096 nearest scene d16 bias:low`).
+/// defaults (`2048 pcf2x2 cascades4`, `4096 nearest scene d16 bias:low`); `exact` for exact
+/// shadows (whose map only the pixels they do not judge read).
 fn label(map: u32, filter: &str, method: &str, format: &str, bias: &str) -> String {
+    if method == "exact" {
+        return method.into();
+    }
     let mut s = format!("{map} {filter} {method}");
     if format != "d32" {
         s.push_str(&format!(" {format}"));
