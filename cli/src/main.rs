@@ -135,6 +135,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         frame = renderer.render(&view, w, h)?;
     }
     all.push(frame.stats.clone());
+    app::cli::warn_exact(&view, &frame.plan);
     frame
         .image
         .save(&a.output)
@@ -155,8 +156,8 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         String::new()
     };
     println!(
-        "rendered {} ({} triangles, {} draws of which {} deferred and {} unshadowed beyond the casters' reach, {} casters drawn, {} shadow view(s)) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
-        scene.name, s.triangles, s.draws, s.deferred_draws, s.unshadowed_draws, s.casters_drawn, if frame.plan.shadows_on { frame.plan.shadow_views.len() } else { 0 }, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
+        "rendered {} ({} triangles, {} draws of which {} deferred and {} unshadowed beyond the casters' reach, {} casters drawn, {} shadow view(s){}) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
+        scene.name, s.triangles, s.draws, s.deferred_draws, s.unshadowed_draws, s.casters_drawn, if frame.plan.shadows_on { frame.plan.shadow_views.len() } else { 0 }, if frame.plan.exact_shadows() { ", exact" } else { "" }, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
     );
     // Count after the renderer and the context are gone, so destroy-time and leak messages count.
     drop(renderer);

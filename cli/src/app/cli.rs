@@ -614,6 +614,19 @@ pub fn print_warning(scene: &str, w: &umbra::scene::Warning) {
     eprintln!("warning: {scene}: {} [{}{at}]", w.message, w.code);
 }
 
+/// Warns when `view` asked for exact shadows and the frame planned as `plan` could not have
+/// them (its shadowed lights are not one directional or spot light with one view).
+pub fn warn_exact(view: &View, plan: &umbra::FramePlan) {
+    if view.shadow.method == umbra::ShadowMethod::Exact && plan.shadows_on && !plan.exact_shadows()
+    {
+        eprintln!(
+            "warning: --shadow-method exact: {} shadow view(s) (exact shadows need one shadowed \
+             directional or spot light, or a device with fragment-shader stores); shadow maps used",
+            plan.shadow_views.len()
+        );
+    }
+}
+
 /// Loads SCENE or builds the demo, prints its warnings (`warning: NAME: …` on stderr, one per
 /// line), and adds a ground plane when asked.
 pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene> {
