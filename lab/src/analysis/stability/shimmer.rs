@@ -16,7 +16,7 @@ use umbra::math::bezier::CubicBezier;
 use umbra::math::projection::pixel_to_ndc;
 use umbra::math::Aabb;
 use umbra::plan::camera_projection;
-use umbra::render::{Renderer, ShadowFit, ShadowHold, ShadowSettings, View};
+use umbra::render::{Renderer, ShadowFit, ShadowHold, ShadowMethod, ShadowSettings, View};
 use umbra::scene::Camera;
 
 /// A shadow method the path is flown with.
@@ -36,7 +36,8 @@ pub struct Method {
 /// the frustum's bounding sphere; a single map whose extent steps by powers of 2
 /// (`ShadowSettings::extent_steps` = 1). Held across frames (as the viewer renders,
 /// `View::shadow_hold`): the snapped single map, the snapped cascades, and the defaults
-/// (automatic cascade count). (Cascades fitted to spheres are left out: their splits follow the
+/// (automatic cascade count). And exact shadows (`ShadowMethod::Exact`), whose verdict at a
+/// point does not depend on any fit. (Cascades fitted to spheres are left out: their splits follow the
 /// receivers' depth range, which steps as the camera moves, and each step changes every cascade:
 /// 1.38·10⁻⁴ against 0.99·10⁻⁴ fitted to the receivers on the built-in scene.)
 pub fn methods(defaults: &ShadowSettings) -> Vec<Method> {
@@ -90,6 +91,14 @@ pub fn methods(defaults: &ShadowSettings) -> Vec<Method> {
             true,
         ),
         ("defaults, held (the viewer)", *defaults, true),
+        (
+            "exact",
+            ShadowSettings {
+                method: ShadowMethod::Exact,
+                ..*defaults
+            },
+            false,
+        ),
     ]
     .into_iter()
     .map(|(name, shadow, held)| Method {
