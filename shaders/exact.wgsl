@@ -13,6 +13,7 @@
 //    alpha texture at the hit for masked and blended casters), marking the samples it blocks. No
 //    bias, no texels in the answer: the grid only sorts the work.
 // The camera pass reads the result at its pixel where its fragment is the receiver (scene.wgsl).
+// Contact shadows reuse step 1 and replace 2 and 3 by `cs_contact`.
 
 #include "lib/material.wgsl"
 
@@ -24,9 +25,17 @@ struct ExactFrame {
     light: vec4<f32>,
     // x: ray offset eps (world units), y: grid side in cells, z: image width, w: image height.
     params: vec4<f32>,
+    // The camera's clip from world, and its position (contact shadows).
+    camera_clip: mat4x4<f32>,
+    eye: vec4<f32>,
+    // Contact shadows: x = how far a ray marches towards the light (world units; per unit of
+    // distance to a spot or point light, whose texels grow with it), z = the thickness a surface
+    // in the depth image is taken to have.
+    contact: vec4<f32>,
 }
 
 const LIGHT_DIRECTIONAL: f32 = 0.0;
+// Any light with a position (spot, or point for contact shadows).
 const LIGHT_SPOT: f32 = 2.0;
 // Words per vertex of the scene's attribute stream (src/render/gpu_scene.rs VertexAttributes:
 // normal 3, uv 2, tangent 4, colour 2 (four u16), uv1 2).
@@ -176,6 +185,83 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
             atomicMax(&heads[g * g + cell], ordered(dot(origin, xf.light.xyz)));
         }
     }
+}
+
+// ---- Contact shadows (instead of 2 and 3) ----
+
+// Steps of a contact ray.
+const CONTACT_STEPS: u32 = 16u;
+
+// Each covered pixel's shadow ray marched a short way towards the light through the receiver
+// image as a depth buffer: a step behind what the camera sees there, by less than the thickness,
+// is blocked (verdict 0); else -1, the maps decide. It sees only what the camera sees: a caster
+// hidden behind another surface casts nothing, and a surface in front of the ray by less than the
+// thickness casts where nothing does (the false shadows `compare` counts).
+@compute @workgroup_size(8, 8)
+fn cs_contact(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = u32(xf.params.z);
+    let h = u32(xf.params.w);
+    if id.x >= w || id.y >= h {
+        return;
+    }
+    let i = id.y * w + id.x;
+    if i == 0u {
+        samples[0] = vec4<f32>(f32(w), f32(h), 0.0, 0.0);
+    }
+    let pos = textureLoad(receiver_position, vec2<i32>(id.xy), 0);
+    if pos.w <= 0.0 {
+        samples[i + 1u] = vec4<f32>(pos.xyz, -1.0);
+        return;
+    }
+    let p = pos.xyz;
+    var dir = -xf.light.xyz;
+    var length = xf.contact.x;
+    if xf.light.w == LIGHT_SPOT {
+        // A spot or point light: the length is per unit of distance, as its texels are.
+        let d = xf.light.xyz - p;
+        let dist = sqrt(dot(d, d));
+        dir = d / max(dist, 1e-20);
+        length = min(length * dist, 0.5 * dist);
+    }
+    let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
+    let side = select(-ng, ng, dot(ng, dir) >= 0.0);
+    let origin = p + side * xf.params.x;
+    let size = vec2<f32>(f32(w), f32(h));
+    var verdict = -1.0;
+    for (var k = 1u; k <= CONTACT_STEPS; k++) {
+        let q = origin + dir * (length * f32(k) / f32(CONTACT_STEPS));
+        let c = xf.camera_clip * vec4<f32>(q, 1.0);
+        if c.w <= 0.0 {
+            break;
+        }
+        let ndc = c.xy / c.w;
+        if abs(ndc.x) >= 1.0 || abs(ndc.y) >= 1.0 {
+            break;
+        }
+        let px = vec2<i32>(vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * size);
+        let seen = textureLoad(receiver_position, px, 0);
+        if seen.w <= 0.0 {
+            continue;
+        }
+        // How far q lies behind the surface seen there, along the camera's ray through q: the
+        // surface taken as the plane of the pixel's face (the pixel centre's own depth would be
+        // off by its footprint, which on a surface seen at a grazing angle shadows the surface
+        // itself).
+        let eye = xf.eye.xyz;
+        let v = normalize(q - eye);
+        let n = textureLoad(receiver_normal, px, 0).xyz;
+        let facing = dot(n, v);
+        var depth = distance(seen.xyz, eye);
+        if abs(facing) > 1e-4 {
+            depth = dot(n, seen.xyz - eye) / facing;
+        }
+        let behind = distance(q, eye) - depth;
+        if behind > xf.params.x && behind < xf.contact.z {
+            verdict = 0.0;
+            break;
+        }
+    }
+    samples[i + 1u] = vec4<f32>(p, verdict);
 }
 
 // ---- 3. Casters ----

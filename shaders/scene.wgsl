@@ -30,9 +30,10 @@ override PCF_BIT1: bool = false; // requires SHADOWS
 override MANY_VIEWS: bool = true; // requires SHADOWS
 // A shadowed light has a size (light.direction.w > 0): its lookups are PCSS soft shadows.
 override SOFT: bool = true; // requires SHADOWS
-// The shadowed light's visibility from the exact pass (shaders/exact.wgsl) where this fragment is
-// the receiver it judged; the map elsewhere (blended layers over it, MSAA edge samples).
-override EXACT: bool = false; // requires SHADOWS; excludes MANY_VIEWS SOFT
+// A per-pixel verdict on the shadowed light (shaders/exact.wgsl: exact shadows, or contact
+// shadows) where this fragment is the receiver it was made for; the maps elsewhere (blended
+// layers over it, MSAA edge samples) and where the verdict is -1.
+override EXACT: bool = false; // requires SHADOWS; excludes SOFT
 
 // Bilinear taps per side of the PCF kernel (0 = one nearest comparison).
 fn pcf_taps() -> i32 {

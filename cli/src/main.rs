@@ -157,7 +157,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     };
     println!(
         "rendered {} ({} triangles, {} draws of which {} deferred and {} unshadowed beyond the casters' reach, {} casters drawn, {} shadow view(s){}) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
-        scene.name, s.triangles, s.draws, s.deferred_draws, s.unshadowed_draws, s.casters_drawn, if frame.plan.shadows_on { frame.plan.shadow_views.len() } else { 0 }, if frame.plan.exact_shadows() { ", exact" } else { "" }, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
+        scene.name, s.triangles, s.draws, s.deferred_draws, s.unshadowed_draws, s.casters_drawn, if frame.plan.shadows_on { frame.plan.shadow_views.len() } else { 0 }, if frame.plan.exact_shadows() { ", exact" } else if frame.plan.contact_shadows() { ", contact shadows" } else { "" }, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
     );
     // Count after the renderer and the context are gone, so destroy-time and leak messages count.
     drop(renderer);
@@ -393,6 +393,7 @@ fn sweep(a: app::cli::SweepArgs) -> anyhow::Result<()> {
     let mut grid = if a.quick { Grid::quick() } else { Grid::full() };
     grid.sdsm = a.depth_fit;
     grid.exact = a.exact;
+    grid.contact = a.contact;
     if !a.formats.is_empty() {
         grid.formats = a.formats.iter().filter_map(|f| f.parse().ok()).collect();
     }

@@ -379,8 +379,9 @@ impl OffscreenRenderer {
     /// (`segmentation` uint32 (H, W), instance + 1, 0 for the background; `normals` float32
     /// (H, W, 3) world space; `shadow` float32 (H, W), the first shadowed light's visibility, or
     /// `shadow_light`'s). Keyword settings as the command line's options: `shadows`,
-    /// `shadow_map`, `shadow_format`, `shadow_method`, `pcf`, `cascades`, `depth_fit`, `fit`, `bias_constant`,
-    /// `bias_slope`, `normal_offset`, `shadow_budget` (%), `shadow_light`, `light_size`,
+    /// `shadow_map`, `shadow_format`, `shadow_method`, `contact_shadows`, `pcf`, `cascades`,
+    /// `depth_fit`, `fit`, `bias_constant`, `bias_slope`, `normal_offset`, `shadow_budget` (%),
+    /// `shadow_light`, `light_size`,
     /// `exposure`, `tonemap`, `post_aa`, `ambient`, `background`, `sun_direction`,
     /// `sun_intensity`, `time`, `animation`.
     #[pyo3(signature = (scene, camera, camera_pose, outputs = None, **settings))]

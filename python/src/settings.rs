@@ -26,6 +26,7 @@ pub const NAMES: &[&str] = &[
     "shadow_map",
     "shadow_format",
     "shadow_method",
+    "contact_shadows",
     "pcf",
     "cascades",
     "depth_fit",
@@ -77,6 +78,7 @@ pub fn apply(view: &mut View, settings: Option<&Bound<'_, PyDict>>) -> PyResult<
             "shadow_method" => {
                 s.method = text()?.parse().map_err(|e| invalid(&name, e))?;
             }
+            "contact_shadows" => s.contact = v.extract()?,
             "pcf" => s.pcf = text()?.parse().map_err(|e| invalid(&name, e))?,
             "cascades" => {
                 let n: u32 = v.extract()?;

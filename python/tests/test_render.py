@@ -253,6 +253,9 @@ def test_settings_act_like_the_command_line_options(renderer):
     shadowed = ((exact == 0.0) & surface).sum(), ((base["shadow"] < 0.5) & surface).sum()
     # Measured: 11 pixels in shadow in both (the card's thin shadow at this distance).
     assert shadowed[0] >= 8 and abs(shadowed[0] - shadowed[1]) <= 2, shadowed
+    # Contact shadows only darken (measured: no pixel of this frame changes at 0.5).
+    contact = renderer.render(scene, camera, pose, outputs=("shadow",), contact_shadows=True)
+    assert ((contact["shadow"] > 0.5) & (base["shadow"] <= 0.5)).sum() == 0
     with pytest.raises(ValueError, match="shadow_method: shadow method 'rays'"):
         renderer.render(scene, camera, pose, shadow_method="rays")
 

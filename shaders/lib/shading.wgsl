@@ -41,9 +41,9 @@ struct Texels {
     emissive: vec3<f32>,
 }
 
-// The exact pass's verdict on the shadowed light at the pixel `frag` (1 lit, 0 blocked) when
-// the point `p` shaded there is the receiver it judged (the same position: the camera pass and the
-// receiver pass transform alike); -1 otherwise.
+// The verdict on the shadowed light at the pixel `frag` (1 lit, 0 blocked; -1 none: the maps
+// decide) when the point `p` shaded there is the receiver it was made for (the same position: the
+// camera pass and the receiver pass transform alike); -1 otherwise.
 fn exact_verdict(p: vec3<f32>, frag: vec2<f32>) -> f32 {
     let size = exact_samples[0].xy;
     let px = vec2<u32>(clamp(frag, vec2<f32>(0.0), max(size - vec2<f32>(1.0), vec2<f32>(0.0))));
@@ -135,7 +135,17 @@ fn shade_texels(in: VsOut, front_facing: bool, base: vec4<f32>, texels: Texels) 
         var vis = select(0.0, 1.0, dot(n_geo, l) > 0.0);
         let shown = u32(frame.shadow_light.w) == i;
         if SHADOWS && frame.shadow.w > 0.5 {
-            if MANY_VIEWS {
+            // The per-pixel verdict on the shown light where this fragment is the receiver it was
+            // made for (`exact_verdict`): the exact pass's, or contact shadows' where they found
+            // a caster; the maps elsewhere.
+            var verdict = -1.0;
+            if EXACT && shown {
+                verdict = exact_verdict(p, in.clip.xy);
+            }
+            if verdict >= 0.0 {
+                vis *= verdict;
+                cascade = 0;
+            } else if MANY_VIEWS {
                 // Each light its own views.
                 let first = i32(light.shadow.x);
                 if first >= 0 {
@@ -146,16 +156,8 @@ fn shade_texels(in: VsOut, front_facing: bool, base: vec4<f32>, texels: Texels) 
                     }
                 }
             } else if shown {
-                // The one shadowed light, view 0; exactly where the exact pass judged this point.
-                var exact = -1.0;
-                if EXACT {
-                    exact = exact_verdict(p, in.clip.xy);
-                }
-                if exact >= 0.0 {
-                    vis *= exact;
-                } else {
-                    vis *= shadow_visibility(p, n_geo, l, light, 0, in.clip.xy);
-                }
+                // The one shadowed light, view 0.
+                vis *= shadow_visibility(p, n_geo, l, light, 0, in.clip.xy);
                 cascade = 0;
             }
         }

@@ -39,6 +39,9 @@ pub struct FramePlan {
     /// The scene shader's variant bits this frame sets (one light, shadows sampled, comparison
     /// path, PCF kernel); each draw adds its material's bits.
     pub(crate) shader_variant: usize,
+    /// What decided the shown light's visibility per pixel beside the maps, when anything did
+    /// (set when the frame is prepared on the device).
+    pub(crate) verdicts: Option<PixelVerdicts>,
     /// Lights shading this frame.
     pub lights: Vec<Light>,
     /// The shadowed light whose visibility `--view shadow` writes (and whose views the shadow
@@ -190,7 +193,13 @@ impl FramePlan {
     /// Whether the frame's shadowed light is judged by the exact pass
     /// ([`crate::plan::ShadowMethod::Exact`]) rather than its map.
     pub fn exact_shadows(&self) -> bool {
-        self.shader_variant & crate::gpu::shaders::scene::BIT_EXACT != 0
+        self.verdicts == Some(PixelVerdicts::Exact)
+    }
+
+    /// Whether contact shadows darkened the shown light's creases this frame
+    /// ([`crate::plan::ShadowSettings::contact`]).
+    pub fn contact_shadows(&self) -> bool {
+        self.verdicts == Some(PixelVerdicts::Contact)
     }
 
     /// Whether light `i` is shadowed by the map this frame (shadows on and it has views).
@@ -397,6 +406,7 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         shadow_format,
         camera_position: view.camera.position(),
         orthographic: view.camera.is_orthographic(),
+        verdicts: None,
         shader_variant: frame_variant_bits(
             lights.len() == 1 && lights[0].kind == LightKind::Directional,
             shadows_on,
@@ -418,6 +428,15 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         unlit_scale,
         metered_lux,
     }
+}
+
+/// What decides the shown light's visibility per pixel beside the maps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum PixelVerdicts {
+    /// Exact shadows: the exact pass's verdict replaces the maps where it judged.
+    Exact,
+    /// Contact shadows: dark where a contact ray found a caster, the maps elsewhere.
+    Contact,
 }
 
 /// The scene shader's frame variant bits: one directional light and nothing else (a constant

@@ -194,6 +194,12 @@ pub struct ShadowSettings {
     pub enabled: bool,
     /// Shadow maps or exact shadows.
     pub method: ShadowMethod,
+    /// Contact shadows over the maps (`crate::render::passes::exact`): each pixel's shadow ray
+    /// marched a few texels towards the shown light through the depth the camera sees, dark where
+    /// it passes behind a surface. Restores contact detail finer than the map's texels; sees only
+    /// what the camera sees. Hard shadows only (not with PCSS), devices with fragment-shader
+    /// stores; ignored with exact shadows, which need none.
+    pub contact: bool,
     /// Map size in texels (square), within [`ShadowSettings::MAP_SIZES`] (the renderer clamps
     /// other values into it).
     pub map_size: u32,
@@ -260,6 +266,7 @@ impl Default for ShadowSettings {
         Self {
             enabled: true,
             method: ShadowMethod::Map,
+            contact: false,
             map_size: 2048,
             format: ShadowFormat::Auto,
             pcf: Pcf::P2x2,

@@ -39,6 +39,8 @@ pub enum Action {
     ToggleFxaa,
     /// Shadow maps ↔ exact shadows (`M`; `ShadowSettings::method`).
     ToggleMethod,
+    /// Contact shadows on/off (`B`; `ShadowSettings::contact`).
+    ToggleContact,
     /// Exposure half a stop up (`.`).
     ExposureUp,
     /// Exposure half a stop down (`,`).
@@ -191,6 +193,17 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 Tonemap::None => Tonemap::Neutral,
             };
             apply(Action::SetTonemap(next), view, sun)
+        }
+        Action::ToggleContact => {
+            s.contact = !s.contact;
+            format!(
+                "contact shadows: {}",
+                if s.contact {
+                    "on (hard shadows; not with exact shadows)"
+                } else {
+                    "off"
+                }
+            )
         }
         Action::ToggleMethod => {
             let next = match view.shadow.method {
@@ -419,6 +432,10 @@ mod tests {
         assert_eq!(v.post_aa, PostAa::Fxaa);
         apply(Action::ToggleFxaa, &mut v, &mut sun);
         assert_eq!(v.post_aa, PostAa::None);
+        assert!(apply(Action::ToggleContact, &mut v, &mut sun).contains("on"));
+        assert!(v.shadow.contact);
+        apply(Action::ToggleContact, &mut v, &mut sun);
+        assert!(!v.shadow.contact);
         assert!(apply(Action::ToggleMethod, &mut v, &mut sun).contains("exact"));
         assert_eq!(v.shadow.method, ShadowMethod::Exact);
         apply(Action::ToggleMethod, &mut v, &mut sun);

@@ -120,6 +120,10 @@ pub struct SweepArgs {
     /// configuration.
     #[arg(long)]
     pub exact: bool,
+    /// Also contact shadows over the default maps (`--contact-shadows`: filter `contact`), one
+    /// configuration.
+    #[arg(long)]
+    pub contact: bool,
     /// Give every light this size (as for render: degrees of a directional light, radius of
     /// a point or spot light) and add PCSS (filter `pcss`); the reference is the area light,
     /// the other filters cast hard shadows from it.
@@ -264,7 +268,7 @@ pub struct ViewArgsCmd {
     pub validation: bool,
     /// Automation: inputs to play, one every two frames, comma-separated, each optionally
     /// repeated with `*N`: `WxH` resizes (0x0 minimises), `key:NAME` presses a key (up down left
-    /// right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r y m f1), `wheel:N`
+    /// right [ ] k + - v h n g j l t comma period f tab c o p space u i z x r y m b f1), `wheel:N`
     /// scrolls N lines (positive zooms in), `click:X:Y` picks at window pixel (X, Y), `ui:NAME`
     /// clicks the panel's widget NAME, `drop:PATH` drops a file on the window,
     /// `copy:SRC>DST` copies a file (a model changed on disk) and `wait:reload` waits for the
@@ -436,6 +440,11 @@ pub struct ViewArgs {
     /// shadowed directional or spot light, else maps).
     #[arg(long, value_parser = ["map", "exact"], default_value = "map")]
     pub shadow_method: String,
+    /// Contact shadows over the maps: each pixel's shadow ray marched 8 texels towards the shown
+    /// light through the depth the camera sees (contact detail finer than a texel; hard shadows
+    /// only).
+    #[arg(long)]
+    pub contact_shadows: bool,
     /// PCF kernel (2x2 by default: on the demo, wider kernels cost more and measured no better
     /// against the ray-cast reference).
     #[arg(long, value_enum, default_value = "2x2")]
@@ -762,6 +771,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     v.shadow = ShadowSettings {
         enabled: !a.no_shadows,
         method: a.shadow_method.parse().unwrap_or_default(),
+        contact: a.contact_shadows,
         map_size: a.shadow_map,
         format: a.shadow_format.parse().unwrap_or(ShadowFormat::Auto),
         pcf: pcf_of(a.pcf),

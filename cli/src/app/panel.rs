@@ -107,7 +107,7 @@ const MAP_SIZES: [u32; 8] = [64, 128, 256, 512, 1024, 2048, 4096, 8192];
 const BUDGETS: [f64; 5] = [0.0, 0.05, 0.1, 0.2, 0.5];
 
 /// The keys, for the legend.
-const KEYS: [(&str, &str); 24] = [
+const KEYS: [(&str, &str); 25] = [
     ("F1", "panel on/off"),
     ("left drag / right drag / wheel", "orbit / pan / zoom"),
     ("click", "pick"),
@@ -118,6 +118,7 @@ const KEYS: [(&str, &str); 24] = [
     ("arrows", "sun azimuth / elevation"),
     ("[ ]", "shadow map ½ / ×2"),
     ("M", "shadow maps / exact shadows"),
+    ("B", "contact shadows"),
     ("K", "PCF kernel"),
     ("N", "cascades"),
     ("G", "depth fit"),
@@ -252,6 +253,12 @@ fn shadow_section(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: 
             w.add("depth-fit", &r);
             if r.changed() {
                 out.push(Command::ToggleDepthFit);
+            }
+            let mut contact = s.contact;
+            let r = ui.checkbox(&mut contact, "contact shadows (B)");
+            w.add("contact", &r);
+            if r.changed() {
+                out.push(Command::Set(Action::ToggleContact));
             }
             let mut soft = s.soft;
             let r = ui.checkbox(&mut soft, "soft shadows for lights with a size (J)");

@@ -15,7 +15,8 @@
 /// Key names a script may press (each one of the viewer's bindings).
 pub const KEYS: &[&str] = &[
     "up", "down", "left", "right", "[", "]", "k", "+", "-", "v", "h", "n", "g", "j", "l", "t",
-    "comma", "period", "f", "tab", "c", "o", "p", "space", "u", "i", "z", "x", "r", "y", "m", "f1",
+    "comma", "period", "f", "tab", "c", "o", "p", "space", "u", "i", "z", "x", "r", "y", "m", "b",
+    "f1",
 ];
 
 /// Most steps one script may expand to (a typo such as `*1000000000` is an error, not a hang).

@@ -278,6 +278,13 @@ where
             .map_err(e)?;
         chart
             .draw_series(
+                of("contact")
+                    .into_iter()
+                    .map(|p| EmptyElement::at(p) + Rectangle::new([(-6, -6), (6, 6)], line)),
+            )
+            .map_err(e)?;
+        chart
+            .draw_series(
                 of("exact")
                     .into_iter()
                     .map(|p| EmptyElement::at(p) + Rectangle::new([(-6, -6), (6, 6)], fill)),
@@ -297,6 +304,7 @@ where
         ("PCF 5x5", 3),
         ("PCSS", 4),
         ("exact", 5),
+        ("PCF 2x2 + contact", 6),
     ] {
         chart
             .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
@@ -309,7 +317,9 @@ where
                     2 => TriangleMarker::new((x, y), 5, grey.filled()).into_dyn(),
                     3 => Circle::new((x, y), 6, grey.stroke_width(2)).into_dyn(),
                     4 => TriangleMarker::new((x, y), 8, grey.stroke_width(2)).into_dyn(),
-                    _ => Rectangle::new([(x - 6, y - 6), (x + 6, y + 6)], grey.filled()).into_dyn(),
+                    5 => Rectangle::new([(x - 6, y - 6), (x + 6, y + 6)], grey.filled()).into_dyn(),
+                    _ => Rectangle::new([(x - 6, y - 6), (x + 6, y + 6)], grey.stroke_width(2))
+                        .into_dyn(),
                 }
             });
     }

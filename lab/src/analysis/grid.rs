@@ -54,6 +54,8 @@ impl Config {
     pub fn filter(&self) -> &'static str {
         if self.shadow.method == ShadowMethod::Exact {
             "exact"
+        } else if self.shadow.contact {
+            "contact"
         } else if self.pcss {
             "pcss"
         } else {
@@ -129,6 +131,9 @@ pub struct Grid {
     /// Also exact shadows (`ShadowMethod::Exact`, method and filter `exact`): one configuration,
     /// at the largest map of `maps` (which only the pixels the exact pass does not judge read).
     pub exact: bool,
+    /// Also contact shadows over the default maps (`ShadowSettings::contact`, filter
+    /// `contact`): one configuration, at the largest map of `maps`.
+    pub contact: bool,
 }
 
 impl Grid {
@@ -149,6 +154,7 @@ impl Grid {
             sdsm: false,
             pcss: false,
             exact: false,
+            contact: false,
         }
     }
 
@@ -211,10 +217,21 @@ impl Grid {
                 }
             }
         }
+        let largest = self.maps.iter().copied().max().unwrap_or(2048);
         if self.exact {
-            out.push(Config::exact(
-                self.maps.iter().copied().max().unwrap_or(2048),
-            ));
+            out.push(Config::exact(largest));
+        }
+        if self.contact {
+            out.push(Config {
+                shadow: ShadowSettings {
+                    contact: true,
+                    map_size: largest,
+                    soft: false,
+                    ..ShadowSettings::default()
+                },
+                bias: "default",
+                pcss: false,
+            });
         }
         out
     }
@@ -308,7 +325,7 @@ mod tests {
     }
 
     #[test]
-    fn exact_shadows_join_the_grid_as_one_configuration() {
+    fn exact_and_contact_shadows_join_the_grid_as_one_configuration_each() {
         let g = Grid {
             exact: true,
             ..Grid::quick()
@@ -320,6 +337,13 @@ mod tests {
         assert_eq!(exact[0].filter(), "exact");
         assert_eq!(exact[0].shadow.method, ShadowMethod::Exact);
         assert_eq!(exact[0].name(), "4096-auto-exact-exact-default");
+        let g = Grid {
+            contact: true,
+            ..Grid::quick()
+        };
+        let last = g.configs().pop().unwrap();
+        assert!(last.shadow.contact && !last.shadow.soft);
+        assert_eq!(last.name(), "4096-auto-contact-auto-default");
     }
 
     #[test]

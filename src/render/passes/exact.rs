@@ -49,6 +49,9 @@ struct ExactFrame {
     grid_from_world: Mat4,
     light: Vec4,
     params: Vec4,
+    camera_clip: Mat4,
+    eye: Vec4,
+    contact: Vec4,
 }
 
 /// `ExactImmediates` of `shaders/exact.wgsl`.
@@ -59,14 +62,31 @@ struct ExactImmediates {
     extra: Mat4,
 }
 
+/// What the pass decides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ExactMode {
+    /// Exact shadows: every receiver's shadow ray against the caster triangles.
+    Exact,
+    /// Contact shadows: each ray marched `length` (world units; per unit of distance to a light
+    /// with a position) through the receivers as a depth image, surfaces `thickness` thick.
+    Contact {
+        /// March length.
+        length: f32,
+        /// Thickness of what the depth image shows.
+        thickness: f32,
+    },
+}
+
 /// What one frame's exact pass needs from its plan.
 pub struct ExactFrameInputs {
+    /// Exact or contact shadows.
+    pub mode: ExactMode,
     /// The light's view (clip from world) the grid covers.
     pub grid_from_world: Mat4,
-    /// The direction a directional light's rays travel, or a spot light's position.
+    /// The direction a directional light's rays travel, or a spot or point light's position.
     pub light: Vec3,
-    /// A spot light (else directional).
-    pub spot: bool,
+    /// A light with a position (spot, or point for contact shadows), else directional.
+    pub positional: bool,
     /// Shadow rays start this far off the surface and ignore hits nearer (world units).
     pub eps: f32,
     /// The camera's clip from world.
@@ -102,6 +122,7 @@ pub struct ExactPass {
     module: vk::ShaderModule,
     receiver: vk::Pipeline,
     build: vk::Pipeline,
+    contact: vk::Pipeline,
     caster: vk::Pipeline,
     pool: vk::DescriptorPool,
     sets: Vec<vk::DescriptorSet>,
@@ -166,22 +187,27 @@ impl ExactPass {
                 samples: 1,
             },
         )?;
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
-            .name(sh::ENTRY_CS_BUILD);
-        let info = vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(layout);
-        let build = unsafe {
-            ctx.device
-                .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
-        }
-        .map_err(|(_, e)| GpuError::Vk {
-            call: "vkCreateComputePipelines",
-            result: e,
-        })?[0];
-        ctx.set_name(build, "exact build");
+        let compute = |entry, name: &str| -> Result<vk::Pipeline, GpuError> {
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(module)
+                .name(entry);
+            let info = vk::ComputePipelineCreateInfo::default()
+                .stage(stage)
+                .layout(layout);
+            let p = unsafe {
+                ctx.device
+                    .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
+            }
+            .map_err(|(_, e)| GpuError::Vk {
+                call: "vkCreateComputePipelines",
+                result: e,
+            })?[0];
+            ctx.set_name(p, name);
+            Ok(p)
+        };
+        let build = compute(sh::ENTRY_CS_BUILD, "exact build")?;
+        let contact = compute(sh::ENTRY_CS_CONTACT, "contact shadows")?;
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, set_layout, slots)?;
         let uniforms = (0..slots)
             .map(|i| {
@@ -209,6 +235,7 @@ impl ExactPass {
             module,
             receiver,
             build,
+            contact,
             caster,
             pool,
             sets,
@@ -322,9 +349,16 @@ impl ExactPass {
             .targets
             .as_ref()
             .map_or(vk::Extent2D::default(), |t| t.extent);
+        let (length, thickness) = match f.mode {
+            ExactMode::Exact => (0.0, 0.0),
+            ExactMode::Contact { length, thickness } => (length, thickness),
+        };
         let u = ExactFrame {
+            camera_clip: f.clip_from_world,
+            eye: f.eye.0.extend(1.0),
+            contact: Vec4::new(length, 0.0, thickness, 0.0),
             grid_from_world: f.grid_from_world,
-            light: f.light.extend(if f.spot {
+            light: f.light.extend(if f.positional {
                 crate::gpu::shaders::scene::LIGHT_SPOT
             } else {
                 crate::gpu::shaders::scene::LIGHT_DIRECTIONAL
@@ -431,9 +465,31 @@ impl ExactPass {
             );
         }
         unsafe { d.cmd_end_rendering(cmd) };
-        // 2. Binning.
         t.position.transition(d, cmd, Access::ComputeSampled);
         t.normal.transition(d, cmd, Access::ComputeSampled);
+        let groups = (t.extent.width.div_ceil(8), t.extent.height.div_ceil(8));
+        if let ExactMode::Contact { .. } = f.mode {
+            unsafe {
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.contact);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::COMPUTE,
+                    self.layout,
+                    0,
+                    &[set],
+                    &[],
+                );
+                d.cmd_dispatch(cmd, groups.0, groups.1, 1);
+            }
+            memory_barrier(
+                d,
+                cmd,
+                (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+                (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
+            );
+            return;
+        }
+        // 2. Binning.
         memory_barrier(
             d,
             cmd,
@@ -544,6 +600,7 @@ impl Drop for ExactPass {
             self.targets = None;
             d.destroy_pipeline(self.receiver, None);
             d.destroy_pipeline(self.build, None);
+            d.destroy_pipeline(self.contact, None);
             d.destroy_pipeline(self.caster, None);
             d.destroy_shader_module(self.module, None);
             d.destroy_pipeline_layout(self.layout, None);

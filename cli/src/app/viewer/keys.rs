@@ -78,6 +78,7 @@ pub fn script_key(name: &str) -> Option<KeyCode> {
         "r" => KeyCode::KeyR,
         "y" => KeyCode::KeyY,
         "m" => KeyCode::KeyM,
+        "b" => KeyCode::KeyB,
         "f1" => KeyCode::F1,
         _ => return None,
     })
@@ -104,6 +105,7 @@ pub fn key_action(code: KeyCode) -> Option<KeyAction> {
         KeyCode::KeyT => Setting(Action::CycleTonemap),
         KeyCode::KeyY => Setting(Action::ToggleFxaa),
         KeyCode::KeyM => Setting(Action::ToggleMethod),
+        KeyCode::KeyB => Setting(Action::ToggleContact),
         KeyCode::Period => Setting(Action::ExposureUp),
         KeyCode::Comma => Setting(Action::ExposureDown),
         KeyCode::KeyL => ShadowLight,
