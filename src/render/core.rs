@@ -205,14 +205,10 @@ impl FrameCore {
         };
         let mut plan = plan.with_casters(casters);
         let extent = vk::Extent2D { width, height };
-        let exact = if exact_asked {
-            self.prepare_exact(slot, view, &mut plan, extent, ExactMode::Exact)?
-        } else if view.shadow.enabled && view.shadow.contact && self.ctx.fragment_stores {
-            let mode = ExactMode::Contact {
-                length: 0.0,
-                thickness: 0.0,
-            };
-            self.prepare_exact(slot, view, &mut plan, extent, mode)?
+        let contact_asked =
+            !exact_asked && view.shadow.enabled && view.shadow.contact && self.ctx.fragment_stores;
+        let exact = if exact_asked || contact_asked {
+            self.prepare_exact(slot, view, &mut plan, extent, contact_asked)?
         } else {
             None
         };
@@ -246,17 +242,17 @@ impl FrameCore {
         })
     }
 
-    /// The exact pass's inputs for `plan` (and its shader bit set) when `mode` applies: exact
-    /// shadows need one shadowed directional or spot light with one view; contact shadows a
-    /// shown shadowed light and hard shadows (their length is `CONTACT_TEXELS` of its finest
-    /// view, the `mode`'s own ignored). Makes the pass and its targets.
+    /// The exact pass's inputs for `plan` (and its shader bit set) for exact shadows, or with
+    /// `contact` contact shadows, when they apply: exact shadows need one shadowed directional
+    /// or spot light with one view; contact shadows a shown shadowed light and hard shadows
+    /// (they march `CONTACT_TEXELS` of its finest view). Makes the pass and its targets.
     fn prepare_exact(
         &mut self,
         slot: usize,
         view: &View,
         plan: &mut FramePlan,
         extent: vk::Extent2D,
-        mode: ExactMode,
+        contact: bool,
     ) -> Result<Option<ExactFrameInputs>, GpuError> {
         let bits = plan.shader_variant;
         let shown = plan.shadow_light.and_then(|i| {
@@ -269,9 +265,9 @@ impl FrameCore {
         else {
             return Ok(None);
         };
-        let mode = match mode {
-            ExactMode::Exact if plan.shadow_views.len() == 1 => ExactMode::Exact,
-            ExactMode::Contact { .. } if bits & sh::BIT_SOFT == 0 => {
+        let mode = match contact {
+            false if plan.shadow_views.len() == 1 => ExactMode::Exact,
+            true if bits & sh::BIT_SOFT == 0 => {
                 let length = CONTACT_TEXELS * plan.shadow_views[first].texel_world;
                 ExactMode::Contact {
                     length,
