@@ -108,31 +108,36 @@ fn viewer_chooses_shadow_settings_for_a_budget() {
 #[test]
 fn resizing_through_zero_and_back_is_clean() {
     let x = Xvfb::start();
-    let shot = out("viewer_resized.png");
-    let (ok, log) = umbra(
-        &[
-            "view",
-            "--frames",
-            "12",
-            "--screenshot",
-            shot.to_str().unwrap(),
-            "--validation",
-            "--no-vsync",
-            "--size",
-            "320x240",
-            "--resize-script",
-            "400x300,0x0,0x0,200x150,0x0,640x360,300x200",
-        ],
-        Some(&x.display),
-    );
-    assert!(ok, "viewer failed while resizing:\n{log}");
-    assert!(!log.contains("panicked"), "{log}");
-    let img = image::open(&shot).unwrap().to_rgba8();
-    assert_eq!(
-        img.dimensions(),
-        (300, 200),
-        "the last size must be the one on screen"
-    );
+    // With maps, and with exact shadows (whose images and buffers are remade at each size).
+    for method in ["map", "exact"] {
+        let shot = out(&format!("viewer_resized_{method}.png"));
+        let (ok, log) = umbra(
+            &[
+                "view",
+                "--frames",
+                "12",
+                "--screenshot",
+                shot.to_str().unwrap(),
+                "--validation",
+                "--no-vsync",
+                "--size",
+                "320x240",
+                "--shadow-method",
+                method,
+                "--resize-script",
+                "400x300,0x0,0x0,200x150,0x0,640x360,300x200",
+            ],
+            Some(&x.display),
+        );
+        assert!(ok, "viewer failed while resizing ({method}):\n{log}");
+        assert!(!log.contains("panicked"), "{log}");
+        let img = image::open(&shot).unwrap().to_rgba8();
+        assert_eq!(
+            img.dimensions(),
+            (300, 200),
+            "the last size must be the one on screen"
+        );
+    }
 }
 
 #[test]

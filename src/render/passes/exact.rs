@@ -17,7 +17,7 @@
 //! shared by the frames in flight (each frame's barriers order it after the previous one's use).
 
 use crate::gpu::barrier::{memory_barrier, Access};
-use crate::gpu::context::{Context, GpuError};
+use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::resources::Buffer;
 use crate::gpu::shaders::{allocate_sets, create_module, exact as sh, set_layout_for};
 use crate::gpu::Image;
@@ -257,7 +257,11 @@ impl ExactPass {
         if self.targets.as_ref().is_some_and(|t| t.extent == extent) {
             return Ok(());
         }
-        self.targets = None;
+        if let Some(old) = self.targets.take() {
+            // A new image size: the frames in flight may still read the old targets and sets.
+            unsafe { self.ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
+            drop(old);
+        }
         let ctx = &self.ctx;
         let image = |name: &str, format, usage| Image::new(ctx, name, format, extent, 1, usage);
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
