@@ -18,8 +18,9 @@
 #include "lib/material.wgsl"
 
 struct ExactFrame {
-    // The grid: the shadowed light's view (clip space).
-    grid_from_world: mat4x4<f32>,
+    // The grid: the shadowed light's view (clip space), or a point light's six cube faces, each
+    // its own grid of g² cells (`counts.x` views).
+    views: array<mat4x4<f32>, 6>,
     // xyz: the direction a directional light's rays travel, or a spot light's position;
     // w: LIGHT_DIRECTIONAL or LIGHT_SPOT.
     light: vec4<f32>,
@@ -32,6 +33,8 @@ struct ExactFrame {
     // distance to a spot or point light, whose texels grow with it), z = the thickness a surface
     // in the depth image is taken to have.
     contact: vec4<f32>,
+    // x: the views (1, or 6 for a point light's cube).
+    counts: vec4<f32>,
 }
 
 const LIGHT_DIRECTIONAL: f32 = 0.0;
@@ -44,8 +47,9 @@ const ATTRIBUTE_WORDS: u32 = 13u;
 const OCCLUDED: f32 = 0.0;
 
 @group(0) @binding(0) var<uniform> xf: ExactFrame;
-// Cells 0..g²: each cell's list head (sample + 1, 0 for none); cells g²..2g²: the farthest of
-// its samples' shadow ray origins from the light (`ordered` light depth, 0 for none).
+// Cells 0..n (n = views × g²): each cell's list head (sample + 1, 0 for none); n..2n: the
+// farthest of its samples' shadow ray origins from a directional light (`ordered` light depth, 0
+// for none).
 @group(0) @binding(1) var<storage, read_write> heads: array<atomic<u32>>;
 @group(0) @binding(2) var<storage, read_write> next: array<u32>;
 // Element 0: (width, height, 0, 0); element 1 + i: pixel i's (world position, verdict).
@@ -67,7 +71,7 @@ const OCCLUDED: f32 = 0.0;
 struct ExactImmediates {
     world_from_model: mat4x4<f32>,
     // Receiver pass: the camera's clip_from_world. Caster pass: x = first index, y = vertex
-    // offset (bit-cast i32), z = 1 when the caster's alpha is tested, w unused.
+    // offset (bit-cast i32), z = 1 when the caster's alpha is tested, w = the view (cube face).
     extra: mat4x4<f32>,
 }
 
@@ -129,21 +133,44 @@ fn ordered(f: f32) -> u32 {
     return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
 }
 
-// The grid cell of world point `p`, or the cell count (none) outside the light's view.
+// All the grids' cells.
+fn cell_count() -> u32 {
+    let g = u32(xf.params.y);
+    return u32(xf.counts.x) * g * g;
+}
+
+// The cube face a point light's ray towards `d` (from the light) leaves by: +x, -x, +y, -y, +z,
+// -z (the shadow maps' order, shaders/lib/shadow_lookup.wgsl).
+fn cube_face(d: vec3<f32>) -> u32 {
+    let a = abs(d);
+    if a.x >= a.y && a.x >= a.z {
+        return select(1u, 0u, d.x >= 0.0);
+    }
+    if a.y >= a.z {
+        return select(3u, 2u, d.y >= 0.0);
+    }
+    return select(5u, 4u, d.z >= 0.0);
+}
+
+// The grid cell of world point `p`, or `cell_count()` (none) outside the light's views.
 fn cell_of(p: vec3<f32>) -> u32 {
     let g = u32(xf.params.y);
-    let c = xf.grid_from_world * vec4<f32>(p, 1.0);
+    var view = 0u;
+    if xf.counts.x > 1.5 {
+        view = cube_face(p - xf.light.xyz);
+    }
+    let c = xf.views[view] * vec4<f32>(p, 1.0);
     if c.w <= 0.0 {
-        return g * g;
+        return cell_count();
     }
     let ndc = c.xy / c.w;
     if abs(ndc.x) > 1.0 || abs(ndc.y) > 1.0 {
-        return g * g;
+        return cell_count();
     }
     // Framebuffer rows run down (naga flips clip y on the way out of a vertex shader).
     let t = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * f32(g);
     let cell = min(vec2<u32>(t), vec2<u32>(g - 1u));
-    return cell.y * g + cell.x;
+    return view * g * g + cell.y * g + cell.x;
 }
 
 @compute @workgroup_size(8, 8)
@@ -178,11 +205,11 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
     samples[i + 1u] = vec4<f32>(p, 1.0);
     rays[i] = vec4<f32>(origin, reach - eps);
     let cell = cell_of(origin);
-    let g = u32(xf.params.y);
-    if cell < g * g {
+    let n = cell_count();
+    if cell < n {
         next[i] = atomicExchange(&heads[cell], i + 1u);
         if xf.light.w == LIGHT_DIRECTIONAL {
-            atomicMax(&heads[g * g + cell], ordered(dot(origin, xf.light.xyz)));
+            atomicMax(&heads[n + cell], ordered(dot(origin, xf.light.xyz)));
         }
     }
 }
@@ -343,12 +370,39 @@ fn vs_caster(@builtin(vertex_index) vi: u32) -> CasterOut {
         vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
         vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
     )[corner];
-    let c0 = xf.grid_from_world * vec4<f32>(out.v0, 1.0);
-    let c1 = xf.grid_from_world * vec4<f32>(out.v1, 1.0);
-    let c2 = xf.grid_from_world * vec4<f32>(out.v2, 1.0);
+    let view = xf.views[u32(pc.extra[0].w)];
+    let c0 = view * vec4<f32>(out.v0, 1.0);
+    let c1 = view * vec4<f32>(out.v1, 1.0);
+    let c2 = view * vec4<f32>(out.v2, 1.0);
+    if max(c0.w, max(c1.w, c2.w)) <= 1e-6 {
+        // Wholly behind a spot light's or cube face's plane: a ray from a sample of this view
+        // (in front of it) to the light never reaches it.
+        out.clip = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return out;
+    }
     if min(c0.w, min(c1.w, c2.w)) <= 1e-6 {
-        // Crossing a spot light's plane: the whole grid tests it (slow but exact).
-        out.clip = vec4<f32>(mix(vec2<f32>(-1.0), vec2<f32>(1.0), pick), 0.5, 1.0);
+        // Crossing that plane: the box of its part in front (the triangle clipped at w = 1e-6,
+        // projected), within the grid, tests it.
+        let c = array<vec4<f32>, 3>(c0, c1, c2);
+        var lo = vec2<f32>(3.0e38);
+        var hi = vec2<f32>(-3.0e38);
+        for (var k = 0u; k < 3u; k++) {
+            let a = c[k];
+            let b = c[(k + 1u) % 3u];
+            if a.w > 1e-6 {
+                lo = min(lo, a.xy / a.w);
+                hi = max(hi, a.xy / a.w);
+            }
+            if (a.w - 1e-6) * (b.w - 1e-6) < 0.0 {
+                let q = mix(a, b, (1e-6 - a.w) / (b.w - a.w));
+                lo = min(lo, q.xy / 1e-6);
+                hi = max(hi, q.xy / 1e-6);
+            }
+        }
+        let half = vec2<f32>(1.0 / g);
+        lo = clamp(lo - half, vec2<f32>(-1.0), vec2<f32>(1.0));
+        hi = clamp(hi + half, vec2<f32>(-1.0), vec2<f32>(1.0));
+        out.clip = vec4<f32>(mix(lo, hi, pick), 0.5, 1.0);
         out.cells = vec4<f32>(0.0, 0.0, g - 1.0, g - 1.0);
         out.depth = -3.0e38;
         return out;
@@ -403,9 +457,9 @@ fn fs_caster(in: CasterOut) {
     if cell.x < in.cells.x || cell.y < in.cells.y || cell.x > in.cells.z || cell.y > in.cells.w {
         return;
     }
-    let c = u32(cell.y) * g + u32(cell.x);
+    let c = u32(pc.extra[0].w) * g * g + u32(cell.y) * g + u32(cell.x);
     // Behind every sample of the cell (farther from the light): it blocks none of their rays.
-    if xf.light.w == LIGHT_DIRECTIONAL && ordered(nearest) > atomicLoad(&heads[g * g + c]) {
+    if xf.light.w == LIGHT_DIRECTIONAL && ordered(nearest) > atomicLoad(&heads[cell_count() + c]) {
         return;
     }
     let e1 = in.v1 - in.v0;

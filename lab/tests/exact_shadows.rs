@@ -1,6 +1,7 @@
 //! Exact hard shadows (`ShadowMethod::Exact`, lavapipe, validation on): the irregular z-buffer's
 //! shadow view against the CPU reference's exact visibility, on the demo, generated scenes (solid,
-//! open and double-sided, foliage blended and masked, a grazing sun, a spot light) and
+//! open and double-sided, foliage blended and masked, a grazing sun, a spot light, a point light
+//! in a room) and
 //! FlightHelmet when the corpus is there. Pixel-exact apart from pixels where the two see
 //! different surfaces (mipmapped alpha on the GPU against mip 0 in the reference) and a residue
 //! at exact silhouettes of casters (shadow rays grazing a triangle's edge); the map's figures at
@@ -64,7 +65,7 @@ fn spot_scene() -> Scene {
 
 #[test]
 fn exact_shadows_agree_with_the_reference_at_every_judged_pixel() {
-    let mut scenes = vec![demo_scene(), spot_scene()];
+    let mut scenes = vec![demo_scene(), spot_scene(), synthetic::room_scene()];
     for name in [
         "foliage",
         "foliage-masked",
@@ -124,13 +125,12 @@ fn exact_shadows_agree_with_the_reference_at_every_judged_pixel() {
 
 #[test]
 fn frames_exact_shadows_cannot_judge_fall_back_to_maps() {
-    // A point light (six views) and two shadowed lights: maps, as the settings document.
-    for scene in [synthetic::room_scene(), synthetic::sun_and_spot_scene()] {
-        let (m, ran) = measure(&scene, ShadowMethod::Exact);
-        assert!(!ran, "{}: the exact pass ran", scene.name);
-        // Measured: 0.04–0.2 %, the maps' own figures.
-        assert!(m.misclassified < 0.01, "{}: {:?}", scene.name, m);
-    }
+    // Two shadowed lights: maps, as the settings document.
+    let scene = synthetic::sun_and_spot_scene();
+    let (m, ran) = measure(&scene, ShadowMethod::Exact);
+    assert!(!ran, "{}: the exact pass ran", scene.name);
+    // Measured: 0.04 %, the maps' own figure.
+    assert!(m.misclassified < 0.001, "{}: {:?}", scene.name, m);
 }
 
 #[test]

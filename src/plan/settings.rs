@@ -130,9 +130,9 @@ pub enum ShadowMethod {
     Map,
     /// Exact hard shadows by an irregular z-buffer (`crate::render::passes::exact`): each pixel's
     /// shadow ray tested against the caster triangles themselves, no bias, no texels. For one
-    /// shadowed directional or spot light with one view (the map's single cascade); frames where
-    /// that does not hold (a point light, several shadowed lights), and devices without
-    /// fragment-shader stores, use maps. Hard: a light's size is ignored.
+    /// shadowed light: directional (the map's single cascade behind it), spot, or point (a grid
+    /// per cube face); frames with several shadowed lights, and devices without fragment-shader
+    /// stores, use maps. Hard: a light's size is ignored.
     Exact,
 }
 

@@ -265,8 +265,13 @@ impl FrameCore {
         else {
             return Ok(None);
         };
+        // Exact: the shown light's views are the frame's, one (a sun's single map, a spot
+        // light) or a point light's six faces.
+        let only_shown = plan.shadow_views.iter().all(|v| v.light == shown);
+        let point = plan.lights[shown].kind == crate::scene::LightKind::Point;
+        let views = plan.shadow_views.len();
         let mode = match contact {
-            false if plan.shadow_views.len() == 1 => ExactMode::Exact,
+            false if only_shown && (views == 1 || (point && views == 6)) => ExactMode::Exact,
             true if bits & sh::BIT_SOFT == 0 => {
                 let length = CONTACT_TEXELS * plan.shadow_views[first].texel_world;
                 ExactMode::Contact {
@@ -276,7 +281,6 @@ impl FrameCore {
             }
             _ => return Ok(None),
         };
-        let sv = &plan.shadow_views[first];
         let (light, positional) = match plan.light_source(shown) {
             Viewpoint::Eye(p) => (p, true),
             Viewpoint::Along(d) => (d, false),
@@ -286,7 +290,11 @@ impl FrameCore {
         let half = cam.half_extent_at(cam.near, aspect);
         let inputs = ExactFrameInputs {
             mode,
-            grid_from_world: sv.light_clip_from_world,
+            views: plan
+                .shadow_views
+                .iter()
+                .map(|v| v.light_clip_from_world)
+                .collect(),
             light,
             positional,
             // The CPU reference's ray offset: 2·10⁻⁵ of the scene's diagonal.
@@ -298,7 +306,16 @@ impl FrameCore {
             ),
             receivers: (0..self.gpu.draws.len()).collect(),
             casters: match mode {
-                ExactMode::Exact => sv.casters.draws.clone(),
+                ExactMode::Exact => {
+                    let mut all: Vec<usize> = plan
+                        .shadow_views
+                        .iter()
+                        .flat_map(|v| v.casters.draws.iter().copied())
+                        .collect();
+                    all.sort_unstable();
+                    all.dedup();
+                    all
+                }
                 ExactMode::Contact { .. } => Vec::new(),
             },
         };

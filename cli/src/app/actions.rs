@@ -268,8 +268,7 @@ fn apply_set(a: Action, view: &mut View, sun: &mut SunAngles) -> Option<String> 
             match m {
                 ShadowMethod::Map => "shadows: maps".to_string(),
                 ShadowMethod::Exact => {
-                    "shadows: exact (one shadowed directional or spot light; maps otherwise)"
-                        .to_string()
+                    "shadows: exact (one shadowed light; maps otherwise)".to_string()
                 }
             }
         }

@@ -437,7 +437,7 @@ pub struct ViewArgs {
     pub shadow_format: String,
     /// How shadows are decided: `map` (shadow maps, the default) or `exact` (each pixel's shadow
     /// ray tested against the caster triangles on the device: exact hard shadows, no bias; one
-    /// shadowed directional or spot light, else maps).
+    /// shadowed light, else maps).
     #[arg(long, value_parser = ["map", "exact"], default_value = "map")]
     pub shadow_method: String,
     /// Contact shadows over the maps: each pixel's shadow ray marched 8 texels towards the shown
@@ -624,13 +624,13 @@ pub fn print_warning(scene: &str, w: &umbra::scene::Warning) {
 }
 
 /// Warns when `view` asked for exact shadows and the frame planned as `plan` could not have
-/// them (its shadowed lights are not one directional or spot light with one view).
+/// them (it has several shadowed lights, or the device no fragment-shader stores).
 pub fn warn_exact(view: &View, plan: &umbra::FramePlan) {
     if view.shadow.method == umbra::ShadowMethod::Exact && plan.shadows_on && !plan.exact_shadows()
     {
         eprintln!(
             "warning: --shadow-method exact: {} shadow view(s) (exact shadows need one shadowed \
-             directional or spot light, or a device with fragment-shader stores); shadow maps used",
+             light, and a device with fragment-shader stores); shadow maps used",
             plan.shadow_views.len()
         );
     }

@@ -39,6 +39,29 @@ use std::sync::Arc;
 /// FlightHelmet close by; 32 MiB of heads and depths, cleared every frame.)
 pub const GRID: u32 = 2048;
 
+/// Cells per side of each of a point light's six cube-face grids (six of 2048² would be 192 MiB).
+pub const CUBE_GRID: u32 = 1024;
+
+/// Cells of the largest grid set: one `GRID`² or six `CUBE_GRID`².
+const MAX_CELLS: u64 = {
+    let one = (GRID as u64) * (GRID as u64);
+    let six = 6 * (CUBE_GRID as u64) * (CUBE_GRID as u64);
+    if one > six {
+        one
+    } else {
+        six
+    }
+};
+
+/// Cells per side of the grids of a frame with `views` light views.
+fn grid_side(views: usize) -> u32 {
+    if views > 1 {
+        CUBE_GRID
+    } else {
+        GRID
+    }
+}
+
 const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
@@ -46,12 +69,13 @@ const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct ExactFrame {
-    grid_from_world: Mat4,
+    views: [Mat4; 6],
     light: Vec4,
     params: Vec4,
     camera_clip: Mat4,
     eye: Vec4,
     contact: Vec4,
+    counts: Vec4,
 }
 
 /// `ExactImmediates` of `shaders/exact.wgsl`.
@@ -81,8 +105,9 @@ pub enum ExactMode {
 pub struct ExactFrameInputs {
     /// Exact or contact shadows.
     pub mode: ExactMode,
-    /// The light's view (clip from world) the grid covers.
-    pub grid_from_world: Mat4,
+    /// The light's view (clip from world) the grid covers, or a point light's six cube faces
+    /// (a grid each).
+    pub views: Vec<Mat4>,
     /// The direction a directional light's rays travel, or a spot or point light's position.
     pub light: Vec3,
     /// A light with a position (spot, or point for contact shadows), else directional.
@@ -290,7 +315,7 @@ impl ExactPass {
             _position: position,
             _normal: normal,
             _depth: depth,
-            heads: storage("exact grid heads", 2 * (GRID * GRID) as u64 * 4)?,
+            heads: storage("exact grid heads", 2 * MAX_CELLS * 4)?,
             next: storage("exact sample links", pixels * 4)?,
             samples: storage("exact samples", (pixels + 1) * 16)?,
             rays: storage("exact shadow rays", pixels * 16)?,
@@ -361,7 +386,8 @@ impl ExactPass {
             camera_clip: f.clip_from_world,
             eye: f.eye.0.extend(1.0),
             contact: Vec4::new(length, 0.0, thickness, 0.0),
-            grid_from_world: f.grid_from_world,
+            views: std::array::from_fn(|i| f.views.get(i).copied().unwrap_or(Mat4::ZERO)),
+            counts: Vec4::new(f.views.len() as f32, 0.0, 0.0, 0.0),
             light: f.light.extend(if f.positional {
                 crate::gpu::shaders::scene::LIGHT_SPOT
             } else {
@@ -369,7 +395,7 @@ impl ExactPass {
             }),
             params: Vec4::new(
                 f.eps,
-                GRID as f32,
+                grid_side(f.views.len()) as f32,
                 extent.width as f32,
                 extent.height as f32,
             ),
@@ -530,9 +556,10 @@ impl ExactPass {
             ),
         );
         // 3. Casters, into the grid (no attachments: the fragments only test and mark).
+        let side = grid_side(f.views.len());
         let grid = vk::Extent2D {
-            width: GRID,
-            height: GRID,
+            width: side,
+            height: side,
         };
         let info = vk::RenderingInfo::default()
             .render_area(vk::Rect2D {
@@ -558,31 +585,33 @@ impl ExactPass {
         for &i in &f.casters {
             let dr = &scene.draws[i];
             scene.bind_material(d, cmd, self.layout, 1, dr.material);
-            let mut extra = Mat4::ZERO;
-            extra.x_axis = Vec4::new(
-                f32::from_bits(dr.first_index),
-                f32::from_bits(dr.vertex_offset as u32),
-                if dr.alpha.tests_alpha_in_shadow() {
-                    1.0
-                } else {
-                    0.0
-                },
-                0.0,
-            );
-            let pc = ExactImmediates {
-                world_from_model: dr.world_from_model,
-                extra,
-            };
-            unsafe {
-                d.cmd_push_constants(
-                    cmd,
-                    self.layout,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    0,
-                    bytemuck::bytes_of(&pc),
+            for view in 0..f.views.len() {
+                let mut extra = Mat4::ZERO;
+                extra.x_axis = Vec4::new(
+                    f32::from_bits(dr.first_index),
+                    f32::from_bits(dr.vertex_offset as u32),
+                    if dr.alpha.tests_alpha_in_shadow() {
+                        1.0
+                    } else {
+                        0.0
+                    },
+                    view as f32,
                 );
-                // Six vertices a triangle: the two halves of its box in the grid.
-                d.cmd_draw(cmd, 2 * dr.index_count, 1, 0, 0);
+                let pc = ExactImmediates {
+                    world_from_model: dr.world_from_model,
+                    extra,
+                };
+                unsafe {
+                    d.cmd_push_constants(
+                        cmd,
+                        self.layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&pc),
+                    );
+                    // Six vertices a triangle: the triangle grown (or its box's two halves).
+                    d.cmd_draw(cmd, 2 * dr.index_count, 1, 0, 0);
+                }
             }
         }
         unsafe { d.cmd_end_rendering(cmd) };
