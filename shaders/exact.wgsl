@@ -217,7 +217,7 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
 // ---- Contact shadows (instead of 2 and 3) ----
 
 // Steps of a contact ray.
-const CONTACT_STEPS: u32 = 16u;
+const CONTACT_STEPS: u32 = 8u;
 
 // Each covered pixel's shadow ray marched a short way towards the light through the receiver
 // image as a depth buffer: a step behind what the camera sees there, by less than the thickness,
