@@ -182,6 +182,7 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
     let scored = score(&mut renderer, &reference, &view, (w, h), &mut exact)?;
     let reference_ms = build_ms + scored.reference_ms;
     let (metrics, diff, lit) = (&scored.metrics, &scored.diff, &scored.lit);
+    app::cli::warn_exact(&view, &lit.plan);
     let frame = exact.ok_or_else(|| anyhow::anyhow!("no reference frame"))?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     for (name, img) in [
@@ -216,6 +217,13 @@ fn compare(a: CompareArgs) -> anyhow::Result<()> {
     j["scene"] = serde_json::json!(scene.name);
     j["size"] = serde_json::json!([w, h]);
     j["shadow_map"] = serde_json::json!(view.shadow.map_size);
+    j["shadow_method"] = serde_json::json!(if lit.plan.exact_shadows() {
+        "exact"
+    } else if lit.plan.contact_shadows() {
+        "map+contact"
+    } else {
+        "map"
+    });
     j["bvh_build_ms"] = serde_json::json!(build_ms);
     j["reference_ms"] = serde_json::json!(reference_ms);
     j["gpu_ms"] = serde_json::json!(lit
