@@ -4,18 +4,16 @@
 //! One rule holds on the GPU and in the reference for both: a leaf texel casts and receives
 //! where its alpha reaches the cutoff (0.5 for a blended one), and elsewhere light and the
 //! judged pixel pass through it to what lies behind. So the GPU's shadow view is the same image
-//! for both variants, and the reference agrees with it away from edges as on solid scenes. And
-//! the foliage probe of the stability suite: leaf shadows shimmer along its flythrough with maps,
-//! not with exact shadows.
+//! for both variants, and the reference agrees with it away from edges as on solid scenes. (The
+//! stability suite's foliage probe is in `stability.rs`.)
 
 #[path = "../../tests/common/mod.rs"]
 mod common;
 
 use common::*;
-use umbra::render::{RenderedFrame, Renderer, ShadowMethod, ShadowSettings, View, ViewMode};
+use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
 use umbra::scene::foliage::foliage_scene;
 use umbra::scene::{AlphaMode, Scene};
-use umbra_lab::analysis::stability::shimmer::{camera_path, shimmer, Method};
 use umbra_lab::reference::{classify, PixelClass, ReferenceScene};
 
 // The size.
@@ -118,62 +116,4 @@ fn blended_and_masked_foliage_follow_one_rule_on_the_gpu_and_in_the_reference() 
         differ, 0,
         "{differ} pixels differ between blended and masked"
     );
-}
-
-#[test]
-fn leaf_shadows_shimmer_with_maps_and_hold_still_when_exact() {
-    // The stability suite's flythrough of the foliage (its first 12 frames, 320×180): the
-    // fraction of fixed world points whose shadow flips between consecutive frames while only
-    // the camera moves.
-    let scene = foliage_scene(AlphaMode::Mask(0.5));
-    let ctx = context();
-    let mut r = Renderer::new(&ctx, &scene).unwrap();
-    r.set_read_depth(true);
-    let view = View::new(scene.cameras[0]);
-    let path = camera_path(&scene.cameras[0], &scene.bounds(), 60);
-    let defaults = ShadowSettings::default();
-    let methods = [
-        Method {
-            name: "defaults, held".into(),
-            shadow: defaults,
-            held: true,
-        },
-        Method {
-            name: "single map, snapped".into(),
-            shadow: ShadowSettings {
-                cascades: 1,
-                ..defaults
-            },
-            held: false,
-        },
-        Method {
-            name: "exact".into(),
-            shadow: ShadowSettings {
-                method: ShadowMethod::Exact,
-                ..defaults
-            },
-            held: false,
-        },
-    ];
-    let series = shimmer(&mut r, &view, &path[..12], &methods, (320, 180), &mut || {}).unwrap();
-    drop(r);
-    assert_validation_clean(&ctx);
-    for s in &series {
-        eprintln!(
-            "{}: {:.2e} of the points flip per frame (max {:.2e}, {} flips over {} pairs)",
-            s.method,
-            s.mean_fraction,
-            s.max_fraction,
-            s.flipped.iter().sum::<usize>(),
-            s.flipped.len()
-        );
-    }
-    let of = |m: &str| series.iter().find(|s| s.method == m).unwrap();
-    // Exact verdicts do not depend on the fit: nothing flips (measured 0).
-    assert_eq!(of("exact").flipped.iter().sum::<usize>(), 0);
-    // Leaf shadows finer than a texel shimmer with maps: measured 1.58e-3 for a single snapped
-    // map (171 flips, 1.7e-2 on the pair where its extent steps), 2.97e-5 for the defaults held
-    // as the viewer holds them (3 flips).
-    assert!(of("single map, snapped").mean_fraction > 5e-4);
-    assert!(of("defaults, held").mean_fraction < of("single map, snapped").mean_fraction);
 }
