@@ -1,17 +1,19 @@
 //! Exact hard shadows by an irregular z-buffer ([`crate::plan::ShadowMethod::Exact`]): the
 //! shadowed light's visibility at each pixel's receiver, decided by intersecting its shadow ray
-//! with the caster triangles themselves, on the device (`shaders/exact.wgsl`).
+//! with the caster triangles themselves, on the device (`shaders/exact.wgsl`); and contact
+//! shadows ([`crate::plan::ShadowSettings::contact`]), which share its first step.
 //!
 //! Three steps after the shadow pass: the camera's receivers (what casts and is judged: the
 //! alpha cutoff of the shadow pass) are drawn into a position and a face-normal image; a compute
 //! pass makes each covered pixel a sample and links it into the list of the light-view grid cell
-//! its shadow ray starts in; every caster triangle is drawn into that grid as its light-view box
-//! grown by half a cell, so that each cell it touches runs a fragment, and each fragment tests the
-//! cell's samples against the exact triangle (and its alpha texture), unless the triangle lies
-//! wholly farther from a directional light than every sample of the cell. The camera pass then reads the verdict at
-//! its pixel where its fragment is that receiver, and the shadow map elsewhere (blended layers
-//! over the receiver, MSAA's edge samples). The grid only sorts the work: its size changes the
-//! cost, not the answer.
+//! its shadow ray starts in (a grid per cube face for a point light); every caster triangle is
+//! drawn into that grid grown by half a cell (a sliver as its grown box), so that each cell it
+//! touches runs a fragment, and each fragment tests the cell's samples against the exact
+//! triangle (and its alpha texture), unless the triangle lies wholly farther from a directional
+//! light than every sample of the cell. The camera pass then reads the verdict at its pixel where
+//! its fragment is that receiver, and the shadow map elsewhere (blended layers over the receiver,
+//! MSAA's edge samples). The grid only sorts the work: its size changes the cost, not the answer.
+//! Contact shadows replace the last two steps by a march through the receiver image.
 //!
 //! The images and buffers are made on first use and remade when the image size changes; they are
 //! shared by the frames in flight (each frame's barriers order it after the previous one's use).
