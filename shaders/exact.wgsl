@@ -173,30 +173,54 @@ fn cell_of(p: vec3<f32>) -> u32 {
     return view * g * g + cell.y * g + cell.x;
 }
 
-@compute @workgroup_size(8, 8)
-fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
+// The receiver at a compute invocation: its pixel's index and world position (`position.w` >
+// 0: a surface).
+struct Receiver {
+    index: u32,
+    position: vec4<f32>,
+}
+
+// The receiver of invocation `id`; writes the sample list's header, and "no verdict" for a pixel
+// without a surface. None (`position.w` = 0) outside the image.
+fn receiver_at(id: vec3<u32>) -> Receiver {
     let w = u32(xf.params.z);
     let h = u32(xf.params.w);
     if id.x >= w || id.y >= h {
-        return;
+        return Receiver(0u, vec4<f32>(0.0));
     }
     let i = id.y * w + id.x;
     if i == 0u {
         samples[0] = vec4<f32>(f32(w), f32(h), 0.0, 0.0);
     }
-    let pos = textureLoad(receiver_position, vec2<i32>(id.xy), 0);
-    if pos.w <= 0.0 {
-        samples[i + 1u] = vec4<f32>(pos.xyz, -1.0);
-        return;
+    let position = textureLoad(receiver_position, vec2<i32>(id.xy), 0);
+    if position.w <= 0.0 {
+        samples[i + 1u] = vec4<f32>(position.xyz, -1.0);
     }
-    let p = pos.xyz;
-    var dir = -xf.light.xyz;
-    var reach = 3.0e38;
+    return Receiver(i, position);
+}
+
+// The unit direction from `p` towards the light, and how far the light is (3e38 for a
+// directional light).
+fn towards_light(p: vec3<f32>) -> vec4<f32> {
     if xf.light.w == LIGHT_SPOT {
         let d = xf.light.xyz - p;
-        reach = length(d);
-        dir = d / max(reach, 1e-20);
+        let dist = length(d);
+        return vec4<f32>(d / max(dist, 1e-20), dist);
     }
+    return vec4<f32>(-xf.light.xyz, 3.0e38);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
+    let r = receiver_at(id);
+    if r.position.w <= 0.0 {
+        return;
+    }
+    let i = r.index;
+    let p = r.position.xyz;
+    let to_light = towards_light(p);
+    let dir = to_light.xyz;
+    let reach = to_light.w;
     // Off the surface, on the light's side of the face (the reference's shadow ray origin).
     let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
     let side = select(-ng, ng, dot(ng, dir) >= 0.0);
@@ -226,34 +250,23 @@ const CONTACT_STEPS: u32 = 8u;
 // thickness casts where nothing does (the false shadows `compare` counts).
 @compute @workgroup_size(8, 8)
 fn cs_contact(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = u32(xf.params.z);
-    let h = u32(xf.params.w);
-    if id.x >= w || id.y >= h {
+    let r = receiver_at(id);
+    if r.position.w <= 0.0 {
         return;
     }
-    let i = id.y * w + id.x;
-    if i == 0u {
-        samples[0] = vec4<f32>(f32(w), f32(h), 0.0, 0.0);
-    }
-    let pos = textureLoad(receiver_position, vec2<i32>(id.xy), 0);
-    if pos.w <= 0.0 {
-        samples[i + 1u] = vec4<f32>(pos.xyz, -1.0);
-        return;
-    }
-    let p = pos.xyz;
-    var dir = -xf.light.xyz;
+    let i = r.index;
+    let p = r.position.xyz;
+    let to_light = towards_light(p);
+    let dir = to_light.xyz;
     var length = xf.contact.x;
     if xf.light.w == LIGHT_SPOT {
         // A spot or point light: the length is per unit of distance, as its texels are.
-        let d = xf.light.xyz - p;
-        let dist = sqrt(dot(d, d));
-        dir = d / max(dist, 1e-20);
-        length = min(length * dist, 0.5 * dist);
+        length = min(length * to_light.w, 0.5 * to_light.w);
     }
     let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
     let side = select(-ng, ng, dot(ng, dir) >= 0.0);
     let origin = p + side * xf.params.x;
-    let size = vec2<f32>(f32(w), f32(h));
+    let size = xf.params.zw;
     var verdict = -1.0;
     for (var k = 1u; k <= CONTACT_STEPS; k++) {
         let q = origin + dir * (length * f32(k) / f32(CONTACT_STEPS));

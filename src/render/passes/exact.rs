@@ -460,18 +460,16 @@ impl ExactPass {
             .layer_count(1)
             .color_attachments(&colors)
             .depth_attachment(&depth);
+        unsafe { d.cmd_begin_rendering(cmd, &info) };
+        bind(
+            d,
+            self.layout,
+            cmd,
+            (vk::PipelineBindPoint::GRAPHICS, self.receiver),
+            set,
+        );
+        set_viewport(&ctx, cmd, t.extent);
         unsafe {
-            d.cmd_begin_rendering(cmd, &info);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.receiver);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout,
-                0,
-                &[set],
-                &[],
-            );
-            set_viewport(&ctx, cmd, t.extent);
             d.cmd_bind_vertex_buffers(
                 cmd,
                 0,
@@ -501,18 +499,14 @@ impl ExactPass {
         t.normal.transition(d, cmd, Access::ComputeSampled);
         let groups = (t.extent.width.div_ceil(8), t.extent.height.div_ceil(8));
         if let ExactMode::Contact { .. } = f.mode {
-            unsafe {
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.contact);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::COMPUTE,
-                    self.layout,
-                    0,
-                    &[set],
-                    &[],
-                );
-                d.cmd_dispatch(cmd, groups.0, groups.1, 1);
-            }
+            bind(
+                d,
+                self.layout,
+                cmd,
+                (vk::PipelineBindPoint::COMPUTE, self.contact),
+                set,
+            );
+            unsafe { d.cmd_dispatch(cmd, groups.0, groups.1, 1) };
             memory_barrier(
                 d,
                 cmd,
@@ -531,23 +525,14 @@ impl ExactPass {
                 A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
             ),
         );
-        unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.build);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                self.layout,
-                0,
-                &[set],
-                &[],
-            );
-            d.cmd_dispatch(
-                cmd,
-                t.extent.width.div_ceil(8),
-                t.extent.height.div_ceil(8),
-                1,
-            );
-        }
+        bind(
+            d,
+            self.layout,
+            cmd,
+            (vk::PipelineBindPoint::COMPUTE, self.build),
+            set,
+        );
+        unsafe { d.cmd_dispatch(cmd, groups.0, groups.1, 1) };
         memory_barrier(
             d,
             cmd,
@@ -569,18 +554,16 @@ impl ExactPass {
                 extent: grid,
             })
             .layer_count(1);
+        unsafe { d.cmd_begin_rendering(cmd, &info) };
+        bind(
+            d,
+            self.layout,
+            cmd,
+            (vk::PipelineBindPoint::GRAPHICS, self.caster),
+            set,
+        );
+        set_viewport(&ctx, cmd, grid);
         unsafe {
-            d.cmd_begin_rendering(cmd, &info);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.caster);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout,
-                0,
-                &[set],
-                &[],
-            );
-            set_viewport(&ctx, cmd, grid);
             d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
             d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
         }
@@ -624,6 +607,20 @@ impl ExactPass {
             (S::FRAGMENT_SHADER, A::SHADER_STORAGE_WRITE),
             (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
         );
+    }
+}
+
+/// Binds `pipeline` at `point` with the frame's set `set` (set 0 of `layout`).
+fn bind(
+    d: &ash::Device,
+    layout: vk::PipelineLayout,
+    cmd: vk::CommandBuffer,
+    (point, pipeline): (vk::PipelineBindPoint, vk::Pipeline),
+    set: vk::DescriptorSet,
+) {
+    unsafe {
+        d.cmd_bind_pipeline(cmd, point, pipeline);
+        d.cmd_bind_descriptor_sets(cmd, point, layout, 0, &[set], &[]);
     }
 }
 
