@@ -210,6 +210,13 @@ fn towards_light(p: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(-xf.light.xyz, 3.0e38);
 }
 
+// Where the shadow ray of the receiver at invocation `id`, point `p`, towards `dir` starts: off
+// the surface by the reference's offset, on the light's side of the face.
+fn ray_origin(id: vec3<u32>, p: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
+    return p + select(-ng, ng, dot(ng, dir) >= 0.0) * xf.params.x;
+}
+
 @compute @workgroup_size(8, 8)
 fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
     let r = receiver_at(id);
@@ -221,13 +228,9 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
     let to_light = towards_light(p);
     let dir = to_light.xyz;
     let reach = to_light.w;
-    // Off the surface, on the light's side of the face (the reference's shadow ray origin).
-    let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
-    let side = select(-ng, ng, dot(ng, dir) >= 0.0);
-    let eps = xf.params.x;
-    let origin = p + side * eps;
+    let origin = ray_origin(id, p, dir);
     samples[i + 1u] = vec4<f32>(p, 1.0);
-    rays[i] = vec4<f32>(origin, reach - eps);
+    rays[i] = vec4<f32>(origin, reach - xf.params.x);
     let cell = cell_of(origin);
     let n = cell_count();
     if cell < n {
@@ -263,9 +266,7 @@ fn cs_contact(@builtin(global_invocation_id) id: vec3<u32>) {
         // A spot or point light: the length is per unit of distance, as its texels are.
         length = min(length * to_light.w, 0.5 * to_light.w);
     }
-    let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
-    let side = select(-ng, ng, dot(ng, dir) >= 0.0);
-    let origin = p + side * xf.params.x;
+    let origin = ray_origin(id, p, dir);
     let size = xf.params.zw;
     var verdict = -1.0;
     for (var k = 1u; k <= CONTACT_STEPS; k++) {
