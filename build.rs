@@ -139,7 +139,7 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
     })?;
     let options = naga::back::spv::Options {
         lang_version: (1, 3),
-        // No DEBUG flag: it embeds the WGSL source in each of the (up to 256) variants.
+        // No DEBUG flag: it embeds the WGSL source in each of the (up to 2048) variants.
         flags: naga::back::spv::WriterFlags::ADJUST_COORDINATE_SPACE
             | naga::back::spv::WriterFlags::LABEL_VARYINGS,
         ..Default::default()
@@ -199,6 +199,7 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
         m
     };
     let variants = 1usize << overrides.len();
+    let mut spirv: Vec<(usize, Vec<u8>)> = Vec::new();
     for mask in (0..variants).filter(|&m| canonical(m) == m) {
         let mut constants = naga::back::PipelineConstants::default();
         for (i, name) in overrides.iter().enumerate() {
@@ -209,10 +210,9 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
                 .map_err(|e| format!("{}:1:1: error: overrides: {e}", path.display()))?;
         let words = naga::back::spv::write_vec(&m, &i, &options, None)
             .map_err(|e| format!("{}:1:1: error: SPIR-V output: {e}", path.display()))?;
-        let spv_path = Path::new(out_dir).join(format!("{stem}_{mask}.spv"));
-        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-        std::fs::write(&spv_path, bytes).map_err(|e| e.to_string())?;
+        spirv.push((mask, words.iter().flat_map(|w| w.to_le_bytes()).collect()));
     }
+    let packed = pack(out_dir, &stem, &spirv)?;
 
     let shader = Shader {
         file: &file,
@@ -222,6 +222,7 @@ fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
         overrides: &overrides,
         requires: &requires,
         canonical: (0..variants).map(canonical).collect(),
+        packed: &packed,
     };
     reflect(&shader)
 }
@@ -236,6 +237,41 @@ struct Shader<'a> {
     overrides: &'a [String],
     requires: &'a [Option<usize>],
     canonical: Vec<usize>,
+    packed: &'a Packed,
+}
+
+/// Variants of a shader per compressed chunk: neighbouring variants differ in a few functions,
+/// so a chunk compresses ~50× (one variant alone, ~3×), and a pipeline decompresses 16 variants
+/// (~1 MB, a few ms) to read one.
+const VARIANTS_PER_CHUNK: usize = 16;
+
+/// Where `pack` put a shader's variants: per chunk file its name, per canonical variant its
+/// (chunk, byte offset, byte length).
+struct Packed {
+    chunks: Vec<String>,
+    at: std::collections::HashMap<usize, (usize, usize, usize)>,
+}
+
+/// Writes `spirv` (canonical variant → SPIR-V) as zstd-compressed chunks of
+/// `VARIANTS_PER_CHUNK` variants into `out_dir`. Embedded as they are, the scene shader's ~800
+/// variants (~50 MB) went into every binary that links the engine, every test among them.
+fn pack(out_dir: &str, stem: &str, spirv: &[(usize, Vec<u8>)]) -> Result<Packed, String> {
+    let mut packed = Packed {
+        chunks: Vec::new(),
+        at: std::collections::HashMap::new(),
+    };
+    for (k, chunk) in spirv.chunks(VARIANTS_PER_CHUNK).enumerate() {
+        let mut data = Vec::new();
+        for (mask, bytes) in chunk {
+            packed.at.insert(*mask, (k, data.len(), bytes.len()));
+            data.extend_from_slice(bytes);
+        }
+        let compressed = zstd::bulk::compress(&data, 9).map_err(|e| e.to_string())?;
+        let name = format!("{stem}_{k}.spv.zst");
+        std::fs::write(Path::new(out_dir).join(&name), compressed).map_err(|e| e.to_string())?;
+        packed.chunks.push(name);
+    }
+    Ok(packed)
 }
 
 /// The generated module of one shader: its SPIR-V variants, override bits and dependants, named
@@ -278,29 +314,44 @@ fn reflect(shader: &Shader) -> Result<String, String> {
 /// The SPIR-V variants, the override list, each override's bit and each override's dependants.
 fn variants_code(shader: &Shader, code: &mut String) {
     let Shader {
-        stem,
         overrides,
         requires,
         ..
     } = *shader;
     let canonical = &shader.canonical;
-    let variants = canonical.len();
-    let list: Vec<String> = (0..variants)
+    let chunks: Vec<String> = shader
+        .packed
+        .chunks
+        .iter()
+        .map(|name| format!("include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{name}\"))"))
+        .collect();
+    writeln!(
+        code,
+        "    /// The variants' SPIR-V, zstd-compressed, `VARIANTS_PER_CHUNK` to a chunk.\n    pub const CHUNKS: &[&[u8]] = &[{}];",
+        chunks.join(", ")
+    )
+    .unwrap();
+    let at: Vec<String> = canonical
+        .iter()
         .map(|m| {
-            let m = canonical[m];
-            format!("include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{stem}_{m}.spv\"))")
+            let (k, offset, len) = shader.packed.at[m];
+            format!("({k}, {offset}, {len})")
         })
         .collect();
     writeln!(
         code,
-        "    pub const VARIANTS: &[&[u8]] = &[{}];",
-        list.join(", ")
+        "    /// Per override combination: (chunk, byte offset, byte length) of its SPIR-V.\n    pub const VARIANT_AT: &[(usize, usize, usize)] = &[{}];",
+        at.join(", ")
     )
     .unwrap();
     writeln!(
         code,
-        "    /// SPIR-V with every boolean override on.\n    pub const SPIRV: &[u8] = VARIANTS[{}];",
-        variants - 1
+        "    /// The SPIR-V of override combination `mask`.\n    #[allow(dead_code)]\n    pub fn variant(mask: usize) -> Result<Vec<u8>, GpuError> {{\n        super::unpack(CHUNKS, VARIANT_AT, mask)\n    }}"
+    )
+    .unwrap();
+    writeln!(
+        code,
+        "    /// SPIR-V with every boolean override on.\n    pub fn spirv() -> Result<Vec<u8>, GpuError> {{\n        variant(VARIANT_AT.len() - 1)\n    }}"
     )
     .unwrap();
     writeln!(

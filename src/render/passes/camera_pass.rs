@@ -95,7 +95,7 @@ impl CameraPass {
             sh::IMMEDIATE_SIZE,
             "camera pipeline layout",
         )?;
-        let module = create_module(ctx, sh::SPIRV, "scene.wgsl")?;
+        let module = create_module(ctx, &sh::spirv()?, "scene.wgsl")?;
         let desc = PipelineDesc {
             name: "shadow-map view pipeline",
             layout,
@@ -259,7 +259,7 @@ impl CameraPass {
                 None => {
                     let m = create_module(
                         &self.ctx,
-                        sh::VARIANTS[variant],
+                        &sh::variant(variant)?,
                         &format!("scene.wgsl variant {variant}"),
                     )?;
                     self.variant_modules.insert(variant, m);

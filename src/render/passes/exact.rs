@@ -173,7 +173,7 @@ impl ExactPass {
             sh::IMMEDIATE_SIZE,
             "exact layout",
         )?;
-        let module = create_module(ctx, sh::SPIRV, "exact.wgsl")?;
+        let module = create_module(ctx, &sh::spirv()?, "exact.wgsl")?;
         let (bindings, all) = vertex_layout();
         let attributes = [all[0], all[2], all[4], all[5]];
         let receiver = create_pipeline(

@@ -52,7 +52,7 @@ impl PostAaPass {
     pub fn new(ctx: &Arc<Context>, format: vk::Format) -> Result<Self, GpuError> {
         let set_layout = set_layout(ctx, sh::BINDINGS, 0, "post AA set layout")?;
         let layout = create_layout(ctx, &[set_layout], sh::IMMEDIATE_SIZE, "post AA layout")?;
-        let module = create_module(ctx, sh::SPIRV, "post.wgsl")?;
+        let module = create_module(ctx, &sh::spirv()?, "post.wgsl")?;
         // Bilinear, clamped to the edge, base level only: the glTF sampler of that meaning.
         let filter = Sampler {
             mag: Filter::Linear,

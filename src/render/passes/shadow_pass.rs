@@ -219,7 +219,7 @@ impl ShadowPass {
     /// Creates the pass (the map is created by `ensure_map`).
     pub fn new(ctx: &Arc<Context>) -> Result<Self, GpuError> {
         let layout = create_layout(ctx, &[], sh::IMMEDIATE_SIZE, "shadow pipeline layout")?;
-        let module = create_module(ctx, sh::SPIRV, "shadow.wgsl")?;
+        let module = create_module(ctx, &sh::spirv()?, "shadow.wgsl")?;
         Ok(Self {
             ctx: ctx.clone(),
             layout,
