@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Renders the demo, every --synthetic scene and every model of a glTF corpus with two umbra
-# binaries and compares the PNGs byte for byte (lit image and shadow view). For refactors and
-# changes that must not move a pixel.
+# binaries and compares the PNGs byte for byte (lit image, shadow view and shadow map, and the
+# lit image with exact shadows). For refactors and changes that must not move a pixel.
 # Usage: scripts/identical.sh OLD_UMBRA NEW_UMBRA [CORPUS_DIR] [OUT_DIR]
 set -euo pipefail
 old=$1
@@ -11,7 +11,7 @@ out=${4:-$(mktemp -d)}
 export UMBRA_DEVICE="${UMBRA_DEVICE:-llvmpipe}"
 mkdir -p "$out/old" "$out/new"
 scenes=(demo)
-for s in double-sided close-up town town-mover grazing stability room sun-and-spot two-suns lux-yard spheres:4; do
+for s in double-sided close-up foliage foliage-masked town town-mover grazing stability room sun-and-spot two-suns lux-yard spheres:4; do
   scenes+=("--synthetic=$s")
 done
 if [ -n "$corpus" ]; then
@@ -27,11 +27,13 @@ for s in "${scenes[@]}"; do
   esac
   tag=$(basename -- "$s")
   tag=${tag//[^A-Za-z0-9._-]/_}
-  for mode in lit shadow; do
+  for mode in lit shadow shadow-map exact; do
     for side in old new; do
       bin=$old
       [ "$side" = new ] && bin=$new
-      "$bin" render "${args[@]}" --size 640x360 --view "$mode" -o "$out/$side/${tag}_$mode.png" >/dev/null 2>&1
+      view=(--view "$mode")
+      [ "$mode" = exact ] && view=(--shadow-method exact)
+      "$bin" render "${args[@]}" --size 640x360 "${view[@]}" -o "$out/$side/${tag}_$mode.png" >/dev/null 2>&1
     done
     if cmp -s "$out/old/${tag}_$mode.png" "$out/new/${tag}_$mode.png"; then
       same=$((same + 1))

@@ -1,12 +1,13 @@
 //! Work skipped for speed must not change pixels: frustum culling, back-face culling of closed
-//! double-sided meshes, per-material texture fetches and the opaque/masked pipeline split
-//! (lavapipe, validation on).
+//! double-sided meshes, leaf cards cut to their alpha in the shadow pass, per-material texture
+//! fetches and the opaque/masked pipeline split (lavapipe, validation on).
 
 mod common;
 
 use common::*;
 use glam::{Mat4, Vec3};
 use umbra::render::SceneOptions;
+use umbra::scene::foliage::foliage_scene;
 use umbra::scene::shapes::{add_object, add_texture, colored, quad, uv_sphere};
 use umbra::scene::synthetic::double_sided_scene;
 use umbra::scene::{AlphaMode, Camera, Material, Scene, Texture, TextureRef};
@@ -31,6 +32,51 @@ fn changed_pixels(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
         .zip(b.pixels())
         .filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 2))
         .count()
+}
+
+/// The foliage scene, its leaves blended and masked: with culling its shadow pass draws each
+/// crown's cards cut to where their alpha can pass (`scene::trim`), and the lit and shadow views
+/// are the same to the bit as with whole cards. (The shadow-map view is not: without culling
+/// the flat ground casts too.)
+#[test]
+fn cut_leaf_cards_change_no_pixel() {
+    let ctx = context();
+    for mode in [AlphaMode::Blend, AlphaMode::Mask(0.5)] {
+        let scene = foliage_scene(mode);
+        for view_mode in [ViewMode::Lit, ViewMode::Shadow] {
+            let mut view = View::new(scene.cameras[0]);
+            view.mode = view_mode;
+            let frames = [true, false].map(|culling| {
+                let mut r = Renderer::with_options(
+                    &ctx,
+                    &scene,
+                    &SceneOptions {
+                        culling,
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
+                (r.render(&view, 320, 180).unwrap(), r.cut_casters())
+            });
+            // The six crowns.
+            assert_eq!((frames[0].1, frames[1].1), (6, 0));
+            let [(on, _), (off, _)] = &frames;
+            let differ = on
+                .image
+                .pixels()
+                .zip(off.image.pixels())
+                .filter(|(p, q)| p != q)
+                .count();
+            save(&on.image, &format!("cut_cards_{mode:?}_{view_mode:?}.png"));
+            save(
+                &off.image,
+                &format!("cut_cards_{mode:?}_{view_mode:?}_whole.png"),
+            );
+            eprintln!("{mode:?} {view_mode:?}: {differ} pixels differ");
+            assert_eq!(differ, 0, "{mode:?} {view_mode:?}");
+        }
+    }
+    assert_validation_clean(&ctx);
 }
 
 /// The double-sided benchmark scene from its camera and from a close view that leaves most

@@ -290,9 +290,10 @@ pub struct SceneOptions {
     /// Anisotropic texture filtering (1 = off). `None`: 8× on GPUs, off on CPU devices, where
     /// it more than doubles lavapipe's camera pass (demo, 1280×720: 80 → 37 ms without shadows).
     pub anisotropy: Option<u32>,
-    /// Skip work that cannot change the image: draws outside the camera's view, and back faces
-    /// of closed double-sided meshes seen from outside. On by default; off only to measure what
-    /// it saves.
+    /// Skip work that cannot change the image: draws outside the camera's view, back faces of
+    /// closed double-sided meshes seen from outside, and the clear parts of lone cutout cards in
+    /// the shadow passes (`crate::scene::trim`). On by default; off only to measure what it
+    /// saves.
     pub culling: bool,
     /// Multisample anti-aliasing: samples per pixel of the camera pass (1, 2, 4 or 8). `None`:
     /// 4 on GPUs, 1 on CPU devices (lavapipe, where 4 samples cost

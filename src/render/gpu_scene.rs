@@ -167,6 +167,8 @@ struct PrimitiveShape {
     closed: bool,
     plane: Option<Vec4>,
     clusters: Option<(Vec<u32>, Vec<Cluster>)>,
+    /// Its lone cutout cards cut to their alpha for the shadow pass (`scene::trim`).
+    trimmed: Option<crate::scene::Primitive>,
 }
 
 /// One uploaded primitive: its index range, material, model-space bounds and shape facts.
@@ -186,6 +188,19 @@ struct PrimitiveRange {
     white: bool,
     /// Total triangle area (model space).
     area: f32,
+    /// See `Draw::shadow_range`.
+    shadow_range: Option<IndexRange>,
+}
+
+/// An index range of the shared buffers: first index, index count, vertex offset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IndexRange {
+    /// First index in the index buffer.
+    pub first_index: u32,
+    /// Index count.
+    pub index_count: u32,
+    /// Added to each index.
+    pub vertex_offset: i32,
 }
 
 /// How a draw's material treats alpha.
@@ -253,6 +268,9 @@ pub struct Draw {
     /// It can move between frames (`Scene::moving_instances`): animated, or skinned or morphed.
     /// The shadow cache draws such casters every frame.
     pub moving: bool,
+    /// What the shadow pass draws instead for an alpha-tested caster whose lone cards were cut
+    /// to where their alpha can pass (`scene::trim`; the same shadow map, fewer fragments).
+    pub shadow_range: Option<IndexRange>,
 }
 
 /// A model-space plane `(n, w)` carried into world space by `m` (None for a singular `m`).
@@ -265,6 +283,21 @@ fn world_plane(plane: Vec4, m: &Mat4) -> Option<Vec4> {
 }
 
 impl Draw {
+    /// The draw the shadow passes make of it: the range of its cards cut to their alpha
+    /// (`shadow_range`) where it has one, drawn whole (no cluster skipping).
+    pub fn shadow_caster(&self) -> Draw {
+        match self.shadow_range {
+            Some(r) if self.alpha.tests_alpha_in_shadow() => Draw {
+                first_index: r.first_index,
+                index_count: r.index_count,
+                vertex_offset: r.vertex_offset,
+                clusters: (0, 0),
+                ..*self
+            },
+            _ => *self,
+        }
+    }
+
     /// Cull mode for a pass seen from `eye` = (position, near-plane reach), None for a
     /// directional light (outside everything). Single-sided materials cull back faces;
     /// double-sided ones draw (and cast from) both faces, unless the primitive is closed and the
@@ -405,6 +438,7 @@ fn build_draws(
                         m.alpha_mode == AlphaMode::Opaque && reads_texcoord0_only(m)
                     }),
                 moving: moving.get(ii).copied().unwrap_or(false),
+                shadow_range: r.shadow_range,
             });
         }
     }
@@ -562,6 +596,7 @@ impl GpuScene {
                 r.bounds = p.bounds();
                 r.clusters.1 = 0;
                 r.plane = None;
+                r.shadow_range = None;
             }
         }
         let (draws, triangles, bounds) =
@@ -723,6 +758,16 @@ fn pack_geometry(scene: &Scene, options: &SceneOptions) -> Geometry {
                 .culling
                 .then(|| clusters::build(&p.positions, &p.indices))
                 .flatten(),
+            // Work that cannot change the image, as culling is.
+            trimmed: options
+                .culling
+                .then(|| {
+                    let m = scene.materials.get(p.material)?;
+                    let cut = crate::scene::trim::AlphaCut::new(m, p, &scene.textures)?;
+                    crate::scene::trim::trim(p, &cut)
+                })
+                .flatten()
+                .map(|t| t.primitive),
         }
     })
     .into_iter();
@@ -745,10 +790,22 @@ fn pack_geometry(scene: &Scene, options: &SceneOptions) -> Geometry {
                 None => indices.extend_from_slice(&p.indices),
             }
             let cluster_range = (cluster_start, all_clusters.len() as u32 - cluster_start);
+            let index_count = indices.len() as u32 - first;
+            let shadow_range = shape.trimmed.map(|t| {
+                let range = IndexRange {
+                    first_index: indices.len() as u32,
+                    index_count: t.indices.len() as u32,
+                    vertex_offset: positions.len() as i32,
+                };
+                positions.extend(t.positions.iter().map(|v| v.to_array()));
+                attrs.extend(vertex_attributes(&t));
+                indices.extend_from_slice(&t.indices);
+                range
+            });
             r.push(PrimitiveRange {
                 clusters: cluster_range,
                 first_index: first,
-                index_count: indices.len() as u32 - first,
+                index_count,
                 vertex_offset: base,
                 material: p.material.min(scene.materials.len().saturating_sub(1)),
                 bounds: p.bounds(),
@@ -759,6 +816,7 @@ fn pack_geometry(scene: &Scene, options: &SceneOptions) -> Geometry {
                     .iter()
                     .all(|c| c.clamp(Vec4::ZERO, Vec4::ONE) == Vec4::ONE),
                 area: shape.area,
+                shadow_range,
             });
         }
         ranges.push(r);

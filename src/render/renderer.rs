@@ -206,6 +206,17 @@ impl Renderer {
         self.core.gpu.triangles
     }
 
+    /// Draws whose shadow casters are their lone cutout cards cut to their alpha
+    /// (`scene::trim`; only with `SceneOptions::culling`).
+    pub fn cut_casters(&self) -> usize {
+        self.core
+            .gpu
+            .draws
+            .iter()
+            .filter(|d| d.shadow_range.is_some())
+            .count()
+    }
+
     fn ensure_target(&mut self, w: u32, h: u32) -> Result<(), GpuError> {
         if self
             .target

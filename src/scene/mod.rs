@@ -20,6 +20,7 @@ pub mod shapes;
 pub mod synthetic;
 pub mod tangents;
 pub mod topology;
+pub mod trim;
 mod types;
 pub mod warning;
 

@@ -365,8 +365,9 @@ pub enum PcfArg {
 /// View options shared by the subcommands.
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
-    /// Draw everything: no frustum culling, no back-face culling of closed double-sided meshes
-    /// (to measure what they save; the image is the same).
+    /// Draw everything: no frustum culling, no back-face culling of closed double-sided meshes,
+    /// no leaf cards cut to their alpha in the shadow pass (to measure what they save; the image
+    /// is the same).
     #[arg(long)]
     pub no_culling: bool,
     /// A generated scene instead of SCENE: `double-sided` (52k triangles, 12 double-sided

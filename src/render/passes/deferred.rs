@@ -328,6 +328,7 @@ mod tests {
             deferrable: true,
             mean_area,
             moving: false,
+            shadow_range: None,
         }
     }
 

@@ -568,7 +568,7 @@ impl ExactPass {
             d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
         }
         for &i in &f.casters {
-            let dr = &scene.draws[i];
+            let dr = &scene.draws[i].shadow_caster();
             scene.bind_material(d, cmd, self.layout, 1, dr.material);
             for view in 0..f.views.len() {
                 let mut extra = Mat4::ZERO;

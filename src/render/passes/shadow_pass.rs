@@ -580,7 +580,7 @@ impl ShadowPass {
                         (None, true) => break,
                     };
                     let mut bound = false;
-                    for dr in draws.iter().map(|&i| &scene.draws[i]) {
+                    for dr in draws.iter().map(|&i| scene.draws[i].shadow_caster()) {
                         if dr.alpha.tests_alpha_in_shadow() != masked {
                             continue;
                         }
@@ -603,7 +603,7 @@ impl ShadowPass {
                             world_from_model: dr.world_from_model,
                         };
                         let pc = bytemuck::bytes_of(&pc);
-                        scene.record_draw(cmd, layout, dr, eye, from, pc);
+                        scene.record_draw(cmd, layout, &dr, eye, from, pc);
                         drawn += 1;
                     }
                 }
