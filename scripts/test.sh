@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Quick start, command 2: the whole test suite. Lint gate (rustfmt, clippy -D warnings), then unit,
+# Quick start, command 2: the whole test suite. Lint gate (rustfmt, the module graph, clippy -D
+# warnings), then unit,
 # GPU (lavapipe, Khronos validation with synchronization validation), CLI and viewer tests, the
 # library without its default features, a dependent crate using it that way, and the Python
 # package (built into a virtual environment, pytest).
@@ -15,6 +16,8 @@ fi
 # lavapipe is the reference device for tests; a machine with a GPU can override UMBRA_DEVICE.
 export UMBRA_DEVICE="${UMBRA_DEVICE:-llvmpipe}"
 cargo fmt --all -- --check
+# The module graph: no import cycles, the engine never importing the lab or the CLI.
+python3 scripts/imports.py
 cargo clippy --all-targets --quiet -- -D warnings
 cargo clippy --no-default-features --all-targets --quiet -- -D warnings
 cargo clippy -p umbra-python --all-targets --quiet -- -D warnings

@@ -15,8 +15,7 @@ use crate::math::Aabb;
 use crate::scene::{Light, LightKind};
 use glam::{Mat4, Vec3, Vec4};
 
-/// Linear colour where nothing is drawn (the CPU reference uses it too).
-pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
+pub use super::settings::CLEAR_COLOR;
 
 /// The result of planning a frame.
 #[derive(Clone, Debug)]

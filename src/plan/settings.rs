@@ -4,6 +4,9 @@ pub use crate::math::tonemap::Tonemap;
 use crate::scene::Camera;
 use glam::Vec3;
 
+/// Linear colour where nothing is drawn (the CPU reference uses it too).
+pub const CLEAR_COLOR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
+
 /// What the camera pass writes (the command line's `--view`; `clap::ValueEnum` with the `clap` feature).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
@@ -671,7 +674,7 @@ impl View {
         self.exposure_compensation = 0.0;
         self.ambient = self.ambient.or(Some(Vec3::splat(UNIT_AMBIENT)));
         self.tonemap = Tonemap::None;
-        let c = super::frame::CLEAR_COLOR;
+        let c = CLEAR_COLOR;
         self.background = Background::Color(Vec3::new(c[0], c[1], c[2]));
         self
     }
