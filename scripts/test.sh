@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # Quick start, command 2: the whole test suite. Lint gate (rustfmt, the module graph, clippy -D
-# warnings), then unit,
-# GPU (lavapipe, Khronos validation with synchronization validation), CLI and viewer tests, the
-# library without its default features, a dependent crate using it that way, and the Python
-# package (built into a virtual environment, pytest).
+# warnings), then unit, GPU (lavapipe, Khronos validation with synchronization validation), CLI
+# and viewer tests, the library without its default features, a dependent crate using it that
+# way, and the Python package (built into a virtual environment, pytest).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/ensure-vulkan.sh --validation --xvfb --python
