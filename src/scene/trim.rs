@@ -31,8 +31,9 @@ const DIRECTIONS: usize = 4;
 /// weights.
 const REACH_MARGIN: f32 = 1.0 / 64.0;
 
-/// Largest lattice (texels) one patch's texture footprint may span before it is kept whole.
-const MAX_FOOTPRINT: i64 = 1 << 22;
+/// Largest lattice (texels) one patch's texture footprint may span before it is kept whole (a
+/// card over a whole 4096² texture, with the reach around it).
+const MAX_FOOTPRINT: i64 = 4104 * 4104;
 
 /// Where a primitive's alpha test reads, and which texels can pass it.
 pub struct AlphaCut<'a> {
