@@ -13,8 +13,8 @@ use umbra::scene::synthetic::double_sided_scene;
 use umbra::scene::{AlphaMode, Camera, Material, Scene, Texture, TextureRef};
 use umbra::{Renderer, View, ViewMode};
 
-fn render(ctx: &TestContext, scene: &Scene, culling: bool, view: &View) -> umbra::RenderedFrame {
-    let mut r = Renderer::with_options(
+fn renderer(ctx: &TestContext, scene: &Scene, culling: bool) -> Renderer {
+    Renderer::with_options(
         ctx,
         scene,
         &SceneOptions {
@@ -22,8 +22,13 @@ fn render(ctx: &TestContext, scene: &Scene, culling: bool, view: &View) -> umbra
             ..Default::default()
         },
     )
-    .unwrap();
-    r.render(view, 320, 180).unwrap()
+    .unwrap()
+}
+
+fn render(ctx: &TestContext, scene: &Scene, culling: bool, view: &View) -> umbra::RenderedFrame {
+    renderer(ctx, scene, culling)
+        .render(view, 320, 180)
+        .unwrap()
 }
 
 /// Pixels whose colour differs by more than 2 levels in some channel.
@@ -47,15 +52,7 @@ fn cut_leaf_cards_change_no_pixel() {
             let mut view = View::new(scene.cameras[0]);
             view.mode = view_mode;
             let frames = [true, false].map(|culling| {
-                let mut r = Renderer::with_options(
-                    &ctx,
-                    &scene,
-                    &SceneOptions {
-                        culling,
-                        ..Default::default()
-                    },
-                )
-                .unwrap();
+                let mut r = renderer(&ctx, &scene, culling);
                 (r.render(&view, 320, 180).unwrap(), r.cut_casters())
             });
             // The six crowns.

@@ -791,14 +791,18 @@ fn pack_geometry(scene: &Scene, options: &SceneOptions) -> Geometry {
             }
             let cluster_range = (cluster_start, all_clusters.len() as u32 - cluster_start);
             let index_count = indices.len() as u32 - first;
+            // The cut cards share the primitive's vertices: only the new ones (numbered from
+            // its vertex count on) are uploaded, right after it, so its indices hold as they are.
             let shadow_range = shape.trimmed.map(|t| {
+                let n = p.positions.len();
+                debug_assert_eq!(positions.len(), base as usize + n);
                 let range = IndexRange {
                     first_index: indices.len() as u32,
                     index_count: t.indices.len() as u32,
-                    vertex_offset: positions.len() as i32,
+                    vertex_offset: base,
                 };
-                positions.extend(t.positions.iter().map(|v| v.to_array()));
-                attrs.extend(vertex_attributes(&t));
+                positions.extend(t.positions[n..].iter().map(|v| v.to_array()));
+                attrs.extend(vertex_attributes(&t).skip(n));
                 indices.extend_from_slice(&t.indices);
                 range
             });

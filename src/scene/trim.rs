@@ -24,9 +24,6 @@ use crate::scene::AlphaMode;
 use glam::{Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 
-/// Half-plane directions of the bounding polygon (every 90°: a rectangle in texture space).
-const DIRECTIONS: usize = 4;
-
 /// Extra reach of a texel's bilinear footprint, in texels, for the device's fixed-point filter
 /// weights.
 const REACH_MARGIN: f32 = 1.0 / 64.0;
@@ -59,9 +56,6 @@ impl<'a> AlphaCut<'a> {
         let tex = m.base_color_texture?;
         let texture = textures.get(tex.texture)?;
         let vertex_alpha = p.colors.iter().map(|c| c.w).fold(1.0f32, f32::max);
-        if p.colors.is_empty() {
-            debug_assert_eq!(vertex_alpha, 1.0);
-        }
         let factor = (m.base_color.w * vertex_alpha).max(0.0);
         // A texel passes where factor · a / 255 ≥ cutoff; a half step of slack for the
         // device's rounding.
@@ -336,13 +330,17 @@ fn patch_polygon(
     convex.then_some(poly)
 }
 
-/// Twice-signed area → area of a polygon in texture space.
-fn polygon_area(poly: &[Point]) -> f32 {
+/// Twice the signed area of a polygon in texture space (positive counter-clockwise).
+fn twice_signed_area(poly: &[Point]) -> f32 {
     let n = poly.len();
-    let twice: f32 = (0..n)
+    (0..n)
         .map(|k| poly[k].uv.perp_dot(poly[(k + 1) % n].uv))
-        .sum();
-    0.5 * twice.abs()
+        .sum()
+}
+
+/// The area of a polygon in texture space.
+fn polygon_area(poly: &[Point]) -> f32 {
+    0.5 * twice_signed_area(poly).abs()
 }
 
 /// What clipping a patch to its alpha gave.
@@ -353,14 +351,6 @@ enum Clip {
     Empty,
     /// The part that can pass.
     Cut(Vec<Point>),
-}
-
-/// The directions of the bounding polygon's half-planes.
-fn directions() -> [Vec2; DIRECTIONS] {
-    std::array::from_fn(|k| {
-        let a = k as f32 * std::f32::consts::TAU / DIRECTIONS as f32;
-        Vec2::new(a.cos(), a.sin())
-    })
 }
 
 /// Whether the axis-aligned square `[lo, hi]` overlaps convex polygon `poly` (`sign`: its
@@ -379,7 +369,7 @@ fn square_meets(lo: Vec2, hi: Vec2, poly: &[Point], sign: f32) -> bool {
     })
 }
 
-/// Clips convex `poly` to the bounding polygon of the texels it covers that can pass (each
+/// Clips convex `poly` to the bounding rectangle of the texels it covers that can pass (each
 /// grown to its bilinear reach).
 fn clip_to_alpha(cut: &AlphaCut, poly: &[Point]) -> Clip {
     let (w, h) = (cut.texture.width as f32, cut.texture.height as f32);
@@ -388,13 +378,7 @@ fn clip_to_alpha(cut: &AlphaCut, poly: &[Point]) -> Clip {
         lo = lo.min(q.uv);
         hi = hi.max(q.uv);
     }
-    let sign = {
-        let n = poly.len();
-        let s: f32 = (0..n)
-            .map(|k| poly[k].uv.perp_dot(poly[(k + 1) % n].uv))
-            .sum();
-        s.signum()
-    };
+    let sign = twice_signed_area(poly).signum();
     // Texel (i, j)'s bilinear reach: its centre ± one texel.
     let reach = 1.0 + REACH_MARGIN;
     let i0 = (lo.x * w - 0.5 - reach).floor() as i64;
@@ -409,11 +393,9 @@ fn clip_to_alpha(cut: &AlphaCut, poly: &[Point]) -> Clip {
         let r = Vec2::new(reach / w, reach / h);
         (c - r, c + r)
     };
-    let dirs = directions();
-    let mut extent = [f32::NEG_INFINITY; DIRECTIONS];
-    let mut any = false;
+    // The rectangle: along a row, its first and last texels that can pass reach furthest.
+    let (mut keep_lo, mut keep_hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
     for j in j0..=j1 {
-        // Along a row the extremes in every direction are at its first and last texels.
         let meets = |i: i64| {
             let (a, b) = square(i, j);
             cut.hot(i, j) && square_meets(a, b, poly, sign)
@@ -422,25 +404,24 @@ fn clip_to_alpha(cut: &AlphaCut, poly: &[Point]) -> Clip {
             continue;
         };
         let last = (first..=i1).rev().find(|&i| meets(i)).unwrap_or(first);
-        any = true;
-        for i in [first, last] {
-            let (a, b) = square(i, j);
-            for (k, d) in dirs.iter().enumerate() {
-                let far = Vec2::new(
-                    if d.x > 0.0 { b.x } else { a.x },
-                    if d.y > 0.0 { b.y } else { a.y },
-                );
-                extent[k] = extent[k].max(far.dot(*d));
-            }
-        }
+        keep_lo = keep_lo.min(square(first, j).0);
+        keep_hi = keep_hi.max(square(last, j).1);
     }
-    if !any {
+    if keep_lo.x > keep_hi.x {
         return Clip::Empty;
     }
+    // Its four sides as half-planes uv · d ≤ e.
+    let sides = [
+        (Vec2::NEG_X, -keep_lo.x),
+        (Vec2::X, keep_hi.x),
+        (Vec2::NEG_Y, -keep_lo.y),
+        (Vec2::Y, keep_hi.y),
+    ];
     let mut out = poly.to_vec();
     let mut changed = false;
-    for (d, e) in dirs.iter().zip(extent) {
-        let inside = |q: &Point| q.uv.dot(*d) <= e;
+    for (d, e) in &sides {
+        let (d, e) = (*d, *e);
+        let inside = |q: &Point| q.uv.dot(d) <= e;
         if out.iter().all(inside) {
             continue;
         }
@@ -449,7 +430,7 @@ fn clip_to_alpha(cut: &AlphaCut, poly: &[Point]) -> Clip {
         let mut next = Vec::with_capacity(n + 1);
         for k in 0..n {
             let (p0, p1) = (out[k], out[(k + 1) % n]);
-            let (f0, f1) = (p0.uv.dot(*d) - e, p1.uv.dot(*d) - e);
+            let (f0, f1) = (p0.uv.dot(d) - e, p1.uv.dot(d) - e);
             if f0 <= 0.0 {
                 next.push(p0);
             }
