@@ -570,7 +570,7 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
             if !budgeted {
                 v.shadow.pcf = pcf_of(k);
             }
-            renderer.render(&v, w, h)?;
+            let side = renderer.render(&v, w, h)?.plan.shadow_map_size;
             let mut frames = Vec::new();
             for _ in 0..a.repeat.max(1) {
                 frames.push(renderer.render(&v, w, h)?.stats);
@@ -581,10 +581,11 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
             let cam = m(&|s| s.gpu_camera_ms);
             let tot = m(&|s| Some(s.gpu_shadow_ms? + s.gpu_camera_ms?));
             let wall = m(&|s| Some(s.wall_ms));
-            let map_label = if map == 0 {
-                "off".to_string()
-            } else {
-                format!("{map}²")
+            // The automatic setting may draw one map of twice the side instead of cascades.
+            let map_label = match map {
+                0 => "off".to_string(),
+                m if side != m => format!("{m}² (drawn {side}²)"),
+                m => format!("{m}²"),
             };
             let pcf = if map == 0 {
                 "-".to_string()

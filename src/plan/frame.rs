@@ -335,8 +335,12 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
     let fit_camera = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
     let proj = camera_projection(&view.camera, aspect);
     let clip_from_world = proj * view.camera.view_from_world();
-    let size = view.shadow.map_size.max(1);
     let (views, unshadowed) = shadow_views(&lights, scene, view, target);
+    // The layers' side: the map size, or more where the automatic setting doubled a view.
+    let size = views
+        .iter()
+        .map(|v| v.res)
+        .fold(view.shadow.map_size.max(1), u32::max);
     let has_views = |i: usize| views.iter().any(|v| v.light == i);
     let shadow_light = view
         .shown_light
@@ -614,6 +618,50 @@ mod tests {
         assert_eq!(p.lights.len(), 1);
         assert_eq!(p.shader_variant & sh::BIT_ONE_SUN, 0);
     }
+    #[test]
+    fn the_automatic_setting_doubles_one_map_before_it_splits_into_cascades() {
+        // The demo at its own camera, planned without depths seen: one 2048² map's texel is
+        // 0.463 pixels at the nearest receiver at 720 rows (measured), growing with the rows.
+        let s = demo_scene();
+        let planner = ScenePlanner::new(&s);
+        let v = View::new(s.default_camera(16.0 / 9.0));
+        let plan = |v: &View, rows: u32| planner.plan(v, rows * 16 / 9, rows);
+        let one = plan(&v, 720);
+        assert_eq!(one.shadow_views.len(), 1);
+        let texel = one.shadow_views[0].texel_world;
+        let ratio_at = |rows: u32| 0.463 * rows as f32 / 720.0;
+        // Ratio 3.86: one map as set.
+        let p = plan(&v, 6000);
+        assert!(ratio_at(6000) < 4.0);
+        assert_eq!((p.shadow_views.len(), p.shadow_views[0].res), (1, 2048));
+        assert_eq!(p.shadow_map_size, 2048);
+        // Ratio 4.5: one map of twice the side, half the texel (within the fit's rounding).
+        let p = plan(&v, 7000);
+        assert!(ratio_at(7000) > 4.0 && ratio_at(7000) < 5.0);
+        assert_eq!((p.shadow_views.len(), p.shadow_views[0].res), (1, 4096));
+        assert_eq!(p.shadow_map_size, 4096);
+        assert_eq!(p.uniform.shadow.x, 4096.0);
+        let half = p.shadow_views[0].texel_world / (texel * 0.5);
+        assert!(
+            (0.9..1.1).contains(&half),
+            "texel {half} × half the 2048² map's"
+        );
+        // Ratio 5.5: two cascades of the set size.
+        let p = plan(&v, 8500);
+        assert!(ratio_at(8500) > 5.0);
+        assert_eq!(p.shadow_views.len(), 2);
+        assert!(p.shadow_views.iter().all(|sv| sv.res == 2048));
+        assert_eq!(p.shadow_map_size, 2048);
+        // A fixed count, or a map already at the largest doubled side, is never doubled.
+        let mut fixed = v.clone();
+        fixed.shadow.cascades = 1;
+        assert_eq!(plan(&fixed, 7000).shadow_map_size, 2048);
+        let mut big = v.clone();
+        big.shadow.map_size = 4096;
+        let p = plan(&big, 15000);
+        assert_eq!((p.shadow_views.len(), p.shadow_map_size), (2, 4096));
+    }
+
     #[test]
     fn held_cascades_keep_their_splits_until_the_receivers_leave_them() {
         let s = demo_scene();

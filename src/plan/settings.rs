@@ -231,7 +231,8 @@ pub struct ShadowSettings {
     /// Cascades of a directional light's map fitted to the camera (1–4; `MAX_CASCADES`): each
     /// covers a slice of the view depth with its own `map_size`² layer. 1 is the single map; 0
     /// (the default) chooses per frame from how much coarser than a pixel one map's texels would
-    /// be at the nearest receiver (`render::frame::auto_cascades`).
+    /// be at the nearest receiver (`plan::views::auto_cascades`), drawing one map of twice the
+    /// side instead of two cascades where that suffices (`plan::views::auto_doubles_map`).
     pub cascades: u32,
     /// Side in texels of each of a point light's six cube faces (each fills that square of its
     /// own layer); 0 (the default) is half of `map_size`, so a cube costs 1.5 maps of texels, not

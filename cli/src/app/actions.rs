@@ -275,7 +275,7 @@ fn apply_set(a: Action, view: &mut View, sun: &mut SunAngles) -> Option<String> 
         Action::SetCascades(n) => {
             s.cascades = n.min(MAX_CASCADES);
             match s.cascades {
-                0 => "cascades: automatic (1, 2 or 4 by texel size)".into(),
+                0 => "cascades: automatic (1, 2 or 4 by texel size; one map of twice the side in place of 2 where that suffices)".into(),
                 n => format!("cascades: {n}"),
             }
         }
