@@ -391,11 +391,10 @@ pub(super) fn directional_views(
                     let pixel = 2.0 * fit_cam.half_extent_at(near, 1.0).y / height_px.max(1) as f32;
                     let ratio = f.texel_world / pixel.max(f32::MIN_POSITIVE);
                     single = Some(f);
-                    let doubled = size.saturating_mul(2);
                     if auto_doubles_map(ratio, size) {
                         // One map of twice the side instead of two cascades.
-                        let hold = hold(0, 1);
-                        let f = fit_sized(Some(frustum), hold, doubled);
+                        let doubled = 2 * size;
+                        let f = fit_sized(Some(frustum), hold(0, 1), doubled);
                         return vec![ShadowView {
                             res: doubled,
                             ..ShadowView::whole(f.light_clip_from_world, f.texel_world)

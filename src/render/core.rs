@@ -184,7 +184,7 @@ impl FrameCore {
         }
         let layers = plan.shadow_views.len().max(1) as u32;
         self.shadow
-            .ensure_map(plan.shadow_map_size.max(map_size), format, layers)?;
+            .ensure_map(plan.shadow_map_size, format, layers)?;
         self.shadow.ensure_masked(&self.gpu, format)?;
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         let casters = if plan.shadows_on {
