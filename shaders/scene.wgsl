@@ -132,18 +132,21 @@ fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0)
 
 @fragment
 fn fs_gbuffer(in: VsOut, @builtin(front_facing) front_facing: bool) -> GBuffer {
-    let dx = dpdx(in.uv.xy);
-    let dy = dpdy(in.uv.xy);
-    let flags = select(0u, 1u, in.tangent.w >= 0.0) | select(0u, 2u, front_facing)
-        | select(0u, 4u, dot(in.tangent.xyz, in.tangent.xyz) > 0.0);
     var out: GBuffer;
-    out.a = vec4<u32>(bitcast<u32>(in.clip.z), bitcast<u32>(in.uv.x), bitcast<u32>(in.uv.y), pack_grad(dx));
-    out.b = vec4<u32>(
-        pack2x16snorm(oct_encode(in.normal)),
-        pack2x16snorm(oct_encode(in.tangent.xyz)),
-        pack_grad(dy),
-        flags,
-    );
+    out.a = vec4<u32>(bitcast<u32>(in.clip.z), pack2x16snorm(oct_encode(in.normal)), select(0u, 2u, front_facing), 0u);
+    // What only texture reads and normal mapping use (fs_resolve reads it under the same
+    // conditions): an untextured material's pipeline leaves it out, interpolates no uv or
+    // tangent, and masks target b.
+    if textured() {
+        let dx = dpdx(in.uv.xy);
+        let dy = dpdy(in.uv.xy);
+        out.a.w = bitcast<u32>(in.uv.x);
+        out.b = vec4<u32>(bitcast<u32>(in.uv.y), pack_grad(dx), pack_grad(dy), 0u);
+    }
+    if HAS_NORMAL_MAP {
+        out.b.w = pack2x16snorm(oct_encode(in.tangent.xyz));
+        out.a.z |= select(0u, 1u, in.tangent.w >= 0.0) | select(0u, 4u, dot(in.tangent.xyz, in.tangent.xyz) > 0.0);
+    }
     return out;
 }
 
@@ -156,23 +159,26 @@ fn fs_resolve(full: FullscreenOut) -> @location(0) vec4<f32> {
     let frag = full.clip;
     let c = vec2<i32>(frag.xy);
     let a = textureLoad(gbuffer_a, c, 0);
-    let b = textureLoad(gbuffer_b, c, 0);
+    var b = vec4<u32>(0u);
+    if textured() {
+        b = textureLoad(gbuffer_b, c, 0);
+    }
     let size = vec2<f32>(textureDimensions(gbuffer_a));
     // The pixel centre at the stored depth, back to world space (clip y is up, rows go down).
     let ndc = vec4<f32>(frag.x / size.x * 2.0 - 1.0, 1.0 - frag.y / size.y * 2.0, bitcast<f32>(a.x), 1.0);
     let world = frame.world_from_clip * ndc;
-    let flags = b.w;
+    let flags = a.z;
     var in: VsOut;
     in.clip = frag;
     in.world_position = world.xyz / world.w;
-    in.normal = oct_decode(unpack2x16snorm(b.x));
-    let uv = vec2<f32>(bitcast<f32>(a.y), bitcast<f32>(a.z));
+    in.normal = oct_decode(unpack2x16snorm(a.y));
+    let uv = vec2<f32>(bitcast<f32>(a.w), bitcast<f32>(b.x));
     in.uv = vec4<f32>(uv, uv);
-    let tangent = select(vec3<f32>(0.0), oct_decode(unpack2x16snorm(b.y)), (flags & 4u) != 0u);
+    let tangent = select(vec3<f32>(0.0), oct_decode(unpack2x16snorm(b.w)), (flags & 4u) != 0u);
     in.tangent = vec4<f32>(tangent, select(-1.0, 1.0, (flags & 1u) != 0u));
     in.color = vec4<f32>(1.0);
     let front_facing = (flags & 2u) != 0u;
-    let dx = unpack2x16float(a.w);
+    let dx = unpack2x16float(b.y);
     let dy = unpack2x16float(b.z);
     var base = material.base_color;
     if HAS_BASE_TEX {

@@ -6,10 +6,13 @@
 // it keeps; these draws instead store what `shade` reads from their varyings (fs_gbuffer: no
 // texture reads, no lighting), and fs_resolve shades each covered pixel once, per material,
 // where the stencil holds that material's mark. Two RGBA32UI targets:
-//   a: depth (f32 bits: the world position is rebuilt from it), TEXCOORD_0 (f32 bits),
-//      d(uv)/dx (2 x f16)
-//   b: normal and tangent (octahedral, 2 x snorm16 each), d(uv)/dy (2 x f16), flags: 1 tangent
-//      sign >= 0, 2 front face, 4 tangent non-zero
+//   a: depth (f32 bits: the world position is rebuilt from it), the normal (octahedral,
+//      2 x snorm16), flags (1 tangent sign >= 0, 2 front face, 4 tangent non-zero),
+//      TEXCOORD_0.x (f32 bits)
+//   b: TEXCOORD_0.y (f32 bits), d(uv)/dx and d(uv)/dy (2 x f16 each), the tangent (octahedral)
+// An untextured material needs only the depth, normal and front face: its draws write target a
+// alone (b masked in its pipeline: half the colour bytes per fragment), and its
+// resolve reads a alone.
 // Deferred draws have no vertex colours and read TEXCOORD_0 only.
 struct GBuffer {
     @location(0) a: vec4<u32>,
@@ -41,4 +44,9 @@ fn pack_grad(d: vec2<f32>) -> u32 {
 // part).
 fn slot_grad(i: u32, d: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(dot(material.uv[2u * i].xy, d), dot(material.uv[2u * i + 1u].xy, d));
+}
+
+// Whether the material reads any texture (and so needs TEXCOORD_0, its derivatives and target b).
+fn textured() -> bool {
+    return HAS_BASE_TEX || HAS_NORMAL_MAP || HAS_OTHER_TEX;
 }

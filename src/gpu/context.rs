@@ -251,6 +251,9 @@ pub struct Context {
     /// Whether fragment shaders may write storage buffers (`fragmentStoresAndAtomics`, enabled
     /// when the device has it): the exact shadow method needs it.
     pub fragment_stores: bool,
+    /// Whether colour attachments may blend and mask differently (`independentBlend`, enabled
+    /// when the device has it): without it a pipeline writes all its targets.
+    pub independent_blend: bool,
     /// Validation messages (all zero when validation is off). Keep a clone to read the messages
     /// sent while the context is destroyed (leaks, destroy-time errors).
     pub validation_log: Arc<ValidationLog>,
@@ -316,14 +319,14 @@ impl Context {
         }
         let qf_props = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let timestamp_valid_bits = qf_props[queue_family as usize].timestamp_valid_bits;
-        let fragment_stores = unsafe { instance.get_physical_device_features(physical) }
-            .fragment_stores_and_atomics
-            == vk::TRUE;
+        let features = unsafe { instance.get_physical_device_features(physical) };
+        let fragment_stores = features.fragment_stores_and_atomics == vk::TRUE;
+        let independent_blend = features.independent_blend == vk::TRUE;
         let device = create_device(
             &instance,
             physical,
             queue_family,
-            (anisotropy, fragment_stores),
+            (anisotropy, fragment_stores, independent_blend),
             desc.swapchain,
         )?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -377,6 +380,7 @@ impl Context {
             anisotropy,
             timestamp_valid_bits,
             fragment_stores,
+            independent_blend,
             validation_log: log,
             validation_enabled: enable_validation,
             pipeline_cache,
@@ -673,16 +677,16 @@ fn create_instance(
 }
 
 /// Creates the logical device with dynamic rendering, synchronization2 and depth clamp (and the
-/// swapchain extension when asked for), and with sampler anisotropy and fragment-shader stores
-/// where `optional` says the device has them.
+/// swapchain extension when asked for), and with sampler anisotropy, fragment-shader stores and
+/// independent blend where `optional` says the device has them.
 fn create_device(
     instance: &InstanceOwner,
     physical: vk::PhysicalDevice,
     queue_family: u32,
-    optional: (bool, bool),
+    optional: (bool, bool, bool),
     swapchain: bool,
 ) -> Result<DeviceOwner, GpuError> {
-    let (anisotropy, fragment_stores) = optional;
+    let (anisotropy, fragment_stores, independent_blend) = optional;
     let priorities = [1.0f32];
     let queue_info = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(queue_family)
@@ -693,7 +697,8 @@ fn create_device(
     let core = vk::PhysicalDeviceFeatures::default()
         .depth_clamp(true)
         .sampler_anisotropy(anisotropy)
-        .fragment_stores_and_atomics(fragment_stores);
+        .fragment_stores_and_atomics(fragment_stores)
+        .independent_blend(independent_blend);
     let mut device_exts: Vec<*const i8> = Vec::new();
     if swapchain {
         device_exts.push(ash::khr::swapchain::NAME.as_ptr());

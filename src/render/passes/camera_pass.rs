@@ -104,6 +104,7 @@ impl CameraPass {
             bindings: &[],
             attributes: &[],
             color_formats: &[color_format],
+            written_targets: 1,
             depth_format,
             stencil: Stencil::Off,
             depth_clamp: false,
@@ -223,8 +224,11 @@ impl CameraPass {
                     .iter()
                     .map(|r| (r.material_bits | frame_bits, Entry::Resolve)),
             );
-            // One G-buffer pipeline for every material (fs_gbuffer reads no material).
-            keys.push((0, Entry::GBuffer));
+            // One G-buffer pipeline per combination of texture slots.
+            keys.extend(defer.deferred.iter().map(|&(i, _)| {
+                let bits = deferred::gbuffer_variant(scene.draws[i].material_bits);
+                (bits, Entry::GBuffer)
+            }));
             self.ensure_gbuffer(extent)?;
         }
         self.build_pipelines(keys)
@@ -568,8 +572,6 @@ impl CameraPass {
         let (depth, extent) = (targets.depth, targets.extent);
         let ctx = self.ctx.clone();
         let d = &ctx.device;
-        // Both made by `ensure_pipelines` for this frame.
-        let pipeline = self.pipelines[&(0, Entry::GBuffer)];
         let Some(gbuffer) = self.gbuffer.as_mut() else {
             return 0;
         };
@@ -595,10 +597,17 @@ impl CameraPass {
             .depth_attachment(&depth_att)
             .stencil_attachment(&depth_att);
         self.begin_rendering(cmd, &rendering, extent, frame_set);
-        unsafe { d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline) };
         bind_geometry(d, cmd, scene);
+        let mut bound = None;
         for &(i, mark) in &plan.deferred {
             let dr = &scene.draws[i];
+            let variant = deferred::gbuffer_variant(dr.material_bits);
+            if bound != Some(variant) {
+                // Made by `ensure_pipelines` for this frame.
+                let pipeline = self.pipelines[&(variant, Entry::GBuffer)];
+                unsafe { d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline) };
+                bound = Some(variant);
+            }
             unsafe { d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, mark) };
             scene.record_draw(
                 cmd,
@@ -986,6 +995,11 @@ fn scene_pipeline(
                 &AOV_FORMATS
             } else {
                 std::slice::from_ref(&formats.color)
+            },
+            written_targets: match entry {
+                Entry::GBuffer => deferred::gbuffer_targets_written(variant),
+                Entry::Aov => AOV_FORMATS.len(),
+                _ => 1,
             },
             depth_format: formats.depth,
             stencil: match entry {

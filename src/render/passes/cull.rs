@@ -45,7 +45,7 @@ pub enum Entry {
     /// its mark), shaded from the G-buffer.
     Resolve,
     /// `fs_gbuffer`: a deferred draw's varyings into the G-buffer, its material's mark into the
-    /// stencil (one pipeline for every material).
+    /// stencil (one pipeline per combination of texture slots: `deferred::gbuffer_variant`).
     GBuffer,
     /// `fs_aov`: instance ids and world normals into their own targets (`CameraPass::record_aov`).
     Aov,

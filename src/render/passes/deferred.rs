@@ -53,6 +53,22 @@ pub const GBUFFER_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
 /// Number of G-buffer targets.
 pub const GBUFFER_TARGETS: usize = 2;
 
+/// The shader variant of `fs_gbuffer` for a draw of material variant `material_bits`: its
+/// texture slots only (the G-buffer pass reads no light, shadow or frame setting).
+pub fn gbuffer_variant(material_bits: usize) -> usize {
+    material_bits & (sh::BIT_HAS_BASE_TEX | sh::BIT_HAS_NORMAL_MAP | sh::BIT_HAS_OTHER_TEX)
+}
+
+/// The G-buffer targets `fs_gbuffer`'s variant `gbuffer_variant` writes: an untextured
+/// material's depth, normal and flags fit target a; the others also write b.
+pub fn gbuffer_targets_written(gbuffer_variant: usize) -> usize {
+    if gbuffer_variant == 0 {
+        1
+    } else {
+        GBUFFER_TARGETS
+    }
+}
+
 /// Stencil marks are 8 bits; mark 0 is "not deferred".
 const MAX_MARKS: usize = 255;
 
