@@ -21,10 +21,10 @@ pub struct PipelineDesc<'a> {
     pub attributes: &'a [vk::VertexInputAttributeDescription],
     /// Colour attachment formats (none for depth-only passes).
     pub color_formats: &'a [vk::Format],
-    /// How many of them, from the first, the fragment shader writes: the rest are masked (their
-    /// contents kept, and no bytes spent writing them) where the device has independent blend,
-    /// and written with whatever the shader leaves in them elsewhere.
-    pub written_targets: usize,
+    /// How many of them, from the last, the fragment shader leaves alone: masked (their contents
+    /// kept, and no bytes spent writing them) where the device has independent blend, written
+    /// with whatever the shader leaves in them elsewhere.
+    pub masked_targets: usize,
     /// Depth attachment format; a format with stencil is also the stencil attachment's.
     pub depth_format: vk::Format,
     /// Stencil test and write.
@@ -111,13 +111,10 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
     let depth = depth_stencil_state(d);
     let blend_attachment = blend_attachment_state(d);
     let mut blend_attachments = vec![blend_attachment; d.color_formats.len()];
-    let written = if ctx.independent_blend {
-        d.written_targets
-    } else {
-        d.color_formats.len()
-    };
-    for masked in blend_attachments.iter_mut().skip(written) {
-        masked.color_write_mask = vk::ColorComponentFlags::empty();
+    if ctx.independent_blend {
+        for masked in blend_attachments.iter_mut().rev().take(d.masked_targets) {
+            masked.color_write_mask = vk::ColorComponentFlags::empty();
+        }
     }
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
     let mut dyn_states = vec![

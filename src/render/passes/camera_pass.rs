@@ -104,7 +104,7 @@ impl CameraPass {
             bindings: &[],
             attributes: &[],
             color_formats: &[color_format],
-            written_targets: 1,
+            masked_targets: 0,
             depth_format,
             stencil: Stencil::Off,
             depth_clamp: false,
@@ -218,16 +218,12 @@ impl CameraPass {
             }
         }
         if !defer.deferred.is_empty() {
-            keys.extend(
-                defer
-                    .resolved
-                    .iter()
-                    .map(|r| (r.material_bits | frame_bits, Entry::Resolve)),
-            );
-            // One G-buffer pipeline per combination of texture slots.
-            keys.extend(defer.deferred.iter().map(|&(i, _)| {
-                let bits = deferred::gbuffer_variant(scene.draws[i].material_bits);
-                (bits, Entry::GBuffer)
+            // Per resolved material its resolve, and the G-buffer pipeline of its texture slots.
+            keys.extend(defer.resolved.iter().flat_map(|r| {
+                [
+                    (r.material_bits | frame_bits, Entry::Resolve),
+                    (deferred::gbuffer_variant(r.material_bits), Entry::GBuffer),
+                ]
             }));
             self.ensure_gbuffer(extent)?;
         }
@@ -996,10 +992,10 @@ fn scene_pipeline(
             } else {
                 std::slice::from_ref(&formats.color)
             },
-            written_targets: match entry {
-                Entry::GBuffer => deferred::gbuffer_targets_written(variant),
-                Entry::Aov => AOV_FORMATS.len(),
-                _ => 1,
+            masked_targets: if gbuffer {
+                deferred::gbuffer_targets_masked(variant)
+            } else {
+                0
             },
             depth_format: formats.depth,
             stencil: match entry {

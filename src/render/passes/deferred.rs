@@ -59,14 +59,10 @@ pub fn gbuffer_variant(material_bits: usize) -> usize {
     material_bits & (sh::BIT_HAS_BASE_TEX | sh::BIT_HAS_NORMAL_MAP | sh::BIT_HAS_OTHER_TEX)
 }
 
-/// The G-buffer targets `fs_gbuffer`'s variant `gbuffer_variant` writes: an untextured
-/// material's depth, normal and flags fit target a; the others also write b.
-pub fn gbuffer_targets_written(gbuffer_variant: usize) -> usize {
-    if gbuffer_variant == 0 {
-        1
-    } else {
-        GBUFFER_TARGETS
-    }
+/// The G-buffer targets, from the last, that `fs_gbuffer`'s variant `gbuffer_variant` leaves
+/// alone: an untextured material's depth, normal and flags fit target a, so b is masked.
+pub fn gbuffer_targets_masked(gbuffer_variant: usize) -> usize {
+    usize::from(gbuffer_variant == 0)
 }
 
 /// Stencil marks are 8 bits; mark 0 is "not deferred".

@@ -92,7 +92,7 @@ impl PostAaPass {
                         bindings: &[],
                         attributes: &[],
                         color_formats: &[self.format],
-                        written_targets: 1,
+                        masked_targets: 0,
                         depth_format: MARK_FORMAT,
                         stencil: Stencil::Off,
                         depth_clamp: false,

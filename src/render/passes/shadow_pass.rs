@@ -173,7 +173,7 @@ fn depth_pipeline(
             bindings: &bindings[..n_bindings],
             attributes: &attributes[..n_attributes],
             color_formats: &[],
-            written_targets: 0,
+            masked_targets: 0,
             depth_format: format,
             stencil: Stencil::Off,
             depth_clamp: true,
