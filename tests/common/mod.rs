@@ -56,6 +56,8 @@ pub fn context() -> TestContext {
 
 /// `context()` from `desc` (its validation made `Required`).
 pub fn context_with(desc: ContextDesc) -> TestContext {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    crash_report::install();
     let ctx = Context::new(&ContextDesc {
         validation: Validation::Required,
         ..desc
@@ -181,4 +183,63 @@ pub fn linear_to_srgb(c: f32) -> f32 {
         } else {
             1.055 * c.powf(1.0 / 2.4) - 0.055
         }
+}
+
+/// A crash of the test process (a fault in the driver, the validation layer or umbra) prints the
+/// faulting thread and its backtrace to the real stderr before the process dies of the signal as
+/// before: without it a rare crash in CI leaves only "signal: 11". Installed once per test binary
+/// by the first [`context_with`].
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+mod crash_report {
+    use std::io::Write;
+
+    const SIGNALS: [libc::c_int; 4] = [libc::SIGSEGV, libc::SIGBUS, libc::SIGILL, libc::SIGFPE];
+
+    extern "C" fn on_crash(sig: libc::c_int) {
+        // Printing allocates: should the crash have come from inside malloc and the report
+        // deadlock, SIGALRM still ends the process.
+        unsafe { libc::alarm(30) };
+        // Straight to file descriptor 2: the test harness captures `eprintln!` per test thread,
+        // and that capture dies with the process.
+        let name = std::thread::current().name().map(str::to_owned);
+        let _ = writeln!(
+            std::io::stderr(),
+            "test process: signal {sig} in thread '{}'; its frames, then their symbols:",
+            name.as_deref()
+                .unwrap_or("<unnamed: a driver or layer thread>"),
+        );
+        // Library and offset of each frame (the driver's have no symbols here).
+        let mut frames = [std::ptr::null_mut(); 48];
+        unsafe {
+            let n = libc::backtrace(frames.as_mut_ptr(), frames.len() as libc::c_int);
+            libc::backtrace_symbols_fd(frames.as_ptr(), n, 2);
+        }
+        // Walked here, symbolised on a fresh thread: the alternate signal stack is too small
+        // for reading debug information.
+        let trace = std::backtrace::Backtrace::force_capture();
+        let text = std::thread::spawn(move || trace.to_string())
+            .join()
+            .unwrap_or_default();
+        let _ = writeln!(std::io::stderr(), "{text}");
+        // SA_RESETHAND put back the default action: returning re-runs the faulting
+        // instruction, and the process ends with the signal as it would have.
+    }
+
+    pub fn install() {
+        static ONCE: std::sync::Once = std::sync::Once::new();
+        ONCE.call_once(|| unsafe {
+            // glibc's first backtrace loads libgcc_s, too much for a signal stack: done here.
+            let mut frame = [std::ptr::null_mut(); 1];
+            libc::backtrace(frame.as_mut_ptr(), 1);
+            for sig in SIGNALS {
+                let mut action: libc::sigaction = std::mem::zeroed();
+                action.sa_sigaction = on_crash as extern "C" fn(libc::c_int) as usize;
+                // On the alternate stack where the thread has one (Rust's threads do): a stack
+                // overflow is reported too.
+                action.sa_flags = libc::SA_RESETHAND | libc::SA_ONSTACK;
+                libc::sigemptyset(&mut action.sa_mask);
+                libc::sigaction(sig, &action, std::ptr::null_mut());
+            }
+        });
+    }
 }
