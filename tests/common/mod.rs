@@ -186,16 +186,45 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 }
 
 /// A crash of the test process (a fault in the driver, the validation layer or umbra) prints the
-/// faulting thread and its backtrace to the real stderr before the process dies of the signal as
-/// before: without it a rare crash in CI leaves only "signal: 11". Installed once per test binary
-/// by the first [`context_with`].
+/// faulting thread and its backtrace to the real stderr, then the process dies of the signal as
+/// before: without it a rare crash in CI leaves only "signal: 11". A stack overflow is left to
+/// Rust's own handler, which names the thread and aborts. Installed once per test binary by the
+/// first [`context_with`].
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 mod crash_report {
     use std::io::Write;
+    use std::sync::OnceLock;
 
     const SIGNALS: [libc::c_int; 4] = [libc::SIGSEGV, libc::SIGBUS, libc::SIGILL, libc::SIGFPE];
 
-    extern "C" fn on_crash(sig: libc::c_int) {
+    /// The handlers these replaced (Rust's stack-overflow check for SIGSEGV and SIGBUS).
+    static PREVIOUS: OnceLock<Vec<(libc::c_int, libc::sigaction)>> = OnceLock::new();
+
+    extern "C" fn on_crash(
+        sig: libc::c_int,
+        info: *mut libc::siginfo_t,
+        context: *mut libc::c_void,
+    ) {
+        // Rust's handler first: on a guard-page hit it reports the overflow and aborts; on any
+        // other fault it puts back the default action and returns.
+        let previous = PREVIOUS
+            .get()
+            .and_then(|p| p.iter().find(|(s, _)| *s == sig));
+        if let Some((_, old)) = previous {
+            let handler = old.sa_sigaction;
+            if handler != libc::SIG_DFL && handler != libc::SIG_IGN {
+                unsafe {
+                    if old.sa_flags & libc::SA_SIGINFO != 0 {
+                        let f: extern "C" fn(libc::c_int, *mut libc::siginfo_t, *mut libc::c_void) =
+                            std::mem::transmute(handler);
+                        f(sig, info, context);
+                    } else {
+                        let f: extern "C" fn(libc::c_int) = std::mem::transmute(handler);
+                        f(sig);
+                    }
+                }
+            }
+        }
         // Printing allocates: should the crash have come from inside malloc and the report
         // deadlock, SIGALRM still ends the process.
         unsafe { libc::alarm(30) };
@@ -226,20 +255,26 @@ mod crash_report {
     }
 
     pub fn install() {
-        static ONCE: std::sync::Once = std::sync::Once::new();
-        ONCE.call_once(|| unsafe {
+        PREVIOUS.get_or_init(|| unsafe {
             // glibc's first backtrace loads libgcc_s, too much for a signal stack: done here.
             let mut frame = [std::ptr::null_mut(); 1];
             libc::backtrace(frame.as_mut_ptr(), 1);
-            for sig in SIGNALS {
-                let mut action: libc::sigaction = std::mem::zeroed();
-                action.sa_sigaction = on_crash as extern "C" fn(libc::c_int) as usize;
-                // On the alternate stack where the thread has one (Rust's threads do): a stack
-                // overflow is reported too.
-                action.sa_flags = libc::SA_RESETHAND | libc::SA_ONSTACK;
-                libc::sigemptyset(&mut action.sa_mask);
-                libc::sigaction(sig, &action, std::ptr::null_mut());
-            }
+            SIGNALS
+                .iter()
+                .map(|&sig| {
+                    let mut action: libc::sigaction = std::mem::zeroed();
+                    action.sa_sigaction = on_crash
+                        as extern "C" fn(libc::c_int, *mut libc::siginfo_t, *mut libc::c_void)
+                        as usize;
+                    // On the alternate stack where the thread has one (Rust's threads do), as
+                    // Rust's handler needs for an overflow.
+                    action.sa_flags = libc::SA_SIGINFO | libc::SA_RESETHAND | libc::SA_ONSTACK;
+                    libc::sigemptyset(&mut action.sa_mask);
+                    let mut old: libc::sigaction = std::mem::zeroed();
+                    libc::sigaction(sig, &action, &mut old);
+                    (sig, old)
+                })
+                .collect()
         });
     }
 }
