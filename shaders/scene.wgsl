@@ -53,14 +53,14 @@ struct Immediates {
     normal_z: vec4<f32>,
 }
 
-@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(0) var<uniform> frame_block: Frame;
 @group(0) @binding(1) var shadow_map: texture_depth_2d_array;
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
 // Written by the exact pass (shaders/exact.wgsl `samples`): element 0 is (width, height, 0, 0),
 // element 1 + pixel the receiver's world position and verdict (1 lit, 0 blocked, -1 none).
 @group(0) @binding(3) var<storage, read> exact_samples: array<vec4<f32>>;
 
-@group(1) @binding(0) var<uniform> material: Material;
+@group(1) @binding(0) var<uniform> material_block: Material;
 @group(1) @binding(1) var base_color_tex: texture_2d<f32>;
 @group(1) @binding(2) var normal_tex: texture_2d<f32>;
 @group(1) @binding(3) var metal_rough_tex: texture_2d<f32>;
@@ -71,7 +71,73 @@ struct Immediates {
 @group(1) @binding(7) var metal_rough_sampler: sampler;
 @group(1) @binding(8) var emissive_sampler: sampler;
 
-var<immediate> pc: Immediates;
+var<immediate> pc_block: Immediates;
+
+// What the shaders read of the frame block, bar its arrays of lights and shadow views.
+struct FrameValues {
+    clip_from_world: mat4x4<f32>,
+    world_from_clip: mat4x4<f32>,
+    camera_position: vec4<f32>,
+    ambient_sky: vec4<f32>,
+    ambient_ground: vec4<f32>,
+    shadow: vec4<f32>,
+    shadow_light: vec4<f32>,
+    bias: vec4<f32>,
+    camera_forward: vec4<f32>,
+    eye_forward: vec4<f32>,
+    modes: vec4<u32>,
+    output: vec4<f32>,
+}
+
+// The uniforms every function reads: the frame's values, the material, the immediates, and the
+// frame's first light and shadow view (`light_at`, `view_at`). Each entry point fills them first.
+// llvmpipe (Mesa 22.3) loads a uniform in a fragment shader lane by lane, with a bounds check on
+// each lane (it cannot assume lane 0 is active): about 15 instructions per scalar for every 8
+// pixels, where a flat input is one broadcast. So the entry points of full-screen and
+// large-triangle draws (`FlatOut`) take them as flat inputs their vertex shader wrote
+// (`load_flat`); the others copy them from the blocks (`load_uniforms`), which compiles to the
+// loads they made before.
+var<private> frame: FrameValues;
+var<private> material: Material;
+var<private> pc: Immediates;
+var<private> sun: Light;
+var<private> view0: ShadowView;
+
+fn load_uniforms() {
+    load_frame();
+    load_material();
+}
+
+// The frame's values and the immediates (what every pipeline's set 0 and immediates hold).
+fn load_frame() {
+    frame = FrameValues(frame_block.clip_from_world, frame_block.world_from_clip, frame_block.camera_position,
+        frame_block.ambient_sky, frame_block.ambient_ground, frame_block.shadow, frame_block.shadow_light,
+        frame_block.bias, frame_block.camera_forward, frame_block.eye_forward, frame_block.modes, frame_block.output);
+    pc = pc_block;
+    sun = frame_block.lights[0];
+    view0 = frame_block.views[0];
+}
+
+// The draw's material (set 1: pipelines that read it bind it).
+fn load_material() {
+    material = material_block;
+}
+
+// Light i of the frame (under ONE_SUN the only light, 0, is `sun`).
+fn light_at(i: u32) -> Light {
+    if ONE_SUN {
+        return sun;
+    }
+    return frame_block.lights[i];
+}
+
+// Shadow view `layer` (without MANY_VIEWS the only one, 0, is `view0`).
+fn view_at(layer: i32) -> ShadowView {
+    if !MANY_VIEWS {
+        return view0;
+    }
+    return frame_block.views[layer];
+}
 
 struct VsIn {
     @location(0) position: vec3<f32>,
@@ -99,6 +165,12 @@ struct VsOut {
 
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
+    load_frame();
+    return transform(v);
+}
+
+// The vertex `v` in world and clip space (after `load_uniforms`).
+fn transform(v: VsIn) -> VsOut {
     var out: VsOut;
     let world = pc.world_from_model * vec4<f32>(v.position, 1.0);
     out.world_position = world.xyz;
@@ -111,6 +183,152 @@ fn vs_main(v: VsIn) -> VsOut {
     out.uv = vec4<f32>(v.uv, v.uv1);
     out.color = v.color;
     return out;
+}
+
+// A vertex of a draw whose fragments read the uniforms as flat inputs (see `load_uniforms`):
+// VsOut's varyings, then what the lit entry points read per pixel. The frame's clip_from_world
+// and camera_forward, the first light's cone and shadow fields and the material's cutoffs and
+// texture transforms stay in the blocks (the vertex shader, cascades, spot lights, masked and
+// textured materials read them): 31 locations of lavapipe's 32.
+struct FlatOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec4<f32>,
+    @location(3) tangent: vec4<f32>,
+    @location(4) color: vec4<f32>,
+    @location(5) @interpolate(flat) world_from_clip_0: vec4<f32>,
+    @location(6) @interpolate(flat) world_from_clip_1: vec4<f32>,
+    @location(7) @interpolate(flat) world_from_clip_2: vec4<f32>,
+    @location(8) @interpolate(flat) world_from_clip_3: vec4<f32>,
+    @location(9) @interpolate(flat) camera_position: vec4<f32>,
+    @location(10) @interpolate(flat) ambient_sky: vec4<f32>,
+    @location(11) @interpolate(flat) ambient_ground: vec4<f32>,
+    @location(12) @interpolate(flat) shadow: vec4<f32>,
+    @location(13) @interpolate(flat) shadow_light: vec4<f32>,
+    @location(14) @interpolate(flat) bias: vec4<f32>,
+    @location(15) @interpolate(flat) eye_forward: vec4<f32>,
+    @location(16) @interpolate(flat) modes: vec4<u32>,
+    @location(17) @interpolate(flat) output: vec4<f32>,
+    @location(18) @interpolate(flat) sun_position: vec4<f32>,
+    @location(19) @interpolate(flat) sun_direction: vec4<f32>,
+    @location(20) @interpolate(flat) sun_color: vec4<f32>,
+    @location(21) @interpolate(flat) view0_clip_0: vec4<f32>,
+    @location(22) @interpolate(flat) view0_clip_1: vec4<f32>,
+    @location(23) @interpolate(flat) view0_clip_2: vec4<f32>,
+    @location(24) @interpolate(flat) view0_clip_3: vec4<f32>,
+    @location(25) @interpolate(flat) view0_rect: vec4<f32>,
+    @location(26) @interpolate(flat) view0_cascade: vec4<f32>,
+    @location(27) @interpolate(flat) base_color: vec4<f32>,
+    @location(28) @interpolate(flat) emissive: vec4<f32>,
+    @location(29) @interpolate(flat) params: vec4<f32>,
+    @location(30) @interpolate(flat) normal_y: vec4<f32>,
+}
+
+// Vertex `v` with the frame's values (after `load_frame`; the material's are zero).
+fn flat_out(v: VsOut) -> FlatOut {
+    var out: FlatOut;
+    out.clip = v.clip;
+    out.world_position = v.world_position;
+    out.normal = v.normal;
+    out.uv = v.uv;
+    out.tangent = v.tangent;
+    out.color = v.color;
+    out.world_from_clip_0 = frame.world_from_clip[0];
+    out.world_from_clip_1 = frame.world_from_clip[1];
+    out.world_from_clip_2 = frame.world_from_clip[2];
+    out.world_from_clip_3 = frame.world_from_clip[3];
+    out.camera_position = frame.camera_position;
+    out.ambient_sky = frame.ambient_sky;
+    out.ambient_ground = frame.ambient_ground;
+    out.shadow = frame.shadow;
+    out.shadow_light = frame.shadow_light;
+    out.bias = frame.bias;
+    out.eye_forward = frame.eye_forward;
+    out.modes = frame.modes;
+    out.output = frame.output;
+    out.sun_position = sun.position;
+    out.sun_direction = sun.direction;
+    out.sun_color = sun.color;
+    out.view0_clip_0 = view0.clip[0];
+    out.view0_clip_1 = view0.clip[1];
+    out.view0_clip_2 = view0.clip[2];
+    out.view0_clip_3 = view0.clip[3];
+    out.view0_rect = view0.rect;
+    out.view0_cascade = view0.cascade;
+    out.normal_y = pc.normal_y;
+    return out;
+}
+
+// `out` with the material's values (after `load_material`).
+fn with_material(vertex: FlatOut) -> FlatOut {
+    var out = vertex;
+    out.base_color = material.base_color;
+    out.emissive = material.emissive;
+    out.params = material.params;
+    return out;
+}
+
+// Fills the material from flat inputs (and its block for the rest).
+fn load_flat_material(in: FlatOut) {
+    material = material_block;
+    material.base_color = in.base_color;
+    material.emissive = in.emissive;
+    material.params = in.params;
+}
+
+// Fills the frame's values from flat inputs (and the block for the rest); returns the varyings.
+fn load_flat(in: FlatOut) -> VsOut {
+    frame = FrameValues(frame_block.clip_from_world,
+        mat4x4<f32>(in.world_from_clip_0, in.world_from_clip_1, in.world_from_clip_2, in.world_from_clip_3),
+        in.camera_position, in.ambient_sky, in.ambient_ground, in.shadow, in.shadow_light, in.bias,
+        frame_block.camera_forward, in.eye_forward, in.modes, in.output);
+    pc = pc_block;
+    pc.normal_y = in.normal_y;
+    sun = Light(in.sun_position, in.sun_direction, in.sun_color, frame_block.lights[0].cone, frame_block.lights[0].shadow);
+    view0 = ShadowView(mat4x4<f32>(in.view0_clip_0, in.view0_clip_1, in.view0_clip_2, in.view0_clip_3), in.view0_rect,
+        in.view0_cascade);
+    var v: VsOut;
+    v.clip = in.clip;
+    v.world_position = in.world_position;
+    v.normal = in.normal;
+    v.uv = in.uv;
+    v.tangent = in.tangent;
+    v.color = in.color;
+    return v;
+}
+
+@vertex
+fn vs_main_flat(v: VsIn) -> FlatOut {
+    load_uniforms();
+    return with_material(flat_out(transform(v)));
+}
+
+// The full-screen triangle (uv (0,0) at the top-left of the image, in FlatOut.uv.xy) with the
+// uniforms as flat inputs.
+@vertex
+fn vs_fullscreen_flat(@builtin(vertex_index) index: u32) -> FlatOut {
+    load_uniforms();
+    return with_material(fullscreen_flat(index));
+}
+
+// vs_fullscreen_flat without a material (the sky's).
+@vertex
+fn vs_sky(@builtin(vertex_index) index: u32) -> FlatOut {
+    load_frame();
+    return fullscreen_flat(index);
+}
+
+fn fullscreen_flat(index: u32) -> FlatOut {
+    let full = fullscreen(index);
+    var v: VsOut;
+    v.clip = full.clip;
+    v.world_position = vec3<f32>(0.0);
+    v.normal = vec3<f32>(0.0);
+    v.uv = vec4<f32>(full.uv, full.uv);
+    v.tangent = vec4<f32>(0.0);
+    v.color = vec4<f32>(0.0);
+    return flat_out(v);
 }
 
 #include "lib/shadow_lookup.wgsl"
@@ -127,6 +345,18 @@ fn vs_main(v: VsIn) -> VsOut {
 // - fs_debug, the shadow-visibility and normals views, for every material.
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    load_uniforms();
+    return lit_opaque(in, front_facing);
+}
+
+// fs_main with the uniforms as flat inputs (draws of large triangles on CPU devices).
+@fragment
+fn fs_main_flat(in: FlatOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    load_flat_material(in);
+    return lit_opaque(load_flat(in), front_facing);
+}
+
+fn lit_opaque(in: VsOut, front_facing: bool) -> vec4<f32> {
     return vec4<f32>(highlight(display_surface(shade(in, front_facing, base_color(in.uv, in.color)).color)), 1.0);
 }
 
@@ -153,10 +383,11 @@ fn fs_gbuffer(in: VsOut, @builtin(front_facing) front_facing: bool) -> GBuffer {
 @group(2) @binding(0) var gbuffer_a: texture_2d<u32>;
 @group(2) @binding(1) var gbuffer_b: texture_2d<u32>;
 
-// Drawn on the full-screen triangle (its uv unused: the pixel is the fragment's position).
+// Drawn on the full-screen triangle (`vs_fullscreen_flat`; the pixel is the fragment's position).
 @fragment
-fn fs_resolve(full: FullscreenOut) -> @location(0) vec4<f32> {
-    let frag = full.clip;
+fn fs_resolve(inputs: FlatOut) -> @location(0) vec4<f32> {
+    load_flat_material(inputs);
+    let frag = load_flat(inputs).clip;
     let c = vec2<i32>(frag.xy);
     let a = textureLoad(gbuffer_a, c, 0);
     var b = vec4<u32>(0u);
@@ -200,12 +431,14 @@ fn fs_resolve(full: FullscreenOut) -> @location(0) vec4<f32> {
 // behind it were (three.js does the same): exact where the curve is linear.
 @fragment
 fn fs_blend(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    load_uniforms();
     let base = base_color(in.uv, in.color);
     return vec4<f32>(highlight(display_surface(shade(in, front_facing, base).color)), clamp(base.a, 0.0, 1.0));
 }
 
 @fragment
 fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    load_uniforms();
     let base = base_color(in.uv, in.color);
     if base.a < material.extra.x {
         discard;
@@ -224,6 +457,7 @@ struct Aov {
 
 @fragment
 fn fs_aov(in: VsOut, @builtin(front_facing) front_facing: bool) -> Aov {
+    load_uniforms();
     let base = base_color(in.uv, in.color);
     if material.extra.x > 0.0 && base.a < material.extra.x {
         discard;
@@ -253,6 +487,7 @@ fn heat(t: f32) -> vec3<f32> {
 
 @fragment
 fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    load_uniforms();
     let base = base_color(in.uv, in.color);
     // The surfaces that cast and receive (the shadow pass's cutoff: a masked material's own, 0.5
     // on a blended one, none on an opaque one): what lies behind a blended texel below the cutoff
@@ -263,15 +498,15 @@ fn fs_debug(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(0
     let mode = frame.modes.x;
     // Shadow-map texels per screen pixel (derivatives first: uniform control flow), in the shown
     // light's cascade (or face).
-    let shown = frame.lights[min(u32(frame.shadow_light.w), MAX_LIGHTS - 1u)];
+    let shown = frame_block.lights[min(u32(frame.shadow_light.w), MAX_LIGHTS - 1u)];
     let first = max(i32(shown.shadow.x), 0);
     let n = i32(shown.shadow.y);
     var layer = first + cascade_of(in.world_position, first, n);
     if shown.position.w == LIGHT_POINT {
         layer = first + cube_face(in.world_position - shown.position.xyz);
     }
-    let lc = frame.views[clamp(layer, 0, MAX_SHADOW_VIEWS - 1)].clip * vec4<f32>(in.world_position, 1.0);
-    let res = frame.views[clamp(layer, 0, MAX_SHADOW_VIEWS - 1)].cascade.w;
+    let lc = frame_block.views[clamp(layer, 0, MAX_SHADOW_VIEWS - 1)].clip * vec4<f32>(in.world_position, 1.0);
+    let res = frame_block.views[clamp(layer, 0, MAX_SHADOW_VIEWS - 1)].cascade.w;
     let st = vec2<f32>(lc.x, -lc.y) / max(abs(lc.w), 1e-20) * (0.5 * res);
     let jx = dpdx(st);
     let jy = dpdy(st);
@@ -351,6 +586,10 @@ struct FullscreenOut {
 
 @vertex
 fn vs_fullscreen(@builtin(vertex_index) index: u32) -> FullscreenOut {
+    return fullscreen(index);
+}
+
+fn fullscreen(index: u32) -> FullscreenOut {
     var out: FullscreenOut;
     let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
     // uv (0,0) is the top-left of the image (clip y = +1 is the top).
@@ -362,8 +601,9 @@ fn vs_fullscreen(@builtin(vertex_index) index: u32) -> FullscreenOut {
 // The background where no surface was drawn (depth still 0): the ambient hemisphere seen along
 // the pixel's view direction, exposed and tone-mapped (the reference's background too).
 @fragment
-fn fs_sky(full: FullscreenOut) -> @location(0) vec4<f32> {
-    let ndc = vec2<f32>(full.uv.x * 2.0 - 1.0, 1.0 - full.uv.y * 2.0);
+fn fs_sky(inputs: FlatOut) -> @location(0) vec4<f32> {
+    let uv = load_flat(inputs).uv.xy;
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
     let near = frame.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
     let mid = frame.world_from_clip * vec4<f32>(ndc, 0.5, 1.0);
     let dir = normalize(mid.xyz / mid.w - near.xyz / near.w);
@@ -373,6 +613,7 @@ fn fs_sky(full: FullscreenOut) -> @location(0) vec4<f32> {
 // The shadow map itself: grey = stored depth (reversed-z: white is nearest the light), row 0 on top.
 @fragment
 fn fs_shadow_map(in: FullscreenOut) -> @location(0) vec4<f32> {
+    load_frame();
     let size = i32(frame.shadow.x);
     let c = clamp(vec2<i32>(in.uv * f32(size)), vec2<i32>(0), vec2<i32>(size - 1));
     let d = textureLoad(shadow_map, c, 0, 0);

@@ -232,7 +232,10 @@ fn deferred_double_sided_scene_matches_forward() {
 
 /// The close-up stand-in at 1280×720: its open double-sided models, triangles of about 50
 /// pixels, defer because they overdraw themselves (`deferred::overdraws_itself`), its flat ground
-/// stays forward, and the image matches the forward one.
+/// stays forward, and the image matches the forward one. On a CPU device the ground reads its
+/// uniforms as flat inputs (`fs_main_flat`, triangles of over 16 pixels), as the resolves do;
+/// drawn forward, so do the four models whose triangles `pixels_per_triangle` puts at 16 pixels
+/// or more.
 #[test]
 fn open_double_sided_models_defer_at_a_close_view_and_match_forward() {
     let ctx = context();
@@ -243,6 +246,10 @@ fn open_double_sided_models_defer_at_a_close_view_and_match_forward() {
     save(&on.image, "deferred_close_up.png");
     assert_eq!(on.stats.deferred_draws, 11, "the 11 models, not the ground");
     assert_eq!(off.stats.deferred_draws, 0);
+    if ctx.is_cpu() {
+        assert_eq!(on.stats.flat_draws, 1, "the ground");
+        assert_eq!(off.stats.flat_draws, 5, "the ground and four models");
+    }
     let (largest, changed) = difference(&on.image, &off.image);
     eprintln!("close-up: largest difference {largest} levels, {changed} pixels > 2");
     // Measured: largest 1 level (1,537 pixels), 0 pixels over 2.

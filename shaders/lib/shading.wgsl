@@ -110,7 +110,7 @@ fn shade_texels(in: VsOut, front_facing: bool, base: vec4<f32>, texels: Texels) 
     // no point or spot code (llvmpipe runs both sides of a branch, masked, on every pixel).
     let count = select(min(frame.modes.w, MAX_LIGHTS), 1u, ONE_SUN);
     for (var i = 0u; i < count; i++) {
-        let light = frame.lights[i];
+        let light = light_at(i);
         var l: vec3<f32>;
         var radiance = light.color.rgb;
         if ONE_SUN || light.position.w == LIGHT_DIRECTIONAL {

@@ -35,7 +35,7 @@ fn cascade_of(p: vec3<f32>, first: i32, n: i32) -> i32 {
     let d = view_depth(p);
     var c = 0;
     for (var k = 0; k < 3; k++) {
-        c += select(0, 1, k + 1 < n && d > frame.views[min(first + k, MAX_SHADOW_VIEWS - 1)].cascade.x);
+        c += select(0, 1, k + 1 < n && d > frame_block.views[min(first + k, MAX_SHADOW_VIEWS - 1)].cascade.x);
     }
     return c;
 }
@@ -47,7 +47,7 @@ fn cascade_of(p: vec3<f32>, first: i32, n: i32) -> i32 {
 fn cascade_index(p: vec3<f32>, pixel: vec2<f32>, first: i32, n: i32) -> i32 {
     let d = view_depth(p);
     let c = cascade_of(p, first, n);
-    let v = frame.views[min(first + c, MAX_SHADOW_VIEWS - 1)].cascade;
+    let v = frame_block.views[min(first + c, MAX_SHADOW_VIEWS - 1)].cascade;
     let start = v.y;
     let t = clamp((d - start) / max(v.x - start, 1e-20), 0.0, 1.0);
     let noise = fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
@@ -77,7 +77,7 @@ fn light_view(light: Light, p: vec3<f32>, pixel: vec2<f32>, first: i32, n: i32) 
 // Filtered shadow-map visibility of world point `p` with geometric normal `ng`, in shadow view
 // `layer` of light `light` whose direction at `p` is `l` (call only when shadows are on).
 fn shadow_visibility(p: vec3<f32>, ng: vec3<f32>, l: vec3<f32>, light: Light, layer: i32, pixel: vec2<f32>) -> f32 {
-    let view = frame.views[layer];
+    let view = view_at(layer);
     var texel_world = view.cascade.z;
     if light.position.w != LIGHT_DIRECTIONAL {
         texel_world = texel_world * distance(light.position.xyz, p);

@@ -299,6 +299,11 @@ fn score(kind: vk::PhysicalDeviceType) -> u32 {
 }
 
 impl Context {
+    /// Whether the device is a CPU implementation (lavapipe: llvmpipe's trade-offs apply).
+    pub fn is_cpu(&self) -> bool {
+        self.properties.device_type == vk::PhysicalDeviceType::CPU
+    }
+
     /// Creates a context: loads Vulkan, picks a device (explicit choice, then discrete > integrated
     /// > CPU), enables dynamic rendering, synchronization2 and depth clamp.
     pub fn new(desc: &ContextDesc) -> Result<Arc<Context>, GpuError> {

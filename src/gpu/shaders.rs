@@ -241,8 +241,8 @@ mod tests {
             assert!(spirv.len() > 20 && spirv.len() % 4 == 0);
             assert_eq!(&spirv[0..4], &0x0723_0203u32.to_le_bytes(), "SPIR-V magic");
         }
-        assert_eq!(scene::FRAME.group, 0);
-        assert_eq!(scene::MATERIAL.group, 1);
+        assert_eq!(scene::FRAME_BLOCK.group, 0);
+        assert_eq!(scene::MATERIAL_BLOCK.group, 1);
         assert_eq!(scene::SHADOW_MAP.kind, BindingKind::DepthTexture);
         assert_eq!(scene::SHADOW_SAMPLER.kind, BindingKind::ComparisonSampler);
         // Bindings within a group are unique.

@@ -135,9 +135,10 @@ pub struct ShadowImmediates {
     pub world_from_model: Mat4,
 }
 
-const _: () = assert!(std::mem::size_of::<FrameUniform>() == shaders::scene::FRAME.size as usize);
 const _: () =
-    assert!(std::mem::size_of::<MaterialUniform>() == shaders::scene::MATERIAL.size as usize);
+    assert!(std::mem::size_of::<FrameUniform>() == shaders::scene::FRAME_BLOCK.size as usize);
+const _: () =
+    assert!(std::mem::size_of::<MaterialUniform>() == shaders::scene::MATERIAL_BLOCK.size as usize);
 const _: () =
     assert!(std::mem::size_of::<SceneImmediates>() == shaders::scene::IMMEDIATE_SIZE as usize);
 const _: () =

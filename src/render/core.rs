@@ -454,6 +454,7 @@ impl FrameCore {
             camera_draws: counts.drawn,
             deferred_draws: counts.deferred,
             unshadowed_draws: counts.unshadowed,
+            flat_draws: counts.flat,
         }
     }
 
@@ -617,6 +618,8 @@ pub struct PassCounts {
     pub deferred_draws: usize,
     /// Draws drawn, wholly or in part, without the shadow lookup (`crate::render::passes::receivers`).
     pub unshadowed_draws: usize,
+    /// Forward draws reading the uniforms as flat inputs (`camera_pass::FLAT_FROM_PIXELS`).
+    pub flat_draws: usize,
 }
 
 impl Drop for FrameCore {

@@ -984,7 +984,7 @@ fn write_material_set(
             .descriptor_type(b.descriptor_type())
     };
     let writes = [
-        w(&sh::MATERIAL).buffer_info(&buf_info),
+        w(&sh::MATERIAL_BLOCK).buffer_info(&buf_info),
         w(&sh::BASE_COLOR_TEX).image_info(&i_base),
         w(&sh::NORMAL_TEX).image_info(&i_normal),
         w(&sh::METAL_ROUGH_TEX).image_info(&i_mr),

@@ -40,6 +40,9 @@ pub struct FrameStats {
     /// Of those, draws drawn, wholly or in part, without the shadow lookup where no caster can
     /// shadow them (`SceneOptions::receiver_split`).
     pub unshadowed_draws: usize,
+    /// Of those, forward draws of large triangles that read the uniforms as flat inputs (CPU
+    /// devices: `FLAT_FROM_PIXELS`).
+    pub flat_draws: usize,
     /// Draws in the scene (instances × primitives), before culling.
     pub draws_total: usize,
     /// Triangles in the scene.
@@ -389,6 +392,7 @@ impl Renderer {
             draws: counts.camera_draws,
             deferred_draws: counts.deferred_draws,
             unshadowed_draws: counts.unshadowed_draws,
+            flat_draws: counts.flat_draws,
             draws_total: self.core.gpu.draws.len(),
             triangles: self.core.gpu.triangles,
             hardware_compare: self.core.shadow.hardware_filtering(plan.shadow_format),

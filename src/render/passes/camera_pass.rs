@@ -14,6 +14,7 @@ use crate::render::gpu_scene::{vertex_layout, AlphaDraw, GpuScene};
 use crate::render::passes::cull::{CameraCull, Entry};
 use crate::render::passes::deferred::{self, DeferPlan, GBuffer, GBUFFER_FORMAT, GBUFFER_TARGETS};
 use crate::render::passes::receivers::{self, Split};
+use crate::render::passes::screen::pixels_per_triangle;
 use crate::render::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
     PipelineDesc, Stencil,
@@ -53,6 +54,9 @@ pub struct CameraPass {
     samples: u32,
     /// Whether micro-triangle draws are shaded deferred (`crate::render::passes::deferred`).
     deferred: bool,
+    /// Whether opaque forward draws of large triangles read the uniforms as flat inputs (CPU
+    /// devices: `FLAT_FROM_PIXELS`).
+    flat_forward: bool,
     gbuffer_layout: vk::DescriptorSetLayout,
     /// The G-buffer targets, at the last deferring frame's size.
     gbuffer: Option<GBuffer>,
@@ -119,6 +123,8 @@ impl CameraPass {
             ctx,
             &PipelineDesc {
                 name: "sky pipeline",
+                // Its uniforms as flat inputs (scene.wgsl `load_uniforms`).
+                vertex: (module, sh::ENTRY_VS_SKY),
                 fragment: Some((module, sh::ENTRY_FS_SKY)),
                 depth: Depth::Empty,
                 ..desc
@@ -177,6 +183,7 @@ impl CameraPass {
             depth_format,
             samples,
             deferred,
+            flat_forward: ctx.is_cpu(),
             gbuffer_layout,
             gbuffer: None,
             variant_modules: HashMap::new(),
@@ -209,12 +216,17 @@ impl CameraPass {
             .map(|&(bits, alpha)| (bits | frame_bits, Entry::of(alpha, debug_view)))
             .collect();
         let defer = &frame.defer;
-        // The unshadowed variants of receivers drawn (partly) beyond the casters' reach.
-        for (&i, split) in defer.forward.iter().zip(&frame.splits) {
+        // The unshadowed variants of receivers drawn (partly) beyond the casters' reach, and the
+        // flat-input pipelines of large-triangle draws.
+        for ((&i, split), &flat) in defer.forward.iter().zip(&frame.splits).zip(&frame.flat) {
+            let dr = &scene.draws[i];
+            let entry = frame.entry(dr.alpha, flat);
+            let bits = dr.material_bits | frame_bits;
+            if flat {
+                keys.push((bits, entry));
+            }
             if *split != Split::Shadowed {
-                let dr = &scene.draws[i];
-                let bits = receivers::unshadowed(dr.material_bits | frame_bits);
-                keys.push((bits, Entry::of(dr.alpha, debug_view)));
+                keys.push((receivers::unshadowed(bits), entry));
             }
         }
         if !defer.deferred.is_empty() {
@@ -360,7 +372,7 @@ impl CameraPass {
                 .descriptor_type(b.descriptor_type())
         };
         let writes = [
-            w(&sh::FRAME).buffer_info(&buf),
+            w(&sh::FRAME_BLOCK).buffer_info(&buf),
             w(&sh::SHADOW_MAP).image_info(&img),
             w(&sh::SHADOW_SAMPLER).image_info(&samp),
             w(&sh::EXACT_SAMPLES).buffer_info(&samples),
@@ -469,6 +481,7 @@ impl CameraPass {
             drawn: drawn + deferred_draws,
             deferred: deferred_draws,
             unshadowed,
+            flat: frame.flat.iter().filter(|&&f| f).count(),
         }
     }
 
@@ -491,9 +504,10 @@ impl CameraPass {
             let mut bound_material = usize::MAX;
             let mut bound_pipeline = vk::Pipeline::null();
             let mut sky = frame.sky;
-            for (&i, split) in frame.defer.forward.iter().zip(&frame.splits) {
+            let forward = frame.defer.forward.iter().zip(&frame.splits);
+            for ((&i, split), &flat) in forward.zip(&frame.flat) {
                 let dr = &scene.draws[i];
-                let entry = Entry::of(dr.alpha, cull.debug_view);
+                let entry = frame.entry(dr.alpha, flat);
                 if sky && entry == Entry::Blended {
                     self.record_sky(cmd);
                     bound_pipeline = self.sky_pipeline;
@@ -845,6 +859,13 @@ fn draw_order(scene: &GpuScene, cull: &CameraCull) -> Vec<usize> {
 /// What the camera pass records in one frame, decided before recording: its culling inputs, the
 /// draws in order split between the G-buffer and the forward pass, and for each forward draw
 /// whether it needs the shadow lookup everywhere, nowhere or in part (`receivers::split`).
+/// An opaque forward draw on a CPU device reads its uniforms as flat inputs (`fs_main_flat`)
+/// when its triangles cover at least this many pixels on average (`pixels_per_triangle`): a
+/// uniform read costs llvmpipe a bounds-checked load per lane for every 8 pixels
+/// (scene.wgsl `load_uniforms`), a flat input costs its triangle setup 31 vec4 inputs. At one
+/// 4×4 block per triangle the setup's cost is a fraction of what it saves.
+pub const FLAT_FROM_PIXELS: f32 = 16.0;
+
 pub struct CameraFrame {
     /// The culling and variant inputs.
     pub cull: CameraCull,
@@ -856,6 +877,20 @@ pub struct CameraFrame {
     pub defer: DeferPlan,
     /// Per forward draw (`defer.forward`), its receiver split.
     pub splits: Vec<Split>,
+    /// Per forward draw, whether it reads the uniforms as flat inputs (`FLAT_FROM_PIXELS`).
+    pub flat: Vec<bool>,
+}
+
+impl CameraFrame {
+    /// The entry point of a forward draw treating alpha as `alpha`, `flat`: reading the uniforms
+    /// as flat inputs.
+    fn entry(&self, alpha: AlphaDraw, flat: bool) -> Entry {
+        if flat {
+            Entry::OpaqueFlat
+        } else {
+            Entry::of(alpha, self.cull.debug_view)
+        }
+    }
 }
 
 impl CameraPass {
@@ -885,12 +920,23 @@ impl CameraPass {
                 })
             })
             .collect();
+        let flat = defer
+            .forward
+            .iter()
+            .map(|&i| {
+                let dr = &scene.draws[i];
+                self.flat_forward
+                    && Entry::of(dr.alpha, cull.debug_view) == Entry::Opaque
+                    && pixels_per_triangle(dr, &cull.clip_from_world, extent) >= FLAT_FROM_PIXELS
+            })
+            .collect();
         CameraFrame {
             cull,
             shadow_map_view,
             sky: sky && !shadow_map_view,
             defer,
             splits,
+            flat,
         }
     }
 }
@@ -904,6 +950,8 @@ pub struct CameraCounts {
     pub deferred: usize,
     /// Of those, draws drawn wholly or in part without the shadow lookup.
     pub unshadowed: usize,
+    /// Of those, forward draws reading the uniforms as flat inputs (`FLAT_FROM_PIXELS`).
+    pub flat: usize,
 }
 
 /// The whole of an `extent` image, as a scissor.
@@ -966,15 +1014,16 @@ fn scene_pipeline(
         &PipelineDesc {
             name: &name,
             layout,
-            vertex: if resolve {
-                (module, sh::ENTRY_VS_FULLSCREEN)
-            } else {
-                (module, sh::ENTRY_VS_MAIN)
+            vertex: match entry {
+                Entry::Resolve => (module, sh::ENTRY_VS_FULLSCREEN_FLAT),
+                Entry::OpaqueFlat => (module, sh::ENTRY_VS_MAIN_FLAT),
+                _ => (module, sh::ENTRY_VS_MAIN),
             },
             fragment: Some((
                 module,
                 match entry {
                     Entry::Opaque => sh::ENTRY_FS_MAIN,
+                    Entry::OpaqueFlat => sh::ENTRY_FS_MAIN_FLAT,
                     Entry::Masked => sh::ENTRY_FS_MASKED,
                     Entry::Blended => sh::ENTRY_FS_BLEND,
                     Entry::Debug | Entry::Overdraw => sh::ENTRY_FS_DEBUG,
