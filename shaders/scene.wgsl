@@ -312,7 +312,7 @@ fn vs_fullscreen_flat(@builtin(vertex_index) index: u32) -> FlatOut {
     return with_material(fullscreen_flat(index));
 }
 
-// vs_fullscreen_flat without a material (the sky's).
+// vs_fullscreen_flat without a material (`fs_sky_flat`'s).
 @vertex
 fn vs_sky(@builtin(vertex_index) index: u32) -> FlatOut {
     load_frame();
@@ -601,8 +601,19 @@ fn fullscreen(index: u32) -> FullscreenOut {
 // The background where no surface was drawn (depth still 0): the ambient hemisphere seen along
 // the pixel's view direction, exposed and tone-mapped (the reference's background too).
 @fragment
-fn fs_sky(inputs: FlatOut) -> @location(0) vec4<f32> {
-    let uv = load_flat(inputs).uv.xy;
+fn fs_sky(full: FullscreenOut) -> @location(0) vec4<f32> {
+    load_frame();
+    return sky(full.uv);
+}
+
+// fs_sky with the uniforms as flat inputs (`vs_sky`; CPU devices).
+@fragment
+fn fs_sky_flat(inputs: FlatOut) -> @location(0) vec4<f32> {
+    return sky(load_flat(inputs).uv.xy);
+}
+
+// The sky at `uv` ((0, 0) the image's top-left corner).
+fn sky(uv: vec2<f32>) -> vec4<f32> {
     let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
     let near = frame.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
     let mid = frame.world_from_clip * vec4<f32>(ndc, 0.5, 1.0);

@@ -85,7 +85,16 @@ impl CameraPass {
         slots: usize,
         deferred: bool,
     ) -> Result<Self, GpuError> {
-        let deferred = deferred && samples == 1;
+        // The resolves read their uniforms as flat inputs (`FLAT_LOCATIONS`).
+        let flat = flat_inputs_fit(ctx);
+        if deferred && samples == 1 && !flat {
+            log::warn!(
+                "deferred shading off: the device takes {} fragment input components, the resolve {}",
+                ctx.properties.limits.max_fragment_input_components,
+                FLAT_LOCATIONS * 4
+            );
+        }
+        let deferred = deferred && samples == 1 && flat;
         let depth_format = if deferred {
             DEPTH_STENCIL_FORMAT
         } else {
@@ -123,9 +132,17 @@ impl CameraPass {
             ctx,
             &PipelineDesc {
                 name: "sky pipeline",
-                // Its uniforms as flat inputs (scene.wgsl `load_uniforms`).
-                vertex: (module, sh::ENTRY_VS_SKY),
-                fragment: Some((module, sh::ENTRY_FS_SKY)),
+                // On CPU devices its uniforms as flat inputs (scene.wgsl `load_uniforms`).
+                vertex: if flat && ctx.is_cpu() {
+                    (module, sh::ENTRY_VS_SKY)
+                } else {
+                    (module, sh::ENTRY_VS_FULLSCREEN)
+                },
+                fragment: Some(if flat && ctx.is_cpu() {
+                    (module, sh::ENTRY_FS_SKY_FLAT)
+                } else {
+                    (module, sh::ENTRY_FS_SKY)
+                }),
                 depth: Depth::Empty,
                 ..desc
             },
@@ -183,7 +200,7 @@ impl CameraPass {
             depth_format,
             samples,
             deferred,
-            flat_forward: ctx.is_cpu(),
+            flat_forward: flat && ctx.is_cpu(),
             gbuffer_layout,
             gbuffer: None,
             variant_modules: HashMap::new(),
@@ -866,6 +883,18 @@ fn draw_order(scene: &GpuScene, cull: &CameraCull) -> Vec<usize> {
 /// 4×4 block per triangle the setup's cost is a fraction of what it saves.
 pub const FLAT_FROM_PIXELS: f32 = 16.0;
 
+/// Locations of scene.wgsl's `FlatOut` (the varyings and the uniforms' values).
+pub const FLAT_LOCATIONS: u32 = 31;
+
+/// Whether the device passes `FLAT_LOCATIONS` vec4 from vertex to fragment shader (lavapipe and
+/// desktop GPUs take 32; Vulkan guarantees 16).
+fn flat_inputs_fit(ctx: &Context) -> bool {
+    let l = &ctx.properties.limits;
+    FLAT_LOCATIONS * 4
+        <= l.max_vertex_output_components
+            .min(l.max_fragment_input_components)
+}
+
 pub struct CameraFrame {
     /// The culling and variant inputs.
     pub cull: CameraCull,
@@ -1108,5 +1137,20 @@ fn pieces(bits: usize, split: Split) -> Vec<(usize, Option<vk::Rect2D>)> {
                     .map(|r| (receivers::unshadowed(bits), Some(r))),
             )
             .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// `FLAT_LOCATIONS` counts scene.wgsl's `FlatOut` (checked against the device's limits).
+    #[test]
+    fn flat_locations_match_the_shader() {
+        let source = include_str!("../../../shaders/scene.wgsl");
+        let start = source
+            .find("struct FlatOut {")
+            .expect("FlatOut in scene.wgsl");
+        let end = start + source[start..].find('}').expect("its end");
+        let locations = source[start..end].matches("@location(").count();
+        assert_eq!(locations as u32, super::FLAT_LOCATIONS);
     }
 }
