@@ -132,7 +132,7 @@ impl CameraPass {
             ctx,
             &PipelineDesc {
                 name: "sky pipeline",
-                // On CPU devices its uniforms as flat inputs (scene.wgsl `load_uniforms`).
+                // On CPU devices its uniforms as flat inputs (shaders/lib/uniforms.wgsl).
                 vertex: if flat && ctx.is_cpu() {
                     (module, sh::ENTRY_VS_SKY)
                 } else {
@@ -879,11 +879,11 @@ fn draw_order(scene: &GpuScene, cull: &CameraCull) -> Vec<usize> {
 /// An opaque forward draw on a CPU device reads its uniforms as flat inputs (`fs_main_flat`)
 /// when its triangles cover at least this many pixels on average (`pixels_per_triangle`): a
 /// uniform read costs llvmpipe a bounds-checked load per lane for every 8 pixels
-/// (scene.wgsl `load_uniforms`), a flat input costs its triangle setup 31 vec4 inputs. At one
+/// (shaders/lib/uniforms.wgsl), a flat input costs its triangle setup 31 vec4 inputs. At one
 /// 4×4 block per triangle the setup's cost is a fraction of what it saves.
 pub const FLAT_FROM_PIXELS: f32 = 16.0;
 
-/// Locations of scene.wgsl's `FlatOut` (the varyings and the uniforms' values).
+/// Locations of `FlatOut` (shaders/lib/uniforms.wgsl: the varyings and the uniforms' values).
 pub const FLAT_LOCATIONS: u32 = 31;
 
 /// Whether the device passes `FLAT_LOCATIONS` vec4 from vertex to fragment shader (lavapipe and
@@ -1142,13 +1142,13 @@ fn pieces(bits: usize, split: Split) -> Vec<(usize, Option<vk::Rect2D>)> {
 
 #[cfg(test)]
 mod tests {
-    /// `FLAT_LOCATIONS` counts scene.wgsl's `FlatOut` (checked against the device's limits).
+    /// `FLAT_LOCATIONS` counts `FlatOut` (checked against the device's limits).
     #[test]
     fn flat_locations_match_the_shader() {
-        let source = include_str!("../../../shaders/scene.wgsl");
+        let source = include_str!("../../../shaders/lib/uniforms.wgsl");
         let start = source
             .find("struct FlatOut {")
-            .expect("FlatOut in scene.wgsl");
+            .expect("FlatOut in uniforms.wgsl");
         let end = start + source[start..].find('}').expect("its end");
         let locations = source[start..end].matches("@location(").count();
         assert_eq!(locations as u32, super::FLAT_LOCATIONS);
