@@ -95,6 +95,8 @@ impl CameraPass {
             );
         }
         let deferred = deferred && samples == 1 && flat;
+        // Where flat inputs pay: llvmpipe's per-lane uniform loads (FLAT_FROM_PIXELS).
+        let flat_cpu = flat && ctx.is_cpu();
         let depth_format = if deferred {
             DEPTH_STENCIL_FORMAT
         } else {
@@ -133,12 +135,12 @@ impl CameraPass {
             &PipelineDesc {
                 name: "sky pipeline",
                 // On CPU devices its uniforms as flat inputs (shaders/lib/uniforms.wgsl).
-                vertex: if flat && ctx.is_cpu() {
+                vertex: if flat_cpu {
                     (module, sh::ENTRY_VS_SKY)
                 } else {
                     (module, sh::ENTRY_VS_FULLSCREEN)
                 },
-                fragment: Some(if flat && ctx.is_cpu() {
+                fragment: Some(if flat_cpu {
                     (module, sh::ENTRY_FS_SKY_FLAT)
                 } else {
                     (module, sh::ENTRY_FS_SKY)
@@ -200,7 +202,7 @@ impl CameraPass {
             depth_format,
             samples,
             deferred,
-            flat_forward: flat && ctx.is_cpu(),
+            flat_forward: flat_cpu,
             gbuffer_layout,
             gbuffer: None,
             variant_modules: HashMap::new(),
