@@ -875,9 +875,6 @@ fn draw_order(scene: &GpuScene, cull: &CameraCull) -> Vec<usize> {
     v.into_iter().map(|(_, _, i)| i).collect()
 }
 
-/// What the camera pass records in one frame, decided before recording: its culling inputs, the
-/// draws in order split between the G-buffer and the forward pass, and for each forward draw
-/// whether it needs the shadow lookup everywhere, nowhere or in part (`receivers::split`).
 /// An opaque forward draw on a CPU device reads its uniforms as flat inputs (`fs_main_flat`)
 /// when its triangles cover at least this many pixels on average (`pixels_per_triangle`): a
 /// uniform read costs llvmpipe a bounds-checked load per lane for every 8 pixels
@@ -897,6 +894,10 @@ fn flat_inputs_fit(ctx: &Context) -> bool {
             .min(l.max_fragment_input_components)
 }
 
+/// What the camera pass records in one frame, decided before recording: its culling inputs, the
+/// draws in order split between the G-buffer and the forward pass, and for each forward draw
+/// whether it needs the shadow lookup everywhere, nowhere or in part (`receivers::split`) and
+/// whether it reads its uniforms as flat inputs.
 pub struct CameraFrame {
     /// The culling and variant inputs.
     pub cull: CameraCull,
