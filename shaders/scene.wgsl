@@ -100,10 +100,11 @@ struct VsOut {
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
     load_frame();
+    load_immediates();
     return transform(v);
 }
 
-// The vertex `v` in world and clip space (after `load_frame`).
+// The vertex `v` in world and clip space (after `load_frame` and `load_immediates`).
 fn transform(v: VsIn) -> VsOut {
     var out: VsOut;
     let world = pc.world_from_model * vec4<f32>(v.position, 1.0);
@@ -124,14 +125,17 @@ fn transform(v: VsIn) -> VsOut {
 @vertex
 fn vs_main_flat(v: VsIn) -> FlatOut {
     load_uniforms();
-    return with_material(flat_out(transform(v)));
+    var out = with_material(flat_out(transform(v)));
+    out.normal_y = pc.normal_y;
+    return out;
 }
 
 // The full-screen triangle (uv (0,0) at the top-left of the image, in FlatOut.uv.xy) with the
 // uniforms as flat inputs.
 @vertex
 fn vs_fullscreen_flat(@builtin(vertex_index) index: u32) -> FlatOut {
-    load_uniforms();
+    load_frame();
+    load_material();
     return with_material(fullscreen_flat(index));
 }
 

@@ -36,14 +36,14 @@ var<private> view0: ShadowView;
 fn load_uniforms() {
     load_frame();
     load_material();
+    load_immediates();
 }
 
-// The frame's values and the immediates (what every pipeline's set 0 and immediates hold).
+// The frame's values (set 0, bound for every camera pipeline).
 fn load_frame() {
     frame = FrameValues(frame_block.clip_from_world, frame_block.world_from_clip, frame_block.camera_position,
         frame_block.ambient_sky, frame_block.ambient_ground, frame_block.shadow, frame_block.shadow_light,
         frame_block.bias, frame_block.camera_forward, frame_block.eye_forward, frame_block.modes, frame_block.output);
-    pc = pc_block;
     sun = frame_block.lights[0];
     view0 = frame_block.views[0];
 }
@@ -51,6 +51,11 @@ fn load_frame() {
 // The draw's material (set 1: pipelines that read it bind it).
 fn load_material() {
     material = material_block;
+}
+
+// The draw's immediates (pushed before each draw; full-screen passes read none).
+fn load_immediates() {
+    pc = pc_block;
 }
 
 // Light i of the frame (under ONE_SUN the only light, 0, is `sun`).
@@ -109,7 +114,7 @@ struct FlatOut {
     @location(30) @interpolate(flat) normal_y: vec4<f32>,
 }
 
-// Vertex `v` with the frame's values (after `load_frame`; the material's are zero).
+// Vertex `v` with the frame's values (after `load_frame`; the material's and `normal_y` are zero).
 fn flat_out(v: VsOut) -> FlatOut {
     var out: FlatOut;
     out.clip = v.clip;
@@ -140,7 +145,6 @@ fn flat_out(v: VsOut) -> FlatOut {
     out.view0_clip_3 = view0.clip[3];
     out.view0_rect = view0.rect;
     out.view0_cascade = view0.cascade;
-    out.normal_y = pc.normal_y;
     return out;
 }
 
@@ -167,7 +171,7 @@ fn load_flat(in: FlatOut) -> VsOut {
         mat4x4<f32>(in.world_from_clip_0, in.world_from_clip_1, in.world_from_clip_2, in.world_from_clip_3),
         in.camera_position, in.ambient_sky, in.ambient_ground, in.shadow, in.shadow_light, in.bias,
         frame_block.camera_forward, in.eye_forward, in.modes, in.output);
-    pc = pc_block;
+    // The only immediate a lit fragment shader reads (the viewer's highlight).
     pc.normal_y = in.normal_y;
     sun = Light(in.sun_position, in.sun_direction, in.sun_color, frame_block.lights[0].cone, frame_block.lights[0].shadow);
     view0 = ShadowView(mat4x4<f32>(in.view0_clip_0, in.view0_clip_1, in.view0_clip_2, in.view0_clip_3), in.view0_rect,
