@@ -810,6 +810,15 @@ fn pick_device(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::{Mutex, MutexGuard, PoisonError};
+
+    /// These two tests' contexts live one at a time: the Khronos layer (1.3.239) can crash when
+    /// one thread creates or destroys a device while another uses its own
+    /// (KhronosGroup/Vulkan-ValidationLayers#4391; tests/common's `one_at_a_time`).
+    fn turn() -> MutexGuard<'static, ()> {
+        static TURN: Mutex<()> = Mutex::new(());
+        TURN.lock().unwrap_or_else(PoisonError::into_inner)
+    }
 
     fn validated() -> Arc<Context> {
         Context::new(&ContextDesc {
@@ -823,6 +832,7 @@ mod tests {
     /// the messenger and be counted, so a silently absent messenger fails the suite.
     #[test]
     fn messenger_reports_invalid_usage() {
+        let _turn = turn();
         let ctx = validated();
         assert_eq!(ctx.validation_log.problem_count(), 0);
         let info = vk::SamplerCreateInfo::default().min_lod(2.0).max_lod(1.0);
@@ -847,6 +857,7 @@ mod tests {
     /// vkDestroyDevice) reach a log kept past the context.
     #[test]
     fn leaks_are_counted_after_the_context_is_dropped() {
+        let _turn = turn();
         let ctx = validated();
         let log = ctx.validation_log.clone();
         let _leaked = unsafe {

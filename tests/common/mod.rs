@@ -14,7 +14,8 @@ use umbra::math::projection::{ndc_to_pixel, pixel_to_ndc};
 
 /// A validated context for one test. It derefs to `Arc<Context>`; when it goes out of scope it
 /// drops the context (it must hold the last reference) and fails the test if any warning or error
-/// arrived, destroy-time messages (leaked objects) included.
+/// arrived, destroy-time messages (leaked objects) included. While it lives, no other thread of
+/// the test process holds one ([`one_at_a_time`]).
 pub struct TestContext {
     ctx: Option<Arc<Context>>,
     log: Arc<umbra::ValidationLog>,
@@ -29,6 +30,8 @@ impl std::ops::Deref for TestContext {
 
 impl Drop for TestContext {
     fn drop(&mut self) {
+        // Declared first, dropped last: the turn passes on once the device is gone.
+        let _turn = one_at_a_time::Release;
         let ctx = self.ctx.take().unwrap();
         if std::thread::panicking() {
             return;
@@ -58,11 +61,15 @@ pub fn context() -> TestContext {
 pub fn context_with(desc: ContextDesc) -> TestContext {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     crash_report::install();
+    one_at_a_time::acquire();
     let ctx = Context::new(&ContextDesc {
         validation: Validation::Required,
         ..desc
     })
-    .unwrap_or_else(|e| panic!("cannot create a validated Vulkan context: {e}"));
+    .unwrap_or_else(|e| {
+        one_at_a_time::release();
+        panic!("cannot create a validated Vulkan context: {e}")
+    });
     TestContext {
         log: ctx.validation_log.clone(),
         ctx: Some(ctx),
@@ -183,6 +190,61 @@ pub fn linear_to_srgb(c: f32) -> f32 {
         } else {
             1.055 * c.powf(1.0 / 2.4) - 0.055
         }
+}
+
+/// One validated context at a time in a test process. The Khronos layer (1.3.239, Debian 12)
+/// finds each instance's and device's state in a global map that it reads without a lock on every
+/// call; creating or destroying a device on one thread while another thread's device is in use can
+/// crash it (KhronosGroup/Vulkan-ValidationLayers#4391: two CI runs of this suite ended in a
+/// SIGSEGV inside the layer, in tests/culling.rs and lab/tests/lights.rs). With one context alive
+/// its two entries stay in the map's inline slots and the map never changes under a reader. A GPU
+/// test waits for the one before it; tests without a context still run in parallel (the engine's
+/// and the lab's GPU test binaries: 133–134 s this way, 131 s unserialised in the same minutes;
+/// lavapipe's threads already fill both cores).
+/// Re-entrant per thread, so a test may hold two contexts.
+mod one_at_a_time {
+    use std::cell::RefCell;
+    use std::sync::{Mutex, MutexGuard, PoisonError};
+
+    static TURN: Mutex<()> = Mutex::new(());
+
+    thread_local! {
+        /// This thread's contexts and, while there are any, its turn.
+        static HELD: RefCell<(usize, Option<MutexGuard<'static, ()>>)> =
+            const { RefCell::new((0, None)) };
+    }
+
+    /// Waits for this thread's turn unless it already has it.
+    pub fn acquire() {
+        HELD.with(|h| {
+            let mut h = h.borrow_mut();
+            if h.0 == 0 {
+                // A test that failed while holding the turn poisons the lock; the turn is free.
+                h.1 = Some(TURN.lock().unwrap_or_else(PoisonError::into_inner));
+            }
+            h.0 += 1;
+        });
+    }
+
+    /// Gives the turn back with this thread's last context.
+    pub fn release() {
+        HELD.with(|h| {
+            let mut h = h.borrow_mut();
+            h.0 = h.0.saturating_sub(1);
+            if h.0 == 0 {
+                h.1 = None;
+            }
+        });
+    }
+
+    /// Releases when dropped: after the context, which is dropped before it.
+    pub struct Release;
+
+    impl Drop for Release {
+        fn drop(&mut self) {
+            release();
+        }
+    }
 }
 
 /// A crash of the test process (a fault in the driver, the validation layer or umbra) prints the
