@@ -148,7 +148,7 @@ fn flat_out(v: VsOut) -> FlatOut {
     return out;
 }
 
-// `out` with the material's values (after `load_material`).
+// `vertex` with the material's values (after `load_material`).
 fn with_material(vertex: FlatOut) -> FlatOut {
     var out = vertex;
     out.base_color = material.base_color;

@@ -129,22 +129,19 @@ impl CameraPass {
             samples,
         };
         let map_pipeline = create_pipeline(ctx, &desc)?;
-        // The sky: a full-screen triangle at depth 0 drawn where no surface was.
+        // The sky: a full-screen triangle at depth 0 drawn where no surface was; on CPU devices
+        // its uniforms as flat inputs (shaders/lib/uniforms.wgsl).
+        let (sky_vs, sky_fs) = if flat_cpu {
+            (sh::ENTRY_VS_SKY, sh::ENTRY_FS_SKY_FLAT)
+        } else {
+            (sh::ENTRY_VS_FULLSCREEN, sh::ENTRY_FS_SKY)
+        };
         let sky_pipeline = create_pipeline(
             ctx,
             &PipelineDesc {
                 name: "sky pipeline",
-                // On CPU devices its uniforms as flat inputs (shaders/lib/uniforms.wgsl).
-                vertex: if flat_cpu {
-                    (module, sh::ENTRY_VS_SKY)
-                } else {
-                    (module, sh::ENTRY_VS_FULLSCREEN)
-                },
-                fragment: Some(if flat_cpu {
-                    (module, sh::ENTRY_FS_SKY_FLAT)
-                } else {
-                    (module, sh::ENTRY_FS_SKY)
-                }),
+                vertex: (module, sky_vs),
+                fragment: Some((module, sky_fs)),
                 depth: Depth::Empty,
                 ..desc
             },
