@@ -17,16 +17,15 @@ new=$3
 shift 3
 export UMBRA_DEVICE="${UMBRA_DEVICE:-llvmpipe}"
 rows=$(mktemp)
-trap 'rm -f "$rows"' EXIT
+out=$(mktemp)
+trap 'rm -f "$rows" "$out"' EXIT
+TIMEFORMAT='%U %S'
 for _ in $(seq "$rounds"); do
   for side in old new; do
     bin=$old
     [ "$side" = new ] && bin=$new
-    out=$(mktemp)
-    TIMEFORMAT='%U %S'
     cpu=$({ time "$bin" bench "$@" >"$out" 2>/dev/null; } 2>&1)
     row=$(grep '^|' "$out" | tail -1)
-    rm -f "$out"
     echo "$side $row $(awk '{ printf "%.2f", $1 + $2 }' <<<"$cpu") CPU s" | tee -a "$rows"
   done
 done
