@@ -7,6 +7,7 @@
 # Needs perf, a C compiler and the release CLI (cargo build --release -p umbra-cli).
 # Usage: scripts/profile-llvmpipe.sh [bench arguments...]
 #   e.g. scripts/profile-llvmpipe.sh --synthetic close-up --maps 2048 --kernels 2x2 --repeat 40
+# UMBRA_BIN=PATH profiles that umbra binary instead (a throwaway build kept aside).
 # UMBRA_JITDUMP_DIR=DIR also saves each function's code (objdump -D -b binary -mi386:x86-64
 # --adjust-vma=ADDRESS DIR/NN_name_ADDRESS.bin).
 set -euo pipefail
@@ -16,7 +17,7 @@ trap 'rm -rf "$work"' EXIT
 llvm=$(ldd "$(ldconfig -p | awk '/libvulkan_lvp.so/ {print $NF; exit}')" | awk '/libLLVM/ {print $3; exit}')
 cc -shared -fPIC -O2 -o "$work/jitmap.so" scripts/llvmpipe-jitmap.c "$llvm" -ldl -lpthread
 export UMBRA_DEVICE="${UMBRA_DEVICE:-llvmpipe}"
-LD_PRELOAD="$work/jitmap.so" perf record -q -F 2000 -o "$work/perf.data" target/release/umbra bench "$@"
+LD_PRELOAD="$work/jitmap.so" perf record -q -F 2000 -o "$work/perf.data" "${UMBRA_BIN:-target/release/umbra}" bench "$@"
 # Each function's size: the gap to the next one (at most 64 KiB).
 map=$(ls -t /tmp/perf-*.map | head -1)
   python3 - "$map" <<'PY'
