@@ -7,7 +7,8 @@
 # Needs perf, a C compiler and the release CLI (cargo build --release -p umbra-cli).
 # Usage: scripts/profile-llvmpipe.sh [bench arguments...]
 #   e.g. scripts/profile-llvmpipe.sh --synthetic close-up --maps 2048 --kernels 2x2 --repeat 40
-# UMBRA_BIN=PATH profiles that umbra binary instead (a throwaway build kept aside).
+# UMBRA_BIN=PATH (absolute, or from the repository root) profiles that umbra binary instead (a
+# throwaway build kept aside).
 # UMBRA_JITDUMP_DIR=DIR also saves each function's code (objdump -D -b binary -mi386:x86-64
 # --adjust-vma=ADDRESS DIR/NN_name_ADDRESS.bin).
 set -euo pipefail
