@@ -284,7 +284,14 @@ fn write_depth_profile(
 #[cfg(feature = "viewer")]
 fn view(a: ViewArgsCmd) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
-    let view = make_view(&scene, &a.view)?;
+    let mut view = make_view(&scene, &a.view)?;
+    if view.supersample > 1 {
+        eprintln!(
+            "warning: --ssaa {}: the viewer draws at its window's size; ignored",
+            view.supersample
+        );
+        view.supersample = 1;
+    }
     let start = app::cli::playing(&scene, &a.view)?;
     let args = a.view.clone();
     app::viewer::run(app::viewer::ViewerOptions {
@@ -530,6 +537,26 @@ fn fmt_ms(ms: f64) -> String {
     }
 }
 
+/// The anti-aliasing a frame gets, as a parenthesis after its size (empty without any).
+fn anti_aliasing(samples: u32, view: &umbra::render::View) -> String {
+    let mut parts = Vec::new();
+    if samples > 1 {
+        parts.push(format!("{samples}× MSAA"));
+    }
+    if view.supersample > 1 {
+        let s = view.supersample;
+        parts.push(format!("{s}×{s} supersampled"));
+    }
+    if view.post_aa == umbra::render::PostAa::Fxaa {
+        parts.push("FXAA".to_string());
+    }
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", parts.join(", "))
+    }
+}
+
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut base = make_view(&scene, &a.view)?;
@@ -539,9 +566,10 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
     app::cli::apply_budget(&scene, &mut base, &a.view, &mut renderer)?;
     let (w, h) = a.view.size;
     println!(
-        "{} ({} triangles) at {w}x{h} on {}; medians of {} frames after 1 warm-up",
+        "{} ({} triangles) at {w}x{h}{} on {}; medians of {} frames after 1 warm-up",
         scene.name,
         renderer.triangles(),
+        anti_aliasing(renderer.samples(), &base),
         ctx.device_name,
         a.repeat
     );

@@ -319,6 +319,7 @@ fn bad_arguments() {
         (vec!["render", "--frames", "3", "-o", "x.png"], "pattern"),
         (vec!["render", "--frames", "3", "-o", "x%q.png"], "%0nd"),
         (vec!["render", "--frames", "2", "--fps", "0"], "frame rate"),
+        (vec!["render", "--ssaa", "3"], "3 is not in 1..=2"),
     ] {
         let (ok, stderr) = run(&args, &d);
         assert!(!ok, "{args:?} should fail");

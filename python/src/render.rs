@@ -180,11 +180,13 @@ fn render_outputs(
     let mut out = Vec::new();
     // At one sample a pixel, the lit frame's own depth buffer is the AOV pass's (the same
     // rasterisation of the same depth-writing draws): read it instead of drawing the scene again.
+    // A supersampled frame's is at twice the size: the AOV pass draws the image's own.
     let depth_from_frame = wants("color")
         && wants("depth")
         && !wants("segmentation")
         && !wants("normals")
-        && r.samples() == 1;
+        && r.samples() == 1
+        && view.supersample == 1;
     if wants("color") {
         r.set_read_depth(depth_from_frame);
         let f = r.render(view, w, h);

@@ -6,7 +6,7 @@ use glam::Vec3;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use umbra::render::{Background, Exposure, PostAa, ShadowFit, Tonemap, View};
+use umbra::render::{Background, Exposure, PostAa, ShadowFit, Tonemap, View, SUPERSAMPLE_FACTORS};
 
 /// What a frame is rendered with besides the view: the error budget, the light whose visibility
 /// `shadow` holds, and the scene's time.
@@ -40,6 +40,7 @@ pub const NAMES: &[&str] = &[
     "exposure",
     "tonemap",
     "post_aa",
+    "supersample",
     "ambient",
     "background",
     "sun_direction",
@@ -124,6 +125,16 @@ pub fn apply(view: &mut View, settings: Option<&Bound<'_, PyDict>>) -> PyResult<
                 view.tonemap = text()?.parse::<Tonemap>().map_err(|e| invalid(&name, e))?
             }
             "post_aa" => view.post_aa = text()?.parse::<PostAa>().map_err(|e| invalid(&name, e))?,
+            "supersample" => {
+                let f: u32 = v.extract()?;
+                if !SUPERSAMPLE_FACTORS.contains(&f) {
+                    return Err(invalid(
+                        &name,
+                        format!("{f} is not one of {SUPERSAMPLE_FACTORS:?}"),
+                    ));
+                }
+                view.supersample = f;
+            }
             "ambient" => view.ambient = Some(rgb(&name, &v)?),
             "background" => {
                 view.background = match v.extract::<[f32; 3]>() {

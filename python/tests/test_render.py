@@ -242,6 +242,22 @@ def test_settings_act_like_the_command_line_options(renderer):
     assert 0.01 < moved < 0.04, moved
     with pytest.raises(ValueError, match="post_aa: post anti-aliasing 'smaa'"):
         renderer.render(scene, camera, pose, post_aa="smaa")
+    # 2×2 supersampling: each pixel the mean, in linear light, of the render at twice the size
+    # (measured: at most 1 level off, rounding), and the depth still at the image's size.
+    ss = renderer.render(scene, camera, pose, supersample=2)
+    twice = umbra.OffscreenRenderer(2 * W, 2 * H, validation=True)
+    big = twice.render(scene, camera, pose)
+    problems = twice.validation_problems
+    twice.close()
+    assert problems == 0, f"{problems} validation message(s) at twice the size"
+    assert ss[0].shape == (H, W, 3)
+    assert np.array_equal(ss[1], renderer.render(scene, camera, pose)[1]), "depth moved"
+    lin = np.where(big[0] <= 10, big[0] / 255 / 12.92, ((big[0] / 255 + 0.055) / 1.055) ** 2.4)
+    mean = lin.reshape(H, 2, W, 2, 3).mean(axis=(1, 3))
+    enc = np.where(mean <= 0.0031308, mean * 12.92, 1.055 * mean ** (1 / 2.4) - 0.055)
+    assert np.abs(np.round(enc * 255) - ss[0]).max() <= 1
+    with pytest.raises(ValueError, match=r"supersample: 3 is not one of \[1, 2\]"):
+        renderer.render(scene, camera, pose, supersample=3)
     # Exact shadows: hard (0 or 1 only, where the map's filter leaves greys on edges), and the
     # same verdict as the map away from its edges (measured: no pixel differs at 0.5).
     out = renderer.render(scene, camera, pose, outputs=("shadow", "depth"), shadow_method="exact")

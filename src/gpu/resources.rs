@@ -410,7 +410,7 @@ impl Image {
             (width, height, mips),
             rgba,
             &base,
-            |d, cmd, img| unsafe {
+            |d, cmd, img| {
                 let (mut w, mut h) = (width as i32, height as i32);
                 for level in 1..mips {
                     image_barrier(
@@ -423,29 +423,7 @@ impl Image {
                         Access::TransferSrc,
                     );
                     let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-                    let layer = |mip_level| vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        mip_level,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    };
-                    let blit = [vk::ImageBlit::default()
-                        .src_subresource(layer(level - 1))
-                        .src_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }])
-                        .dst_subresource(layer(level))
-                        .dst_offsets([
-                            vk::Offset3D::default(),
-                            vk::Offset3D { x: nw, y: nh, z: 1 },
-                        ])];
-                    d.cmd_blit_image(
-                        cmd,
-                        img,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                        img,
-                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                        &blit,
-                        vk::Filter::LINEAR,
-                    );
+                    blit_linear(d, cmd, (img, level - 1, w, h), (img, level, nw, nh));
                     image_barrier(
                         d,
                         cmd,
@@ -546,6 +524,39 @@ impl Image {
 }
 
 /// The RGBA8 format of a texture in the sRGB or linear colour space.
+/// A whole colour mip level: (image, mip, width, height).
+pub type Level = (vk::Image, u32, i32, i32);
+
+/// Records a linear-filtered blit of level `src` (in TRANSFER_SRC_OPTIMAL) onto level `dst` (in
+/// TRANSFER_DST_OPTIMAL), each whole. At 2:1 it samples each destination texel's centre midway
+/// between its four source texels: their mean, in linear light for sRGB formats (a blit filters
+/// after the format's decode).
+pub fn blit_linear(d: &ash::Device, cmd: vk::CommandBuffer, src: Level, dst: Level) {
+    let layer = |mip_level| vk::ImageSubresourceLayers {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        mip_level,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    let corner = |(_, _, x, y): Level| vk::Offset3D { x, y, z: 1 };
+    let blit = [vk::ImageBlit::default()
+        .src_subresource(layer(src.1))
+        .src_offsets([vk::Offset3D::default(), corner(src)])
+        .dst_subresource(layer(dst.1))
+        .dst_offsets([vk::Offset3D::default(), corner(dst)])];
+    unsafe {
+        d.cmd_blit_image(
+            cmd,
+            src.0,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            dst.0,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &blit,
+            vk::Filter::LINEAR,
+        )
+    };
+}
+
 fn rgba8_format(srgb: bool) -> vk::Format {
     if srgb {
         vk::Format::R8G8B8A8_SRGB

@@ -24,7 +24,7 @@ pub use lights::{effective_lights, exposure_scale, metered_illuminance};
 pub use settings::{
     Ambient, Background, Exposure, HeldLight, Pcf, PostAa, SceneOptions, ShadowFit, ShadowFormat,
     ShadowHold, ShadowMethod, ShadowSettings, Tonemap, View, ViewMode, AUTO_GROUND, AUTO_SKY,
-    GROUND_TINT, MAX_CASCADES, SKY_TINT, UNIT_AMBIENT,
+    GROUND_TINT, MAX_CASCADES, SKY_TINT, SUPERSAMPLE_FACTORS, UNIT_AMBIENT,
 };
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
 pub use views::{lookup_reach, soft_size, ShadowView};

@@ -607,6 +607,13 @@ pub struct View {
     pub tonemap: Tonemap,
     /// Post-process anti-aliasing of the lit image ([`PostAa`]; debug views are not filtered).
     pub post_aa: PostAa,
+    /// Supersampling of offscreen frames ([`SUPERSAMPLE_FACTORS`]): 1 (off) or 2, drawn at
+    /// twice the width and height and filtered down to the asked size, each pixel the mean of
+    /// its 2×2 samples in linear light: four samples a pixel, shading included, for less than
+    /// 4× MSAA costs on lavapipe (docs/speed.md). The shadow maps are planned for the asked
+    /// size's pixels (as with MSAA, a pixel's samples share its texels). The viewer draws at
+    /// its window's size and ignores it.
+    pub supersample: u32,
     /// Fit the light frustum to this camera instead of `camera` (for stability tests).
     pub shadow_fit_camera: Option<Camera>,
     /// Tint this (instance, primitive) orange in the lit image (the viewer's picked primitive).
@@ -658,6 +665,9 @@ impl ShadowHold {
     }
 }
 
+/// The values `View::supersample` takes.
+pub const SUPERSAMPLE_FACTORS: [u32; 2] = [1, 2];
+
 impl View {
     /// The same view in coordinates relative to `origin` (cameras moved; directions unchanged).
     pub fn rebased(&self, origin: Vec3) -> Self {
@@ -695,6 +705,7 @@ impl View {
             exposure_compensation: 0.0,
             tonemap: Tonemap::Neutral,
             post_aa: PostAa::None,
+            supersample: 1,
             shadow_fit_camera: None,
             highlight: None,
             shown_light: None,

@@ -163,9 +163,11 @@ impl FrameCore {
             receivers: &self.receiver_bounds,
             origin: self.origin,
         };
+        // The image's pixel footprint: a supersampled frame's samples share their pixel's maps,
+        // as MSAA's do.
         let target = |hw_compare| PlanTarget {
             aspect: width as f32 / height.max(1) as f32,
-            height_px: height,
+            height_px: height / view.supersample.max(1),
             hw_compare,
         };
         // An automatic format is resolved by the plan; planned again in the rare case that the

@@ -19,7 +19,7 @@ pub use crate::plan::{
     effective_lights, metered_illuminance, Ambient, Background, Exposure, FramePlan, HeldLight,
     Pcf, PostAa, SceneOptions, ScenePlanner, ShadowFit, ShadowFormat, ShadowHold, ShadowMethod,
     ShadowSettings, ShadowView, Tonemap, View, ViewMode, MAX_CASCADES, MAX_LIGHTS,
-    MAX_SHADOW_VIEWS, UNIT_AMBIENT,
+    MAX_SHADOW_VIEWS, SUPERSAMPLE_FACTORS, UNIT_AMBIENT,
 };
 pub use renderer::{view_axis_depths, Aovs, FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 #[cfg(feature = "viewer")]

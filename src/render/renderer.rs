@@ -3,8 +3,9 @@
 use super::core::{FrameCore, Targets};
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::resources::blit_linear;
 use crate::gpu::{Buffer, Image};
-use crate::plan::settings::{SceneOptions, View};
+use crate::plan::settings::{SceneOptions, View, SUPERSAMPLE_FACTORS};
 use crate::plan::FramePlan;
 use crate::render::targets::{Attachment, MsaaTargets};
 use crate::scene::Scene;
@@ -60,7 +61,7 @@ pub struct RenderedFrame {
     /// The CPU-side plan it was rendered with.
     pub plan: FramePlan,
     /// The camera depth buffer (reversed-z, 0 = nothing drawn), row-major, when requested with
-    /// `Renderer::set_read_depth`.
+    /// `Renderer::set_read_depth`; at the drawn size (`View::supersample` times the image's).
     pub depth: Option<Vec<f32>>,
 }
 
@@ -73,6 +74,9 @@ struct Target {
     depth_readback: Buffer,
     /// The multisampled images drawn into (resolved into `color`, `depth`) with MSAA.
     msaa: Option<MsaaTargets>,
+    /// With supersampling, the image at the asked size `color` is filtered into (read back
+    /// instead of `color`).
+    filtered: Option<(Image, Attachment)>,
 }
 
 /// Renders views of one scene offscreen.
@@ -220,12 +224,13 @@ impl Renderer {
             .count()
     }
 
-    fn ensure_target(&mut self, w: u32, h: u32) -> Result<(), GpuError> {
-        if self
-            .target
-            .as_ref()
-            .is_some_and(|t| t.color.extent.width == w && t.color.extent.height == h)
-        {
+    /// Targets of `w`×`h` drawn pixels, filtered to `out` (with supersampling).
+    fn ensure_target(&mut self, w: u32, h: u32, out: Option<vk::Extent2D>) -> Result<(), GpuError> {
+        if self.target.as_ref().is_some_and(|t| {
+            t.color.extent.width == w
+                && t.color.extent.height == h
+                && t.filtered.as_ref().map(|f| f.0.extent) == out
+        }) {
             return Ok(());
         }
         let ctx = &self.core.ctx;
@@ -271,8 +276,25 @@ impl Renderer {
         } else {
             None
         };
+        let filtered = match out {
+            Some(extent) => {
+                let image = Image::new(
+                    ctx,
+                    "offscreen filtered colour",
+                    OFFSCREEN_FORMAT,
+                    extent,
+                    1,
+                    // SAMPLED: never sampled, but `Image` makes a view, which needs a view usage.
+                    vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::SAMPLED | usage,
+                )?;
+                let at = Attachment::of(&image);
+                Some((image, at))
+            }
+            None => None,
+        };
         self.target = Some(Target {
             msaa,
+            filtered,
             color_at: Attachment::of(&color),
             depth_at: Attachment::of(&depth),
             color,
@@ -340,13 +362,21 @@ impl Renderer {
         height: u32,
     ) -> Result<RenderedFrame, GpuError> {
         check_size(width, height)?;
+        let s = view.supersample;
+        check_supersample(&self.core.ctx, s)?;
+        let extent = vk::Extent2D { width, height };
+        let (dw, dh) = (width * s, height * s);
+        check_size(dw, dh)?;
         let start = Instant::now();
-        let prepared = self.core.prepare(0, view, width, height)?;
-        self.ensure_target(width, height)?;
+        let prepared = self.core.prepare(0, view, dw, dh)?;
+        self.ensure_target(dw, dh, (s > 1).then_some(extent))?;
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
         let cmd = self.cmd;
-        let extent = vk::Extent2D { width, height };
+        let drawn = vk::Extent2D {
+            width: dw,
+            height: dh,
+        };
         let t = self.target.as_mut().expect("target");
         ctx.begin_one_time(cmd)?;
         let counts = self.core.record(
@@ -361,10 +391,21 @@ impl Renderer {
         );
         let plan = prepared.plan;
         t.color_at.transition(d, cmd, Access::TransferSrc);
+        let shown = match t.filtered.as_mut() {
+            Some((image, at)) => {
+                at.transition(d, cmd, Access::TransferDst);
+                // 2:1: each pixel the mean of its 2×2 samples, in linear light.
+                let (dw, dh, w, h) = (dw as i32, dh as i32, width as i32, height as i32);
+                blit_linear(d, cmd, (t.color.raw, 0, dw, dh), (image.raw, 0, w, h));
+                at.transition(d, cmd, Access::TransferSrc);
+                image.raw
+            }
+            None => t.color.raw,
+        };
         copy_to_buffer(
             d,
             cmd,
-            t.color.raw,
+            shown,
             vk::ImageAspectFlags::COLOR,
             extent,
             t.readback.raw,
@@ -376,7 +417,7 @@ impl Renderer {
                 cmd,
                 t.depth.raw,
                 vk::ImageAspectFlags::DEPTH,
-                extent,
+                drawn,
                 t.depth_readback.raw,
             );
         }
@@ -409,7 +450,7 @@ impl Renderer {
                 .mapped()
                 .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
             Some(bytemuck::pod_collect_to_vec(
-                &bytes[..(width * height * 4) as usize],
+                &bytes[..(dw * dh * 4) as usize],
             ))
         } else {
             None
@@ -423,6 +464,25 @@ impl Renderer {
             depth,
         })
     }
+}
+
+/// An error for a supersampling factor outside [`SUPERSAMPLE_FACTORS`], or one the device
+/// cannot filter down (a linear blit of the offscreen format).
+fn check_supersample(ctx: &Context, s: u32) -> Result<(), GpuError> {
+    if !SUPERSAMPLE_FACTORS.contains(&s) {
+        return Err(GpuError::Unsupported(format!(
+            "supersample {s} is not one of {SUPERSAMPLE_FACTORS:?}"
+        )));
+    }
+    let linear_blits = vk::FormatFeatureFlags::BLIT_SRC
+        | vk::FormatFeatureFlags::BLIT_DST
+        | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR;
+    if s > 1 && !ctx.format_features(OFFSCREEN_FORMAT).contains(linear_blits) {
+        return Err(GpuError::Unsupported(format!(
+            "supersample {s}: the device cannot filter {OFFSCREEN_FORMAT:?} in a blit"
+        )));
+    }
+    Ok(())
 }
 
 /// An error for an image size outside 1×1..`MAX_SIDE`².

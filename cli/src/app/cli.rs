@@ -512,6 +512,12 @@ pub struct ViewArgs {
     /// fraction of MSAA's cost on CPU devices; docs/speed.md).
     #[arg(long, value_parser = ["none", "fxaa"], default_value = "none")]
     pub post_aa: String,
+    /// Supersampling of offscreen frames: `2` draws at twice the width and height and gives
+    /// each pixel the mean of its 2×2 samples in linear light (four samples a pixel, shading
+    /// included: on CPU devices cheaper than `--msaa 4`; docs/speed.md); 1 (the default) is off.
+    /// The viewer ignores it, with a warning.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=2), default_value = "1")]
+    pub ssaa: u32,
     /// Shade draws of triangles smaller than a 4×4 pixel block deferred (a G-buffer, then each
     /// covered pixel shaded once: the same image, less work where llvmpipe would shade whole
     /// blocks per tiny triangle); default on for CPU devices at one sample per pixel, off on GPUs.
@@ -753,6 +759,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     v.background = a.background;
     v.tonemap = a.tonemap;
     v.post_aa = a.post_aa.parse().unwrap_or_default();
+    v.supersample = a.ssaa;
     if let Some(i) = a.shadow_light {
         let n = umbra::render::effective_lights(&scene.lights, &v).len();
         if i >= n {

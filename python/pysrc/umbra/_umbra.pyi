@@ -177,7 +177,7 @@ class OffscreenRenderer:
         the caster triangles), contact_shadows (bool: creases finer than a texel), pcf ('none', '2x2', '3x3', '5x5'), cascades (0 = automatic), depth_fit, fit
         ('camera', 'sphere', 'scene'), bias_constant, bias_slope, normal_offset, shadow_budget
         (misclassified pixels, %), shadow_light, light_size, exposure ('auto', an EV100, or
-        'x1.5'), tonemap ('neutral', 'aces', 'none'), post_aa ('none', 'fxaa'), ambient, background ('sky', '#rrggbb' or an
+        'x1.5'), tonemap ('neutral', 'aces', 'none'), post_aa ('none', 'fxaa'), supersample (1, 2), ambient, background ('sky', '#rrggbb' or an
         RGB triple within 0..1), sun_direction, sun_intensity, time (seconds), animation (a
         name, an index or 'all'). The GIL is released while the GPU works."""
     def render_batch(
