@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # umbra's Python renderer against pyrender, side by side in the same minutes: per-frame time of
 # `render(scene, camera, pose)` (colour and depth into numpy, shadows on) on FlightHelmet + the
-# peer's ground and on the peer's 16×16 sphere grid, umbra at msaa 1, msaa 1 with FXAA and msaa 4
-# (pyrender always 4×),
+# peer's ground and on the peer's 16×16 sphere grid, umbra at msaa 1, msaa 1 with FXAA, msaa 4
+# and 2×2 supersampling (pyrender always 4×),
 # the runs alternating ROUNDS times; then render_batch of 100 poses against 100 render calls.
 # Needs the package in the active Python (scripts/python-test.sh's target/pyenv will do) and the
 # pyrender peer's environment (../shared/peers/pyrender/setup.sh).
@@ -26,11 +26,12 @@ for r in $(seq "$rounds"); do
     else
       umbra_args=(--gltf-scene "$out/spheres16.gltf"); peer_args=(--synthetic 16)
     fi
-    for aa in msaa1 fxaa msaa4; do
+    for aa in msaa1 fxaa msaa4 ssaa2; do
       case $aa in
         msaa1) aa_args=(--msaa 1) ;;
         fxaa) aa_args=(--msaa 1 --post-aa fxaa) ;;
         msaa4) aa_args=(--msaa 4) ;;
+        ssaa2) aa_args=(--msaa 1 --supersample 2) ;;
       esac
       python python/examples/bench.py "${umbra_args[@]}" "${aa_args[@]}" \
         | sed "s/^/{\"run\": \"umbra $aa $scene r$r\", \"r\": /; s/\$/}/" >>"$out/runs.jsonl"

@@ -3,7 +3,8 @@
 camera and sun as ../shared/peers/pyrender/bench_pyrender.py), for side-by-side runs in the
 same minutes. Prints one JSON line.
 
-  bench.py MODEL.gltf [--msaa 1|4] [--post-aa none|fxaa] [--width 1280 --height 720] [--frames 15] [--warmup 3]
+  bench.py MODEL.gltf [--msaa 1|4] [--post-aa none|fxaa] [--supersample 1|2] [--width 1280 --height 720]
+           [--frames 15] [--warmup 3]
   bench.py --gltf-scene EXPORTED.gltf ...   # bench_pyrender.py --synthetic 16 --export-gltf
   bench.py ... --batch 100                   # render_batch of N poses against N render calls
 
@@ -63,6 +64,7 @@ def main():
     ap.add_argument("--height", type=int, default=720)
     ap.add_argument("--msaa", type=int, default=1)
     ap.add_argument("--post-aa", default="none", choices=["none", "fxaa"])
+    ap.add_argument("--supersample", type=int, default=1, choices=[1, 2])
     ap.add_argument("--frames", type=int, default=15)
     ap.add_argument("--warmup", type=int, default=3)
     ap.add_argument("--batch", type=int, default=0)
@@ -77,14 +79,15 @@ def main():
     r = umbra.OffscreenRenderer(a.width, a.height, msaa=a.msaa)
     create_ms = (time.perf_counter() - t) * 1e3
     t = time.perf_counter()
-    color, _ = r.render(scene, camera, pose, post_aa=a.post_aa)
+    aa = {"post_aa": a.post_aa, "supersample": a.supersample}
+    color, _ = r.render(scene, camera, pose, **aa)
     first_ms = (time.perf_counter() - t) * 1e3
     if a.png:
         from PIL import Image
 
         Image.fromarray(color).save(a.png)
-    timed(lambda: r.render(scene, camera, pose, post_aa=a.post_aa), a.warmup)
-    frames = timed(lambda: r.render(scene, camera, pose, post_aa=a.post_aa), a.frames)
+    timed(lambda: r.render(scene, camera, pose, **aa), a.warmup)
+    frames = timed(lambda: r.render(scene, camera, pose, **aa), a.frames)
     out = {
         "scene": scene.name,
         "triangles": scene.triangles,
@@ -92,6 +95,7 @@ def main():
         "size": [a.width, a.height],
         "msaa": r.samples,
         "post_aa": a.post_aa,
+        "supersample": a.supersample,
         "renderer_create_ms": round(create_ms, 1),
         "first_frame_ms": round(first_ms, 1),
         "frame_ms": {
