@@ -523,7 +523,6 @@ impl Image {
     }
 }
 
-/// The RGBA8 format of a texture in the sRGB or linear colour space.
 /// A whole colour mip level: (image, mip, width, height).
 pub type Level = (vk::Image, u32, i32, i32);
 
@@ -557,6 +556,7 @@ pub fn blit_linear(d: &ash::Device, cmd: vk::CommandBuffer, src: Level, dst: Lev
     };
 }
 
+/// The RGBA8 format of a texture in the sRGB or linear colour space.
 fn rgba8_format(srgb: bool) -> vk::Format {
     if srgb {
         vk::Format::R8G8B8A8_SRGB

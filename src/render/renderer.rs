@@ -92,7 +92,7 @@ pub struct Renderer {
     aov: Option<aov::AovTarget>,
 }
 
-/// A camera (view matrix, projection, image size) and the (nearest, farthest) view depth it saw
+/// A camera (view matrix, projection, drawn size) and the (nearest, farthest) view depth it saw
 /// (None: nothing drawn).
 type SeenDepths = (
     Mat4,
@@ -321,10 +321,12 @@ impl Renderer {
         if !fit {
             return self.render_once(view, width, height);
         }
+        // The drawn size: a supersampled frame measures its own depths.
+        let s = view.supersample;
         let key = (
             view.camera.view_from_world(),
             view.camera.projection,
-            (width, height),
+            (width.saturating_mul(s), height.saturating_mul(s)),
         );
         let known = self
             .seen_depths
