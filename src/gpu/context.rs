@@ -550,6 +550,16 @@ impl Context {
         }
         .optimal_tiling_features
     }
+
+    /// Whether `format` (optimal tiling) can be both ends of a linear-filtered blit
+    /// (`resources::blit_linear`: mip chains, the supersampled frame's filter).
+    pub fn blits_linear(&self, format: vk::Format) -> bool {
+        self.format_features(format).contains(
+            vk::FormatFeatureFlags::BLIT_SRC
+                | vk::FormatFeatureFlags::BLIT_DST
+                | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
+        )
+    }
 }
 
 impl Drop for Context {

@@ -392,12 +392,7 @@ impl Image {
         rgba: &[u8],
         srgb: bool,
     ) -> Result<Self, GpuError> {
-        let can_blit = ctx.format_features(rgba8_format(srgb)).contains(
-            vk::FormatFeatureFlags::BLIT_SRC
-                | vk::FormatFeatureFlags::BLIT_DST
-                | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
-        );
-        let mips = if can_blit {
+        let mips = if ctx.blits_linear(rgba8_format(srgb)) {
             crate::math::mip_levels(width, height)
         } else {
             1

@@ -476,10 +476,7 @@ fn check_supersample(ctx: &Context, s: u32) -> Result<(), GpuError> {
             "supersample {s} is not one of {SUPERSAMPLE_FACTORS:?}"
         )));
     }
-    let linear_blits = vk::FormatFeatureFlags::BLIT_SRC
-        | vk::FormatFeatureFlags::BLIT_DST
-        | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR;
-    if s > 1 && !ctx.format_features(OFFSCREEN_FORMAT).contains(linear_blits) {
+    if s > 1 && !ctx.blits_linear(OFFSCREEN_FORMAT) {
         return Err(GpuError::Unsupported(format!(
             "supersample {s}: the device cannot filter {OFFSCREEN_FORMAT:?} in a blit"
         )));
