@@ -271,6 +271,16 @@ pub(super) const MAX_VIEWLESS_ACCESSOR_BYTES: usize = 256 << 20;
 pub(super) fn check_accessor(path: &Path, a: &gltf::Accessor) -> Result<(), LoadError> {
     let elem = a.size();
     let count = a.count();
+    // glTF's minimum; the gltf crate's readers compute `count - 1`.
+    if count == 0 {
+        return Err(corrupt(
+            path,
+            format!(
+                "accessor {} has count 0 (glTF requires 1 or more)",
+                a.index()
+            ),
+        ));
+    }
     if a.view().is_none() && count.saturating_mul(elem) > MAX_VIEWLESS_ACCESSOR_BYTES {
         return Err(corrupt(
             path,

@@ -11,14 +11,6 @@ pub use super::load_error::{LoadError, MAX_TEXTURE_SIDE};
 use super::{Material, Mesh, Scene, Texture};
 use std::path::{Path, PathBuf};
 
-/// Extensions that may appear in `extensionsRequired`.
-const SUPPORTED_REQUIRED: &[&str] = &[
-    "KHR_materials_emissive_strength",
-    "KHR_materials_unlit",
-    "KHR_lights_punctual",
-    "KHR_texture_transform",
-];
-
 /// Loads a `.gltf` or `.glb` file into a scene.
 pub fn load_gltf(path: &Path) -> Result<Scene, LoadError> {
     let meta = std::fs::metadata(path).map_err(|e| LoadError::Io {
@@ -57,15 +49,6 @@ pub fn load_gltf(path: &Path) -> Result<Scene, LoadError> {
 
 fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     check_references(path, json_part(path, bytes)?)?;
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| invalid(path, e))?;
-    for ext in gltf.extensions_required() {
-        if !SUPPORTED_REQUIRED.contains(&ext) {
-            return Err(LoadError::UnsupportedExtension {
-                path: path.into(),
-                extension: ext.to_string(),
-            });
-        }
-    }
     let base = path
         .parent()
         .map(|p| p.to_path_buf())
@@ -75,15 +58,24 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     } else {
         base
     };
+    // Compressed and quantized data decoded, required extensions resolved: plain glTF from here.
+    let prepared = super::compressed::prepare(path, bytes, &base)?;
+    let root: gltf::json::Root =
+        serde_json::from_value(prepared.json).map_err(|e| invalid(path, e))?;
+    let gltf = gltf::Gltf {
+        document: gltf::Document::from_json(root).map_err(|e| invalid(path, e))?,
+        blob: None,
+    };
+    let buffers = check_buffers(path, &gltf, prepared.buffers)?;
     let mut scene = Scene {
         name: path
             .file_name()
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default(),
+        compression: prepared.report,
         ..Default::default()
     };
 
-    let buffers = read_buffers(path, &gltf, &base)?;
     let image_slots = read_images(path, &gltf, &buffers, &base, &mut scene)?;
     super::gltf_material::read_materials(&gltf, &image_slots, &mut scene);
     let default_material = scene.materials.len();
@@ -128,41 +120,16 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     Ok(scene)
 }
 
-/// Reads every buffer (the GLB chunk or a URI inside the model's folder) and checks every
-/// buffer view and accessor against them.
-fn read_buffers(path: &Path, gltf: &gltf::Gltf, base: &Path) -> Result<Vec<Vec<u8>>, LoadError> {
-    let mut buffers: Vec<Vec<u8>> = Vec::new();
-    for b in gltf.buffers() {
-        let data = match b.source() {
-            gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
-                corrupt(
-                    path,
-                    format!(
-                        "buffer {} refers to a GLB binary chunk that is missing",
-                        b.index()
-                    ),
-                )
-            })?,
-            gltf::buffer::Source::Uri(uri) => {
-                read_uri(path, base, uri, &format!("buffer {}", b.index()))?
-            }
-        };
-        if data.len() < b.length() {
-            return Err(corrupt(
-                path,
-                format!(
-                    "buffer {} holds {} bytes but declares {}",
-                    b.index(),
-                    data.len(),
-                    b.length()
-                ),
-            ));
-        }
-        buffers.push(data);
-    }
+/// Checks every buffer view and accessor against the buffers' bytes.
+fn check_buffers(
+    path: &Path,
+    gltf: &gltf::Gltf,
+    buffers: Vec<Vec<u8>>,
+) -> Result<Vec<Vec<u8>>, LoadError> {
     for v in gltf.views() {
         let end = v.offset().checked_add(v.length());
-        if end.is_none_or(|e| e > buffers[v.buffer().index()].len()) {
+        let data = buffers.get(v.buffer().index()).map_or(0, |b| b.len());
+        if end.is_none_or(|e| e > data) {
             return Err(corrupt(
                 path,
                 format!(
@@ -176,7 +143,6 @@ fn read_buffers(path: &Path, gltf: &gltf::Gltf, base: &Path) -> Result<Vec<Vec<u
     for a in gltf.accessors() {
         check_accessor(path, &a)?;
     }
-
     Ok(buffers)
 }
 
@@ -273,6 +239,7 @@ type Decoded = Result<(u32, u32, Vec<u8>), String>;
 /// Decodes every readable image, on as many threads as the machine has (in order).
 fn decode_all(sources: &[ImageSource]) -> Vec<Decoded> {
     crate::parallel::map(sources, |(_, _, data)| match data {
+        Ok(d) if super::compressed::is_ktx2(d) => super::compressed::decode_ktx2(d),
         Ok(d) => decode_image(d),
         Err(_) => Err(String::new()),
     })

@@ -15,9 +15,10 @@ use std::path::Path;
 /// quantised normals land within it).
 const UNIT_TOLERANCE: f32 = 4e-3;
 
-/// Whether a stored vector's length is 1 within `UNIT_TOLERANCE` (NaN is not).
-fn unit_length(len: f32) -> bool {
-    (len - 1.0).abs() <= UNIT_TOLERANCE
+/// Whether a stored vector's length is 1 within `UNIT_TOLERANCE` plus the rounding `slack` of a
+/// quantized accessor (NaN is not).
+fn unit_length(len: f32, slack: f32) -> bool {
+    (len - 1.0).abs() <= UNIT_TOLERANCE + slack
 }
 
 /// Warns when a POSITION accessor's declared min/max (required by glTF) differ from its data.
@@ -79,10 +80,15 @@ pub(super) fn read_primitive(
     };
     let positions: Vec<Vec3> = positions.map(Vec3::from_array).collect();
     let n = positions.len();
+    let slack = |s: gltf::Semantic| {
+        prim.get(&s)
+            .map_or(0.0, |a| scene.compression.unit_slack(a.index()))
+    };
     let site = Site {
         at: &at,
         label: &label,
         n,
+        slack: slack(gltf::Semantic::Normals).max(slack(gltf::Semantic::Tangents)),
     };
     if let Some(acc) = prim.get(&gltf::Semantic::Positions) {
         check_min_max(scene, &acc, &positions);
@@ -179,6 +185,8 @@ struct Site<'a> {
     at: &'a str,
     label: &'a str,
     n: usize,
+    /// How far quantized normals and tangents may be from unit length by rounding alone.
+    slack: f32,
 }
 
 /// The triangles of a triangle list, strip or fan as a list; `None` for points and lines.
@@ -258,7 +266,7 @@ where
             let normals = it
                 .map(|v| {
                     let v = Vec3::from_array(v);
-                    if !unit_length(v.length()) {
+                    if !unit_length(v.length(), site.slack) {
                         off_unit += 1;
                     }
                     v.try_normalize().unwrap_or(Vec3::Y)
@@ -270,7 +278,8 @@ where
                     format!("{at}/attributes/NORMAL"),
                     format!(
                         "{label}: {off_unit} of {n} normals are not unit length (|n| off 1 by \
-                         more than {UNIT_TOLERANCE}); normalised"
+                         more than {}); normalised",
+                        UNIT_TOLERANCE + site.slack
                     ),
                 );
             }
@@ -370,7 +379,7 @@ fn stored_tangents(
         .map(|t| {
             let t = Vec4::from_array(t);
             bad_w += (t.w != 1.0 && t.w != -1.0) as usize;
-            off_unit += !unit_length(t.truncate().length()) as usize;
+            off_unit += !unit_length(t.truncate().length(), site.slack) as usize;
             if t.is_finite() && t.truncate().length_squared() > 1e-12 {
                 t.truncate()
                     .normalize()

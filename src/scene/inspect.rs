@@ -22,12 +22,10 @@ use std::path::Path;
 pub const SCHEMA: &str = "umbra-inspect/1";
 
 /// Extensions umbra reads (others are ignored; required ones it does not read refuse the file).
-pub const SUPPORTED_EXTENSIONS: &[&str] = &[
-    "KHR_lights_punctual",
-    "KHR_materials_emissive_strength",
-    "KHR_materials_unlit",
-    "KHR_texture_transform",
-];
+/// Those whose decoder is a cargo feature are listed only when this build has it.
+pub fn supported_extensions() -> Vec<&'static str> {
+    super::compressed::supported_extensions()
+}
 
 fn finding(code: &str, pointer: String, message: String) -> Value {
     json!({"code": code, "severity": severity_of(code), "pointer": pointer, "message": message})
@@ -148,6 +146,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
                   "generator": doc["asset"]["generator"], "copyright": doc["asset"]["copyright"]},
         "resources": {"buffers": buffers, "images": images},
         "extensions": {"used": used, "required": required, "supported": supported},
+        "compression": scene.compression.to_json(),
         "scene_tree": {"scene": scene_index, "roots": roots, "nodes": node_list,
                        "cameras": cameras, "lights": lights},
         "meshes": mesh.list,
@@ -219,8 +218,9 @@ fn extensions(
         .filter_map(|v| v.as_str().map(String::from))
         .collect();
     let mut supported = Map::new();
+    let known = supported_extensions();
     for e in &used {
-        let ok = SUPPORTED_EXTENSIONS.contains(&e.as_str());
+        let ok = known.contains(&e.as_str());
         supported.insert(e.clone(), json!(ok));
         if !ok {
             findings.push(finding(

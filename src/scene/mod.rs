@@ -3,6 +3,7 @@
 
 pub mod anim;
 pub mod clusters;
+pub mod compressed;
 pub mod demo;
 pub mod foliage;
 pub mod framing;

@@ -471,6 +471,8 @@ pub struct Scene {
     /// For a loaded glTF with animations, skins or morph targets: what moves and how
     /// ([`super::anim`]); the scene as loaded holds its rest pose.
     pub rig: Option<std::sync::Arc<super::anim::Rig>>,
+    /// For a loaded glTF: what was decoded from compressed or quantized data (empty if none).
+    pub compression: super::compressed::CompressionReport,
 }
 
 impl Scene {

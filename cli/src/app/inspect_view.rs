@@ -54,6 +54,7 @@ pub fn format_report(r: &Value, md: bool) -> String {
     let mut out = String::new();
     out += &asset(r, md, &h);
     out += &totals(r, md, &h);
+    out += &compression(&r["compression"], md, &h);
     out += &scale(r, md, &h);
     out += &exposure(r, &h);
     out += &shadow_plan(r, md, &h);
@@ -103,6 +104,49 @@ fn asset(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
     t.row(vec!["extensions required".into(), cell(&ext["required"])]);
     out += &h("Asset");
     out += &t.render(md);
+    out
+}
+
+/// What the loader decoded, per extension, and the quantized attributes (nothing for a plain file).
+fn compression(c: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let exts = c["extensions"].as_object();
+    if exts.is_none_or(|e| e.is_empty()) {
+        return String::new();
+    }
+    let mut t = Table::new(&["extension", "covers", "stored", "decoded", "decode ms"]);
+    for (name, e) in exts.into_iter().flatten() {
+        let covers = arr(&e["covers"]);
+        let first = covers.first().map(cell).unwrap_or_default();
+        t.row(vec![
+            name.clone(),
+            format!("{} ({first}…)", covers.len()),
+            bytes(&e["bytes_stored"]),
+            bytes(&e["bytes_decoded"]),
+            cell(&e["decode_ms"]),
+        ]);
+    }
+    let mut out = h("Compression");
+    out += &t.render(md);
+    let q = arr(&c["quantized_attributes"]);
+    if !q.is_empty() {
+        let mut t = Table::new(&["quantized accessor", "semantic", "stored as"]);
+        for a in q {
+            t.row(vec![
+                cell(&a["accessor"]),
+                cell(&a["semantic"]),
+                cell(&a["stored"]),
+            ]);
+        }
+        out += &t.render(md);
+        let nodes = arr(&c["dequantizing_transforms"]);
+        let list: Vec<String> = nodes.iter().map(|n| cell(&n["node"])).collect();
+        out += &format!(
+            "{}dequantized by the transforms of {} node(s): {}\n",
+            if md { "\n" } else { "" },
+            nodes.len(),
+            list.join(", ")
+        );
+    }
     out
 }
 
