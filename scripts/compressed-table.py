@@ -73,9 +73,18 @@ def main():
         stem = os.path.splitext(os.path.basename(model))[0]
         cam = camera(umbra, model)
         base, _ = measure(umbra, model, cam, os.path.join(out, stem))
-        size0 = sum(os.path.getsize(os.path.join(r, f)) for r, _, fs in os.walk(os.path.dirname(model)) for f in fs) \
-            if model.endswith(".gltf") else os.path.getsize(model)
+        size0 = os.path.getsize(model)
+        doc = json.loads(run([umbra, "inspect", model, "--json"]).stdout)
+        if model.endswith(".gltf"):
+            # The .gltf and the external files it names.
+            base = os.path.dirname(model)
+            for r in doc["resources"]["buffers"] + doc["resources"]["images"]:
+                if r.get("uri") and not r["uri"].startswith("data:"):
+                    size0 += os.path.getsize(os.path.join(base, r["uri"]))
+        textured = len(doc["resources"]["images"]) > 0
         for s in SETTINGS:
+            if s in ("etc1s", "uastc", "webp") and not textured:
+                continue
             dst = os.path.join(out, f"{stem}.{s}.glb")
             enc = run(["python3", os.path.join(here, "gltf-recompress.py"), s, model, dst], env=env)
             if enc.returncode != 0:

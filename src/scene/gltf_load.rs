@@ -175,7 +175,11 @@ fn read_images(
     }
     let decoded = decode_all(&sources);
     let mut image_slots: Vec<Option<usize>> = Vec::new();
-    for (i, ((name, what, data), result)) in sources.iter().zip(decoded).enumerate() {
+    for (i, ((name, what, data), (result, seconds))) in sources.iter().zip(decoded).enumerate() {
+        if let (Ok(d), Ok((w, h, _))) = (data, &result) {
+            let pixels = *w as usize * *h as usize * 4;
+            scene.compression.add_image(i, d, pixels, seconds);
+        }
         let image = format!("/images/{i}");
         match (data, result) {
             (Err(e), _) => {
@@ -236,12 +240,17 @@ type ImageSource = (String, String, Result<Vec<u8>, LoadError>);
 /// A decoded image (width, height, RGBA8) or why it could not be decoded.
 type Decoded = Result<(u32, u32, Vec<u8>), String>;
 
-/// Decodes every readable image, on as many threads as the machine has (in order).
-fn decode_all(sources: &[ImageSource]) -> Vec<Decoded> {
-    crate::parallel::map(sources, |(_, _, data)| match data {
-        Ok(d) if super::compressed::is_ktx2(d) => super::compressed::decode_ktx2(d),
-        Ok(d) => decode_image(d),
-        Err(_) => Err(String::new()),
+/// Decodes every readable image, on as many threads as the machine has (in order), each with
+/// the seconds it took.
+fn decode_all(sources: &[ImageSource]) -> Vec<(Decoded, f64)> {
+    crate::parallel::map(sources, |(_, _, data)| {
+        let start = std::time::Instant::now();
+        let r = match data {
+            Ok(d) if super::compressed::is_ktx2(d) => super::compressed::decode_ktx2(d),
+            Ok(d) => decode_image(d),
+            Err(_) => Err(String::new()),
+        };
+        (r, start.elapsed().as_secs_f64())
     })
 }
 

@@ -5,8 +5,7 @@
 //! primitive names for it, in the type Draco decoded it to (quantized attributes come out
 //! dequantized, as the extension says).
 
-use super::report::CompressionReport;
-use super::{Appended, MAX_DECODED_BYTES};
+use super::{Appended, Rewrite, MAX_DECODED_BYTES};
 use crate::scene::load_error::{corrupt, LoadError};
 use draco_oxide_core::attribute::{Attribute, ComponentDataType as C};
 use serde_json::{json, Value};
@@ -141,13 +140,9 @@ fn jobs<'a>(path: &Path, json: &Value, buffers: &'a [Vec<u8>]) -> Result<Vec<Job
 }
 
 /// Decodes every compressed primitive and points its accessors at the decoded data.
-pub(super) fn decode_primitives(
-    path: &Path,
-    json: &mut Value,
-    buffers: &[Vec<u8>],
-    out: &mut Appended,
-    report: &mut CompressionReport,
-) -> Result<(), LoadError> {
+pub(super) fn decode_primitives(r: &mut Rewrite) -> Result<(), LoadError> {
+    let (path, buffers) = (r.path, r.buffers);
+    let (json, out, report) = (&mut r.json, &mut r.out, &mut r.report);
     let jobs = jobs(path, json, buffers)?;
     if jobs.is_empty() {
         return Ok(());

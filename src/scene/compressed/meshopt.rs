@@ -4,8 +4,7 @@
 //! (which are written to be safe on untrusted input). Each view is independent, so views are
 //! decoded on all cores.
 
-use super::report::CompressionReport;
-use super::{Appended, MAX_DECODED_BYTES};
+use super::{Rewrite, MAX_DECODED_BYTES};
 use crate::scene::load_error::{corrupt, LoadError};
 use serde_json::Value;
 use std::path::Path;
@@ -190,13 +189,9 @@ fn filter(job: &Job, out: &mut [u8]) -> Result<(), String> {
 }
 
 /// Decodes every compressed buffer view into `out` and points the view at its decoded bytes.
-pub(super) fn decode_views(
-    path: &Path,
-    json: &mut Value,
-    buffers: &[Vec<u8>],
-    out: &mut Appended,
-    report: &mut CompressionReport,
-) -> Result<(), LoadError> {
+pub(super) fn decode_views(r: &mut Rewrite) -> Result<(), LoadError> {
+    let (path, buffers) = (r.path, r.buffers);
+    let (json, out, report) = (&mut r.json, &mut r.out, &mut r.report);
     let views = json["bufferViews"].as_array().cloned().unwrap_or_default();
     let mut jobs = Vec::new();
     for (i, v) in views.iter().enumerate() {

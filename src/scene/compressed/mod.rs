@@ -96,6 +96,16 @@ pub(super) struct Prepared {
     pub report: CompressionReport,
 }
 
+/// What each decoding step works on: the file being rewritten (its JSON), its buffers' bytes, the
+/// decoded bytes appended so far and the report.
+pub(super) struct Rewrite<'a> {
+    pub path: &'a Path,
+    pub json: Value,
+    pub buffers: &'a [Vec<u8>],
+    pub out: Appended,
+    pub report: CompressionReport,
+}
+
 /// Decoded bytes appended to the file as one more buffer; `add` returns a new buffer view.
 pub(super) struct Appended {
     /// Index the appended buffer will have.
@@ -238,24 +248,36 @@ fn read_buffers(
 
 /// Makes the file at `path` (its `bytes`, resources under `base`) plain glTF: see the module.
 pub(super) fn prepare(path: &Path, bytes: &[u8], base: &Path) -> Result<Prepared, LoadError> {
-    let (mut json, blob) = split(path, bytes)?;
+    let (json, blob) = split(path, bytes)?;
     check_required(path, &json)?;
     let buffers = read_buffers(path, &json, blob, base)?;
-    let mut report = CompressionReport::default();
-    let mut out = Appended {
+    let out = Appended {
         buffer: buffers.len(),
         bytes: Vec::new(),
         views: Vec::new(),
         first_view: json["bufferViews"].as_array().map_or(0, |v| v.len()),
     };
-    meshopt::decode_views(path, &mut json, &buffers, &mut out, &mut report)?;
+    let mut r = Rewrite {
+        path,
+        json,
+        buffers: &buffers,
+        out,
+        report: CompressionReport::default(),
+    };
+    meshopt::decode_views(&mut r)?;
     #[cfg(feature = "draco")]
-    draco::decode_primitives(path, &mut json, &buffers, &mut out, &mut report)?;
+    draco::decode_primitives(&mut r)?;
     #[cfg(not(feature = "draco"))]
-    strip_draco(&mut json);
-    check_fallback_unused(path, &json)?;
-    quantized::dequantize(path, &mut json, &buffers, &mut out, &mut report)?;
-    textures::use_extension_sources(&mut json, &mut report);
+    strip_draco(&mut r.json);
+    check_fallback_unused(path, &r.json)?;
+    quantized::dequantize(&mut r)?;
+    textures::use_extension_sources(&mut r.json, &mut r.report);
+    let Rewrite {
+        mut json,
+        out,
+        report,
+        ..
+    } = r;
     strip_required(&mut json);
     let mut buffers = buffers;
     if !out.views.is_empty() {

@@ -4,12 +4,10 @@
 //! loader never meets an integer position.
 
 use super::accessor::{read_f32, Sources};
-use super::report::CompressionReport;
-use super::Appended;
+use super::Rewrite;
 use crate::scene::load_error::{corrupt, LoadError};
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
-use std::path::Path;
 
 const EXTENSION: &str = "KHR_mesh_quantization";
 
@@ -80,13 +78,9 @@ fn dequantizing_nodes(json: &Value, positions: &[usize]) -> Vec<Value> {
 }
 
 /// Rewrites every quantized attribute accessor as `f32` data in `out`.
-pub(super) fn dequantize(
-    path: &Path,
-    json: &mut Value,
-    buffers: &[Vec<u8>],
-    out: &mut Appended,
-    report: &mut CompressionReport,
-) -> Result<(), LoadError> {
+pub(super) fn dequantize(r: &mut Rewrite) -> Result<(), LoadError> {
+    let (path, buffers) = (r.path, r.buffers);
+    let (json, out, report) = (&mut r.json, &mut r.out, &mut r.report);
     if !declared(json) {
         return Ok(());
     }

@@ -45,6 +45,27 @@ impl CompressionReport {
         e.bytes_decoded += decoded as u64;
     }
 
+    /// Records image `index` decoded from `stored` bytes to `pixels` bytes in `seconds`, under
+    /// KHR_texture_basisu when it is KTX2 and EXT_texture_webp when it is WebP (other formats
+    /// are not this report's).
+    pub(in crate::scene) fn add_image(
+        &mut self,
+        index: usize,
+        stored: &[u8],
+        pixels: usize,
+        seconds: f64,
+    ) {
+        let ext = if super::is_ktx2(stored) {
+            "KHR_texture_basisu"
+        } else if stored.len() >= 12 && &stored[0..4] == b"RIFF" && &stored[8..12] == b"WEBP" {
+            "EXT_texture_webp"
+        } else {
+            return;
+        };
+        self.add(ext, "images", index, stored.len(), pixels);
+        self.add_seconds(ext, seconds);
+    }
+
     /// Adds decoding time to `ext`.
     pub(super) fn add_seconds(&mut self, ext: &str, seconds: f64) {
         self.extensions.entry(ext.to_string()).or_default().seconds += seconds;
