@@ -354,7 +354,10 @@ fn load_edited(
 ) -> Result<Scene, umbra::scene::LoadError> {
     let (mut json, mut bin) = glb_parts(&std::fs::read(fixtures().join(fixture)).unwrap());
     edit(&mut json, &mut bin);
-    let p = out_dir().join(format!("edited_{fixture}"));
+    // A name of its own: the tests run in parallel and edit the same fixtures.
+    static EDITS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = EDITS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let p = out_dir().join(format!("edited_{n}_{fixture}"));
     std::fs::write(&p, glb(&json, &bin)).unwrap();
     load_gltf(&p)
 }
