@@ -35,12 +35,16 @@ use super::load_error::{corrupt, invalid, LoadError};
 use serde_json::{json, Value};
 use std::path::Path;
 
-/// Extensions the loader reads without any decoding (their JSON is understood by the gltf crate).
-const PLAIN: &[&str] = &[
+/// Extensions the gltf crate reads itself (its features are on).
+const KNOWN_TO_GLTF: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_unlit",
     "KHR_lights_punctual",
     "KHR_texture_transform",
+];
+
+/// Extensions decoded here in every build.
+const DECODED: &[&str] = &[
     "KHR_mesh_quantization",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -59,7 +63,7 @@ const BY_FEATURE: &[(&str, &str, bool)] = &[
 
 /// Every extension umbra reads, for `inspect` (those of a feature this build lacks excluded).
 pub fn supported_extensions() -> Vec<&'static str> {
-    let mut v: Vec<&str> = PLAIN.to_vec();
+    let mut v: Vec<&str> = [KNOWN_TO_GLTF, DECODED].concat();
     v.extend(BY_FEATURE.iter().filter(|f| f.2).map(|f| f.0));
     v
 }
@@ -176,7 +180,7 @@ fn check_required_with(
     let required = json["extensionsRequired"].as_array().cloned();
     for ext in required.unwrap_or_default() {
         let name = ext.as_str().unwrap_or("");
-        if PLAIN.contains(&name) {
+        if KNOWN_TO_GLTF.contains(&name) || DECODED.contains(&name) {
             continue;
         }
         match by_feature.iter().find(|f| f.0 == name) {
@@ -350,7 +354,7 @@ fn strip_required(json: &mut Value) {
     {
         list.retain(|e| {
             let name = e.as_str().unwrap_or("");
-            !PLAIN[4..].contains(&name) && !BY_FEATURE.iter().any(|f| f.0 == name)
+            !DECODED.contains(&name) && !BY_FEATURE.iter().any(|f| f.0 == name)
         });
     }
 }
