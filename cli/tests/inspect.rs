@@ -252,6 +252,57 @@ fn raw_accessor_defects_are_reported_with_codes_and_pointers() {
     assert_eq!(codes(&write(false)), Vec::<(String, String)>::new());
 }
 
+/// The compression extensions a file uses at a site its JSON shows (a compressed buffer view, a
+/// Draco primitive, a texture's KTX2 or WebP source, an integer vertex attribute under
+/// KHR_mesh_quantization), read from the file itself: what `inspect` must say it decoded.
+fn compressed_sites(path: &Path) -> std::collections::BTreeSet<String> {
+    let bytes = std::fs::read(path).unwrap();
+    let json: Value = if bytes.starts_with(b"glTF") {
+        let n = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        serde_json::from_slice(&bytes[20..20 + n]).unwrap()
+    } else {
+        serde_json::from_slice(&bytes).unwrap()
+    };
+    let list = |v: &Value| v.as_array().cloned().unwrap_or_default();
+    let prims: Vec<Value> = list(&json["meshes"])
+        .iter()
+        .flat_map(|m| list(&m["primitives"]))
+        .collect();
+    let mut sites = list(&json["bufferViews"]);
+    sites.extend(list(&json["textures"]));
+    sites.extend(prims.iter().cloned());
+    let mut out = std::collections::BTreeSet::new();
+    for v in &sites {
+        for k in v["extensions"]
+            .as_object()
+            .into_iter()
+            .flatten()
+            .map(|(k, _)| k)
+        {
+            if k.contains("compression") || k == "KHR_texture_basisu" || k == "EXT_texture_webp" {
+                out.insert(k.clone());
+            }
+        }
+    }
+    let widened =
+        |k: &str| ["POSITION", "NORMAL", "TANGENT"].contains(&k) || k.starts_with("TEXCOORD_");
+    let quantized = list(&json["extensionsUsed"]).contains(&"KHR_mesh_quantization".into())
+        && prims.iter().any(|p| {
+            let mut maps = vec![p["attributes"].clone()];
+            maps.extend(list(&p["targets"]));
+            maps.iter()
+                .flat_map(|m| m.as_object().cloned().unwrap_or_default())
+                .any(|(k, a)| {
+                    let ct = &json["accessors"][a.as_u64().unwrap_or(0) as usize]["componentType"];
+                    widened(&k) && ct != 5126
+                })
+        });
+    if quantized {
+        out.insert("KHR_mesh_quantization".into());
+    }
+    out
+}
+
 #[test]
 fn every_corpus_model_validates_against_the_schema() {
     let dir = tmp("corpus");
@@ -259,10 +310,40 @@ fn every_corpus_model_validates_against_the_schema() {
     if let Some(extra) = extra_corpus() {
         models.extend(models_under(&extra));
     }
+    // The compressed fixtures (quantized, meshopt, Draco, KTX2, WebP): each reports what it
+    // decoded.
+    let compressed =
+        models_under(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/compressed"));
+    assert!(
+        compressed.len() >= 20,
+        "{} compressed fixtures",
+        compressed.len()
+    );
+    models.extend(compressed.iter().cloned());
     let s = schema();
     for m in &models {
         let r = inspect_json(m);
         validate(&r, &s, "").unwrap_or_else(|e| panic!("{}: {e}", m.display()));
+        let decoded: Vec<&String> = r["compression"]["extensions"]
+            .as_object()
+            .map(|e| e.keys().collect())
+            .unwrap_or_default();
+        assert_eq!(
+            decoded,
+            compressed_sites(m).iter().collect::<Vec<_>>(),
+            "{}: compression {}",
+            m.display(),
+            r["compression"]
+        );
+        for (name, e) in r["compression"]["extensions"]
+            .as_object()
+            .into_iter()
+            .flatten()
+        {
+            let covers = e["covers"].as_array().map_or(0, |c| c.len());
+            let bytes = e["bytes_decoded"].as_u64().unwrap_or(0);
+            assert!(covers > 0 && bytes > 0, "{}: {name} {e}", m.display());
+        }
         let t = &r["totals"];
         assert!(t["triangles"].as_u64().unwrap() > 0, "{}", m.display());
         assert!(t["draw_calls"].as_u64().unwrap() > 0, "{}", m.display());

@@ -10,6 +10,7 @@
 //! from the loaded [`Scene`] (decoded image sizes, repaired geometry). The shadow plan is added by
 //! the render layer (`render::frame::plan_report`).
 
+use super::compressed::accessor_type;
 use super::gltf_input::json_part;
 use super::load_error::LoadError;
 use super::warning::severity_of;
@@ -29,35 +30,6 @@ pub fn supported_extensions() -> Vec<&'static str> {
 
 fn finding(code: &str, pointer: String, message: String) -> Value {
     json!({"code": code, "severity": severity_of(code), "pointer": pointer, "message": message})
-}
-
-/// `POSITION:f32x3`, `TEXCOORD_0:u16_norm x2`: an attribute's accessor type.
-fn accessor_type(a: &Value) -> String {
-    let comp = match a["componentType"].as_u64().unwrap_or(0) {
-        5120 => "i8",
-        5121 => "u8",
-        5122 => "i16",
-        5123 => "u16",
-        5125 => "u32",
-        5126 => "f32",
-        _ => "?",
-    };
-    let norm = if a["normalized"].as_bool().unwrap_or(false) {
-        "_norm"
-    } else {
-        ""
-    };
-    let n = match a["type"].as_str().unwrap_or("") {
-        "SCALAR" => "",
-        "VEC2" => "x2",
-        "VEC3" => "x3",
-        "VEC4" => "x4",
-        "MAT2" => "x2x2",
-        "MAT3" => "x3x3",
-        "MAT4" => "x4x4",
-        _ => "?",
-    };
-    format!("{comp}{norm}{n}")
 }
 
 fn arr<'a>(v: &'a Value, key: &str) -> &'a [Value] {

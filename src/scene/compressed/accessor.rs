@@ -165,3 +165,32 @@ fn apply_sparse(
     }
     Some(())
 }
+
+/// `f32x3`, `u16_normx2`: an accessor's component type and shape, as `inspect` prints it.
+pub fn accessor_type(a: &Value) -> String {
+    let comp = match a["componentType"].as_u64().unwrap_or(0) {
+        5120 => "i8",
+        5121 => "u8",
+        5122 => "i16",
+        5123 => "u16",
+        5125 => "u32",
+        5126 => "f32",
+        _ => "?",
+    };
+    let norm = if a["normalized"].as_bool().unwrap_or(false) {
+        "_norm"
+    } else {
+        ""
+    };
+    let n = match a["type"].as_str().unwrap_or("") {
+        "SCALAR" => "",
+        "VEC2" => "x2",
+        "VEC3" => "x3",
+        "VEC4" => "x4",
+        "MAT2" => "x2x2",
+        "MAT3" => "x3x3",
+        "MAT4" => "x4x4",
+        _ => "?",
+    };
+    format!("{comp}{norm}{n}")
+}

@@ -27,6 +27,7 @@ mod quantized;
 mod report;
 mod textures;
 
+pub use accessor::accessor_type;
 pub use report::{CompressionReport, ExtensionUse};
 pub(super) use textures::{decode_ktx2, is_ktx2};
 

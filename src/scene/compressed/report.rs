@@ -23,10 +23,13 @@ pub struct ExtensionUse {
 pub struct CompressionReport {
     /// By extension name.
     pub extensions: BTreeMap<String, ExtensionUse>,
-    /// Quantized attribute accessors: `{accessor, semantic, stored}` (`stored`: `i16_norm x3`).
+    /// Quantized attribute accessors: `{accessor, semantic, stored}` (`stored`: `i16_normx3`).
     pub quantized: Vec<Value>,
     /// Nodes placing meshes with quantized positions, with their transforms.
     pub transforms: Vec<Value>,
+    /// Each quantized integer accessor's step (one over its normalising divisor): the rounding
+    /// a unit vector stored in it carries.
+    steps: BTreeMap<usize, f32>,
 }
 
 impl CompressionReport {
@@ -73,62 +76,31 @@ impl CompressionReport {
 
     /// Records a quantized accessor (as stored, before it was widened).
     pub(super) fn quantized(&mut self, index: usize, semantic: &str, accessor: &Value) {
-        let ct = match accessor["componentType"].as_u64().unwrap_or(0) {
-            5120 => "i8",
-            5121 => "u8",
-            5122 => "i16",
-            5123 => "u16",
-            5125 => "u32",
-            _ => "?",
-        };
-        let norm = if accessor["normalized"].as_bool() == Some(true) {
-            "_norm"
-        } else {
-            ""
-        };
-        let n = accessor["type"]
-            .as_str()
-            .unwrap_or("")
-            .trim_start_matches("VEC");
-        let stored = format!("{ct}{norm} x{n}");
+        let ct = accessor["componentType"].as_u64().unwrap_or(0);
+        let size = super::accessor::component_size(ct).unwrap_or(4) as u64;
+        let n = super::accessor::components(accessor["type"].as_str().unwrap_or("")).unwrap_or(1);
+        let count = accessor["count"].as_u64().unwrap_or(0);
         let e = self
             .extensions
             .entry("KHR_mesh_quantization".into())
             .or_default();
         e.covers.push(format!("/accessors/{index}"));
-        let count = accessor["count"].as_u64().unwrap_or(0);
-        let n: u64 = n.parse().unwrap_or(1);
-        let size = match ct {
-            "i8" | "u8" => 1,
-            "i16" | "u16" => 2,
-            _ => 4,
-        };
-        e.bytes_stored += count * n * size;
-        e.bytes_decoded += count * n * 4;
+        e.bytes_stored += count * n as u64 * size;
+        e.bytes_decoded += count * n as u64 * 4;
+        if let Some(d) = super::accessor::norm_divisor(ct) {
+            self.steps.insert(index, 1.0 / d);
+        }
         self.quantized.push(json!({
             "accessor": format!("/accessors/{index}"),
             "semantic": semantic,
-            "stored": stored,
+            "stored": super::accessor::accessor_type(accessor),
         }));
     }
 
     /// How far from unit length a unit vector stored in quantized accessor `index` may be by
     /// rounding alone (half a step on each of three components; 0 for an accessor not quantized).
     pub fn unit_slack(&self, index: usize) -> f32 {
-        let at = format!("/accessors/{index}");
-        let stored = self
-            .quantized
-            .iter()
-            .find(|q| q["accessor"] == at.as_str())
-            .and_then(|q| q["stored"].as_str());
-        let step = match stored.map(|s| s.split(['_', ' ']).next().unwrap_or("")) {
-            Some("i8") => 1.0 / 127.0,
-            Some("u8") => 1.0 / 255.0,
-            Some("i16") => 1.0 / 32767.0,
-            Some("u16") => 1.0 / 65535.0,
-            _ => 0.0,
-        };
-        0.5 * step * 3f32.sqrt()
+        0.5 * self.steps.get(&index).copied().unwrap_or(0.0) * 3f32.sqrt()
     }
 
     /// Whether nothing was decoded.
