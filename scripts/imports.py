@@ -42,6 +42,69 @@ PATH = re.compile(r"\b((?:crate|super|self|umbra|umbra_lab|umbra_cli)(?:::[A-Za-
 GROUP = re.compile(r"\b(crate|super|umbra|umbra_lab|umbra_cli)((?:::[a-z_][a-z0-9_]*)*)::\{([^;]*?)\};", re.S)
 
 
+ITEM = re.compile(r"^pub\s+(?:struct|enum|fn|type|const|static|trait)\s+([A-Za-z_][A-Za-z0-9_]*)", re.M)
+PUB_USE = re.compile(r"\bpub(?:\([a-z]+\))?\s+use\s+([^;]+);", re.S)
+
+
+def absolute(mod, p):
+    """The path `p` (split on ::) written in module `mod`, from its crate's root."""
+    if p[0] == "crate":
+        return [mod[0], *p[1:]]
+    if p[0] == "super":
+        ups = len(p) - len([x for x in p if x != "super"])
+        return [*mod[: len(mod) - ups], *[x for x in p if x != "super"]]
+    if p[0] == "self":
+        return [*mod, *p[1:]]
+    if p[0] in CRATES:
+        return p
+    # A path relative to the module itself (`pub use types::Scene;` in a mod.rs).
+    return [*mod, *p]
+
+
+def reexports(mods):
+    """(module, name) -> the absolute path it re-exports (`pub use` lists and single items, and
+    `pub use m::*` for the public items defined in m)."""
+    out, globs = {}, {}
+    for mod, f in mods.items():
+        text = strip_comments(open(f, encoding="utf-8").read())
+        for body in PUB_USE.findall(text):
+            body = re.sub(r"\s+", "", body)
+            m = re.match(r"^(.*?)::\{(.*)\}$", body)
+            items = [(m.group(1), i) for i in m.group(2).split(",") if i] if m else [(body.rsplit("::", 1) + [""])[0:2]]
+            for prefix, item in items:
+                if item == "*":
+                    globs.setdefault(mod, []).append(absolute(mod, prefix.split("::")))
+                    continue
+                if item == "self" or "{" in item:
+                    continue
+                alias = item.split(" as ")[-1].split("as")[-1] if " as " in item else item
+                path = absolute(mod, prefix.split("::") + item.split(" as ")[0].split("::"))
+                out[(mod, alias.split("::")[-1])] = path
+    for mod, sources in globs.items():
+        for src in sources:
+            target = resolve(mods, src)
+            if not target:
+                continue
+            text = strip_comments(open(mods[target], encoding="utf-8").read())
+            for name in ITEM.findall(text):
+                out.setdefault((mod, name), [*target, name])
+    return out
+
+
+def follow(mods, reexp, full):
+    """The module `full` names, through re-exports: `crate::scene::Scene`, re-exported by
+    scene/mod.rs from scene::types, is a use of scene::types."""
+    for _ in range(8):
+        target = resolve(mods, full)
+        if not target or len(full) <= len(target):
+            return target
+        origin = reexp.get((target, full[len(target)]))
+        if not origin:
+            return target
+        full = [*origin, *full[len(target) + 1 :]]
+    return resolve(mods, full)
+
+
 def strip_comments(text):
     text = re.sub(r"//[^\n]*", "", text)
     return re.sub(r"/\*.*?\*/", "", text, flags=re.S)
@@ -52,6 +115,7 @@ def main():
     for crate, src in CRATES.items():
         mods.update(modules(crate, src))
     edges = set()
+    reexp = reexports(mods)
     for mod, f in mods.items():
         text = strip_comments(open(f, encoding="utf-8").read())
         paths = [m.split("::") for m in PATH.findall(text)]
@@ -60,16 +124,7 @@ def main():
                 if item and item[0].islower():
                     paths.append([head, *[p for p in mid.split("::") if p], item.split("::")[0]])
         for p in paths:
-            if p[0] == "crate":
-                full = [mod[0], *p[1:]]
-            elif p[0] == "super":
-                ups = len(p) - len([x for x in p if x != "super"])
-                full = [*mod[: len(mod) - ups], *[x for x in p if x != "super"]]
-            elif p[0] == "self":
-                full = [*mod, *p[1:]]
-            else:
-                full = p
-            target = resolve(mods, full)
+            target = follow(mods, reexp, absolute(mod, p))
             if target and target != mod and not (target == mod[: len(target)] and len(target) < len(mod)):
                 # a module naming its own ancestor's re-export is not a dependency on a sibling
                 if len(target) == 1 and target[0] == mod[0]:

@@ -14,15 +14,28 @@ else
 fi
 # lavapipe is the reference device for tests; a machine with a GPU can override UMBRA_DEVICE.
 export UMBRA_DEVICE="${UMBRA_DEVICE:-llvmpipe}"
-cargo fmt --all -- --check
+# Each step's wall time, printed as it ends and again in a table at the end.
+suite_start=$SECONDS
+timings=()
+step() {
+  local name=$1 start=$SECONDS
+  shift
+  "$@"
+  timings+=("$(printf '%5d s  %s' $((SECONDS - start)) "$name")")
+  echo "umbra tests: $name took $((SECONDS - start)) s"
+}
+step fmt cargo fmt --all -- --check
 # The module graph: no import cycles, the engine never importing the lab or the CLI.
-python3 scripts/imports.py
-cargo clippy --all-targets --quiet -- -D warnings
-cargo clippy --no-default-features --all-targets --quiet -- -D warnings
-cargo clippy -p umbra-python --all-targets --quiet -- -D warnings
-cargo test --all-targets
-cargo test --doc
+step "module graph" python3 scripts/imports.py
+step clippy cargo clippy --all-targets --quiet -- -D warnings
+step "clippy, no default features" cargo clippy --no-default-features --all-targets --quiet -- -D warnings
+step "clippy, python" cargo clippy -p umbra-python --all-targets --quiet -- -D warnings
+step "cargo test" cargo test --all-targets
+step "doc tests" cargo test --doc
 # umbra as a user's dev-dependency with default-features = false (shares this target dir).
-cargo test --manifest-path examples/offscreen_user/Cargo.toml --target-dir target --test offscreen
+step "dependent crate" cargo test --manifest-path examples/offscreen_user/Cargo.toml --target-dir target --test offscreen
 # The Python package (its extension linked by maturin, not by cargo test).
-bash scripts/python-test.sh
+step python bash scripts/python-test.sh
+echo "umbra tests: wall time per step"
+printf '  %s\n' "${timings[@]}"
+echo "umbra tests: the whole suite took $((SECONDS - suite_start)) s"

@@ -3,9 +3,7 @@
 //! perspective and an orthographic camera; two instances read their own ids exactly, the
 //! background 0; normals face the camera; an alpha-masked cut-out reads what lies behind it.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3, Vec4};
 use umbra::render::{Renderer, View};
 use umbra::scene::shapes::{add_object, add_texture, colored, quad};

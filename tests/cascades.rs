@@ -5,9 +5,7 @@
 //! ground pixel's ray towards the sun against the boxes, away from shadow edges (EDGE_TEXELS
 //! texels of the cascade that shades the pixel, or one pixel).
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;

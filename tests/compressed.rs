@@ -8,10 +8,8 @@
 //! tools (`.ci/run` installs them), the same settings are also applied live to the generated
 //! models and to every model of `UMBRA_GLTF_CORPUS`.
 
-mod common;
-
-use common::corpus::{extra_corpus, models_under, write_corpus};
-use common::*;
+use crate::common::corpus::{extra_corpus, models_under, write_corpus};
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use std::path::{Path, PathBuf};
 use umbra::render::{Renderer, View, ViewMode};
@@ -100,20 +98,6 @@ fn shoot(ctx: &std::sync::Arc<umbra::gpu::Context>, scene: &Scene, camera: Camer
     }
 }
 
-fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let se: f64 = a
-        .pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] as f64 - q[c] as f64).powi(2)))
-        .sum();
-    let mse = se / (a.width() * a.height() * 3) as f64;
-    if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (255.0f64 * 255.0 / mse).log10()
-    }
-}
-
 /// The model's pixels: those whose depth differs from the ground-only render's.
 fn mask(depth: &[f32], ground: &[f32]) -> Vec<bool> {
     depth
@@ -198,9 +182,9 @@ fn judge(ctx: &std::sync::Arc<umbra::gpu::Context>, original: &Path, encoded: &P
     Verdict {
         welded,
         psnr: if normals {
-            psnr(&a.normals, &b.normals)
+            image_diff(&a.normals, &b.normals).psnr()
         } else {
-            psnr(&a.lit, &b.lit)
+            image_diff(&a.lit, &b.lit).psnr()
         },
         normals,
         silhouette: silhouette_mismatch(&ma, &mb),

@@ -2,9 +2,7 @@
 //! double-sided meshes, leaf cards cut to their alpha in the shadow pass, per-material texture
 //! fetches and the opaque/masked pipeline split (lavapipe, validation on).
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::render::SceneOptions;
 use umbra::scene::foliage::foliage_scene;

@@ -4,9 +4,7 @@
 //! depth darkening with distance, shadow texel density brighter near the camera, the cascade
 //! index rising with depth, and overdraw counting layers.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
 use umbra::scene::shapes::{add_object, colored, cuboid, plane, quad};

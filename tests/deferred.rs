@@ -3,9 +3,7 @@
 //! spheres of sub-pixel triangles under a shadowing sun and a point light, beside draws that
 //! stay forward (a vertex-coloured sphere, the ground). Validation on.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use umbra::render::SceneOptions;
 use umbra::scene::shapes::{add_object, add_texture, colored, quad, uv_sphere};
@@ -29,18 +27,6 @@ fn render_at(
         ..Default::default()
     };
     render_with(ctx, scene, &options, view, size)
-}
-
-/// (largest channel difference, pixels differing by more than 2 levels).
-fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> (u8, usize) {
-    let mut largest = 0;
-    let mut changed = 0;
-    for (p, q) in a.pixels().zip(b.pixels()) {
-        let d = (0..3).map(|k| p[k].abs_diff(q[k])).max().unwrap_or(0);
-        largest = largest.max(d);
-        changed += usize::from(d > 2);
-    }
-    (largest, changed)
 }
 
 /// A 64×64 texture from `f(x, y)`.
@@ -163,7 +149,8 @@ fn micro_deferred_against_forward(ctx: &TestContext, size: (u32, u32), name: &st
     );
     assert_eq!(off.stats.deferred_draws, 0);
     assert_eq!(on.stats.draws, off.stats.draws);
-    let (largest, changed) = difference(&on.image, &off.image);
+    let d = image_diff(&on.image, &off.image);
+    let (largest, changed) = (d.largest(), d.over(2));
     eprintln!(
         "deferred vs forward at {}x{}: largest difference {largest} levels, {changed} pixels > 2",
         size.0, size.1
@@ -222,7 +209,8 @@ fn deferred_double_sided_scene_matches_forward() {
         "{} draws deferred",
         on.stats.deferred_draws
     );
-    let (largest, changed) = difference(&on.image, &off.image);
+    let d = image_diff(&on.image, &off.image);
+    let (largest, changed) = (d.largest(), d.over(2));
     eprintln!("double-sided: largest difference {largest} levels, {changed} pixels > 2");
     // Measured: largest 1 level, 0 pixels over 2.
     assert!(largest <= 3, "largest difference {largest} levels");
@@ -250,7 +238,8 @@ fn open_double_sided_models_defer_at_a_close_view_and_match_forward() {
         assert_eq!(on.stats.flat_draws, 1, "the ground");
         assert_eq!(off.stats.flat_draws, 5, "the ground and four models");
     }
-    let (largest, changed) = difference(&on.image, &off.image);
+    let d = image_diff(&on.image, &off.image);
+    let (largest, changed) = (d.largest(), d.over(2));
     eprintln!("close-up: largest difference {largest} levels, {changed} pixels > 2");
     // Measured: largest 1 level (1,537 pixels), 0 pixels over 2.
     assert!(largest <= 2, "largest difference {largest} levels");

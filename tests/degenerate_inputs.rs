@@ -1,10 +1,8 @@
 //! Degenerate but loadable input: documented fallbacks with warnings, never a panic or a
 //! validation message (lavapipe, validation on).
 
-mod common;
-
+use crate::common::*;
 use base64::Engine as _;
-use common::*;
 use serde_json::json;
 use std::path::PathBuf;
 use umbra::render::{Renderer, View};

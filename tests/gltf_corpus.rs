@@ -3,10 +3,8 @@
 //! removed) and casts a shadow on a ground plane; the textured, normal-mapped models show their
 //! textures and normal maps.
 
-mod common;
-
-use common::corpus::{extra_corpus, models_under, write_corpus};
-use common::*;
+use crate::common::corpus::{extra_corpus, models_under, write_corpus};
+use crate::common::*;
 use std::path::{Path, PathBuf};
 use umbra::render::{Renderer, View, ViewMode};
 use umbra::scene::{load_gltf, shapes::add_ground, Scene};

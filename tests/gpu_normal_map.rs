@@ -2,14 +2,12 @@
 //! on its left-facing slopes, with stored tangents, with mirrored UVs (tangent w = −1), and with
 //! MikkTSpace-generated tangents.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec2, Vec3};
 use umbra::render::{Renderer, View};
 use umbra::scene::demo::bump_normal_map;
+use umbra::scene::mikk::generate_mikktspace;
 use umbra::scene::shapes::{add_object, add_texture, quad};
-use umbra::scene::tangents::generate_mikktspace;
 use umbra::scene::{Camera, Light, Material, Primitive, Scene, TextureRef};
 
 const BUMPS: u32 = 4;

@@ -1,9 +1,7 @@
 //! GPU tests of the offscreen frame (lavapipe, validation on): the demo renders, the X/Y
 //! conventions hold, and a lit surface has the Blinn-Phong value computed on the CPU.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Quat, Vec3};
 use umbra::render::{Renderer, View, ViewMode};
 use umbra::scene::shapes::{add_object, colored, plane, quad};

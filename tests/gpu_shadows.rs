@@ -5,9 +5,7 @@
 //! from the fitted frustum) or one pixel of them are the edge band and are not judged; everything
 //! else must agree with the exact answer (GPU visibility thresholded at 0.5).
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
@@ -379,13 +377,6 @@ fn shadow_touches_the_casters_base_within_two_texels() {
     assert_validation_clean(&ctx);
 }
 
-fn count_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
-    a.pixels()
-        .zip(b.pixels())
-        .filter(|(p, q)| p[0].abs_diff(q[0]) > 8)
-        .count()
-}
-
 #[test]
 fn sub_texel_camera_motion_leaves_shadows_unchanged_when_snapped() {
     let ctx = context();
@@ -410,7 +401,7 @@ fn sub_texel_camera_motion_leaves_shadows_unchanged_when_snapped() {
             moved.world_from_view = Mat4::from_translation(offset) * camera.world_from_view;
             view.shadow_fit_camera = Some(moved);
             let f = r.render(&view, W, H).unwrap();
-            changed[i] += count_diff(&base.image, &f.image);
+            changed[i] += image_diff(&base.image, &f.image).over(8);
         }
     }
     let total = (W * H * 6) as usize;

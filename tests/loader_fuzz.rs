@@ -1,8 +1,6 @@
 //! Mutation fuzzing of the glTF loader: thousands of corrupted copies of real files must each
 //! load or fail with an error, without a panic (even one caught internally) or a hang.
 
-mod common;
-
 use std::sync::atomic::{AtomicUsize, Ordering};
 use umbra::scene::load_gltf;
 
@@ -83,11 +81,11 @@ fn corrupted_files_never_panic() {
     // their external files resolve.
     // Also the compressed fixtures (tests/data/compressed: quantized, meshopt, Draco, KTX2 and
     // WebP, as the real tools wrote them), so mutations reach the decoders.
-    let compressed = common::corpus::models_under(
+    let compressed = crate::common::corpus::models_under(
         &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/compressed"),
     );
     assert!(compressed.len() >= 20, "the compressed fixtures are seeds");
-    let seeds: Vec<(String, Vec<u8>)> = common::corpus::write_corpus(&dir)
+    let seeds: Vec<(String, Vec<u8>)> = crate::common::corpus::write_corpus(&dir)
         .into_iter()
         .chain(compressed)
         .map(|p| {

@@ -5,9 +5,7 @@
 //! with the sample count, and pixels away from edges do not change (MSAA touches only edges, so
 //! no shadow leaks along them).
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::plan::{FramePlan, ScenePlanner};
 use umbra::render::{PostAa, Renderer, SceneOptions, View};

@@ -4,9 +4,7 @@
 //! on screen, under a spot light (a perspective reach with its apex), and in the demo scene.
 //! Validation on.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::render::SceneOptions;
 use umbra::scene::demo::demo_scene;
@@ -20,11 +18,6 @@ fn render(ctx: &TestContext, scene: &Scene, split: bool, view: &View) -> umbra::
         ..Default::default()
     };
     render_with(ctx, scene, &options, view, (320, 180))
-}
-
-/// Pixels whose colour differs at all between `a` and `b`.
-fn differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
-    a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count()
 }
 
 /// Pixels that `shadows` draws darker than `no_shadows` by over 30 levels of luminance: the
@@ -90,7 +83,7 @@ fn assert_unchanged(ctx: &TestContext, scene: &Scene, view: &View, name: &str) -
     save(&on.image, name);
     // Measured: 0 pixels differ in every scene here (beyond the reach the shadowed shader's
     // visibility is exactly 1).
-    let n = differing(&on.image, &off.image);
+    let n = image_diff(&on.image, &off.image).differing();
     assert_eq!(n, 0, "{name}: {n} pixels differ");
     assert_eq!(
         on.stats.unshadowed_draws, 1,

@@ -2,9 +2,7 @@
 //! did not change is not redrawn, and only moving casters are drawn over a cached copy of the
 //! static ones. Every frame must be the uncached frame to the bit.
 
-mod common;
-
-use common::{assert_validation_clean, context};
+use crate::common::{assert_validation_clean, context, image_diff};
 use glam::Vec3;
 use umbra::render::SceneOptions;
 use umbra::scene::anim::Playing;
@@ -25,10 +23,6 @@ fn renderers(ctx: &std::sync::Arc<umbra::Context>, scene: &umbra::Scene) -> (Ren
     )
 }
 
-fn differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
-    a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count()
-}
-
 #[test]
 fn a_still_scene_is_drawn_into_the_map_once() {
     let ctx = context();
@@ -38,7 +32,11 @@ fn a_still_scene_is_drawn_into_the_map_once() {
     let want = plain.render(&v, W, H).unwrap();
     for frame in 0..3 {
         let f = cached.render(&v, W, H).unwrap();
-        assert_eq!(differing(&f.image, &want.image), 0, "frame {frame}");
+        assert_eq!(
+            image_diff(&f.image, &want.image).differing(),
+            0,
+            "frame {frame}"
+        );
         if frame == 0 {
             assert_eq!(f.stats.casters_drawn, want.stats.casters_drawn);
         } else {
@@ -50,7 +48,11 @@ fn a_still_scene_is_drawn_into_the_map_once() {
     v.sun_direction = Some(Vec3::new(0.5, -1.0, 0.2));
     let f = cached.render(&v, W, H).unwrap();
     let want = plain.render(&v, W, H).unwrap();
-    assert_eq!(differing(&f.image, &want.image), 0, "after the sun moved");
+    assert_eq!(
+        image_diff(&f.image, &want.image).differing(),
+        0,
+        "after the sun moved"
+    );
     assert_eq!(f.stats.casters_drawn, want.stats.casters_drawn);
     // A camera moved a little refits the light's view: drawn again.
     for step in 1..=3 {
@@ -59,7 +61,7 @@ fn a_still_scene_is_drawn_into_the_map_once() {
         let f = cached.render(&v, W, H).unwrap();
         let want = plain.render(&v, W, H).unwrap();
         assert_eq!(
-            differing(&f.image, &want.image),
+            image_diff(&f.image, &want.image).differing(),
             0,
             "after camera step {step}"
         );
@@ -69,7 +71,7 @@ fn a_still_scene_is_drawn_into_the_map_once() {
     let f = cached.render(&v, W, H).unwrap();
     let want = plain.render(&v, W, H).unwrap();
     assert_eq!(
-        differing(&f.image, &want.image),
+        image_diff(&f.image, &want.image).differing(),
         0,
         "after the bias changed"
     );
@@ -92,8 +94,8 @@ fn a_moving_caster_is_drawn_over_the_cached_town() {
         plain.set_pose(&scene).unwrap();
         let a = cached.render(&v, W, H).unwrap();
         let b = plain.render(&v, W, H).unwrap();
-        common::save(&a.image, &format!("town_mover_cached_t{t}.png"));
-        assert_eq!(differing(&a.image, &b.image), 0, "t {t}");
+        crate::common::save(&a.image, &format!("town_mover_cached_t{t}.png"));
+        assert_eq!(image_diff(&a.image, &b.image).differing(), 0, "t {t}");
         let views = a.plan.shadow_views.len();
         eprintln!(
             "t {t}: {} casters drawn cached, {} uncached, {views} views",
@@ -111,7 +113,10 @@ fn a_moving_caster_is_drawn_over_the_cached_town() {
         }
         // The walker and its shadow move.
         if let Some(p) = &previous {
-            assert!(differing(p, &a.image) > 200, "t {t}: nothing moved");
+            assert!(
+                image_diff(p, &a.image).differing() > 200,
+                "t {t}: nothing moved"
+            );
         }
         previous = Some(a.image);
     }

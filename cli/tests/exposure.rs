@@ -6,11 +6,8 @@
 //! image; the same yard with its lights scaled to unit intensity and a matching `--exposure`
 //! gives the same picture; the GPU's tone-mapped image matches the reference's.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::gltf_builder::{Builder, Container, U16};
-use common::*;
+use crate::common::gltf_builder::{Builder, Container, U16};
+use crate::common::*;
 use glam::{Quat, Vec3};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};

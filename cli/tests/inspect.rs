@@ -2,11 +2,8 @@
 //! pointer; every corpus model's `--json` validates against `docs/inspect-schema.json`; totals
 //! equal glTF-Validator's `info` block (run through node when it is installed).
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::corpus::{extra_corpus, models_under, write_corpus};
-use common::gltf_builder::{Builder, Container, U16};
+use crate::common::corpus::{extra_corpus, models_under, write_corpus};
+use crate::common::gltf_builder::{Builder, Container, U16};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -122,7 +119,9 @@ fn known_defects_are_reported_with_codes_and_pointers() {
     b.material(json!({"name": "plain"}));
     b.material(json!({"name": "glass", "alphaMode": "BLEND"}));
     b.material(json!({"name": "spare"}));
-    let img = b.image(common::gltf_builder::png(&image::RgbaImage::new(4, 4)));
+    let img = b.image(crate::common::gltf_builder::png(&image::RgbaImage::new(
+        4, 4,
+    )));
     b.texture(img, None);
     b.mesh(
         "defects",

@@ -2,15 +2,11 @@
 //! of the same scene, camera and size, what its window shows (read from the X server) does too,
 //! and resizing (through 0×0 and back) is clean.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-mod xvfb;
-
-use common::gltf_builder::{Builder, Container};
+use crate::common::gltf_builder::{Builder, Container};
+use crate::xvfb::{out, umbra, Xvfb};
 use serde_json::json;
 use std::process::Command;
 use umbra_lab::reference::metrics::{flip, psnr};
-use xvfb::{out, umbra, Xvfb};
 
 #[test]
 fn viewer_screenshot_matches_offscreen_render() {
@@ -428,7 +424,7 @@ fn the_viewer_plays_and_steps_animations_like_the_offscreen_render() {
     // (next: all animations, from 0 playing) and `space` (pause) on the same run leave no
     // validation message.
     let x = Xvfb::start();
-    let model = common::animated::skinned_bar(&out("animated"), "viewer_bar", 0.0, true);
+    let model = crate::common::animated::skinned_bar(&out("animated"), "viewer_bar", 0.0, true);
     let model = model.to_str().unwrap();
     let shot = out("viewer_bar_shot.png");
     let offscreen = out("viewer_bar_offscreen.png");

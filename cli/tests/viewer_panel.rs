@@ -4,14 +4,11 @@
 //! key draws; picking fills the panel; a dropped file opens, a file changed on disk reloads, and
 //! a broken one keeps the scene on screen with its error.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-mod xvfb;
-
-use common::gltf_builder::{Builder, Container};
+use crate::common::gltf_builder::{Builder, Container};
+use crate::common::image_diff;
+use crate::xvfb::{out, umbra, Xvfb};
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use xvfb::{out, umbra, Xvfb};
 
 const SIZE: &str = "640x360";
 
@@ -46,12 +43,6 @@ fn open(p: &Path) -> image::RgbaImage {
     image::open(p).unwrap().to_rgba8()
 }
 
-/// Pixels that differ at all.
-fn differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
-    assert_eq!(a.dimensions(), b.dimensions());
-    a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count()
-}
-
 #[test]
 fn the_panel_shows_and_hides_and_screenshots_leave_it_out() {
     let x = Xvfb::start();
@@ -65,7 +56,11 @@ fn the_panel_shows_and_hides_and_screenshots_leave_it_out() {
     assert!(log.contains("panel: hidden"), "{log}");
     let (scene, with_ui, hidden) = (open(&scene), open(&with_ui), open(&hidden));
     // Hidden, the screen is the scene; shown, the panel covers the right of it.
-    assert_eq!(differing(&scene, &hidden), 0, "the hidden panel left marks");
+    assert_eq!(
+        image_diff(&scene, &hidden).differing(),
+        0,
+        "the hidden panel left marks"
+    );
     let (w, h) = scene.dimensions();
     let (mut left, mut right) = (0, 0);
     for (x, y, p) in with_ui.enumerate_pixels() {
@@ -103,11 +98,11 @@ fn a_panel_widget_draws_what_its_key_draws() {
     }
     let (a, b, c) = (open(&by_key), open(&by_widget), open(&untouched));
     assert_eq!(
-        differing(&a, &b),
+        image_diff(&a, &b).differing(),
         0,
         "the widget and the key drew different frames"
     );
-    let changed = differing(&a, &c);
+    let changed = image_diff(&a, &c).differing();
     eprintln!("3x3 filter and 4096² map: {changed} pixels differ from the defaults");
     // Measured: 224 pixels (the shadow edges) move.
     assert!(changed > 150, "{changed} pixels changed");

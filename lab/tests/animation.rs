@@ -1,14 +1,11 @@
 //! Scenes that move: the project's own animated models (a two-joint skinned bar, a hierarchy
 //! animated with STEP, LINEAR and CUBICSPLINE, a cube with two morph targets), written by
-//! `common::gltf_builder`, loaded, posed at several times and rendered on lavapipe with
+//! `crate::common::gltf_builder`, loaded, posed at several times and rendered on lavapipe with
 //! validation. Where things must be is computed here from the models' definitions (not by the
 //! code under test), and the shadows are judged against the exact ray-cast reference.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::animated;
-use common::{assert_validation_clean, context, project, save};
+use crate::common::animated;
+use crate::common::{assert_validation_clean, context, project, save};
 use glam::{Mat4, Quat, Vec3};
 use std::path::PathBuf;
 use umbra::scene::anim::Playing;
@@ -21,7 +18,7 @@ const W: u32 = 480;
 const H: u32 = 360;
 
 fn model_dir() -> PathBuf {
-    let d = common::out_dir().join("animated-models");
+    let d = crate::common::out_dir().join("animated-models");
     std::fs::create_dir_all(&d).unwrap();
     d
 }
@@ -340,7 +337,7 @@ fn a_renderer_posed_in_place_draws_what_a_fresh_one_draws() {
 
 #[test]
 fn fox_walks_and_its_shadow_follows() {
-    let Some(dir) = common::corpus::extra_corpus() else {
+    let Some(dir) = crate::common::corpus::extra_corpus() else {
         eprintln!("UMBRA_GLTF_CORPUS not set: Fox.glb not tried");
         return;
     };
@@ -389,7 +386,7 @@ fn broken(
     joint: u16,
     w0: [f32; 4],
 ) -> PathBuf {
-    use common::gltf_builder::{Builder, Container, U16};
+    use crate::common::gltf_builder::{Builder, Container, U16};
     use serde_json::json;
     let mut b = Builder::default();
     let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], 3, "VEC3");

@@ -2,10 +2,7 @@
 //! of one view gives sane rows and resumes; the budget mode's choice measures within its budget
 //! by the full-image comparison, and a budget of 0 takes exact shadows.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use umbra::render::{Renderer, View};
 use umbra::scene::synthetic::town_scene;
 use umbra_lab::analysis::budget::{self, PROBE_STRIDE};

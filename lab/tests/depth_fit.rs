@@ -6,10 +6,7 @@
 //! Also here (it needs the reference too): misclassification along view depth in the town has
 //! no spike at the cascade splits.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::render::{Renderer, View};
 use umbra::scene::shapes::{add_object, colored, cuboid};

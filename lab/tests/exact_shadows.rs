@@ -7,10 +7,7 @@
 //! at exact silhouettes of casters (shadow rays grazing a triangle's edge); the map's figures at
 //! the same settings are printed beside.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use umbra::plan::ShadowMethod;
 use umbra::render::{Renderer, View, ViewMode};
 use umbra::scene::{demo::demo_scene, load_gltf, shapes::add_ground, synthetic, Scene};
@@ -76,7 +73,7 @@ fn exact_shadows_agree_with_the_reference_at_every_judged_pixel() {
     ] {
         scenes.push(synthetic::by_name(name).unwrap());
     }
-    if let Some(extra) = common::corpus::extra_corpus() {
+    if let Some(extra) = crate::common::corpus::extra_corpus() {
         let mut helmet = load_gltf(&extra.join("FlightHelmet/FlightHelmet.gltf")).unwrap();
         add_ground(&mut helmet);
         scenes.push(helmet);

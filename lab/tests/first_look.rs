@@ -5,11 +5,8 @@
 //! known square on known pixels and agree with the reference's parallel rays. Every model is a
 //! glTF file the test writes.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::gltf_builder::{png, Builder, Container, U16};
-use common::*;
+use crate::common::gltf_builder::{png, Builder, Container, U16};
+use crate::common::*;
 use glam::Vec3;
 use serde_json::json;
 use std::path::PathBuf;

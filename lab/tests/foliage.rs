@@ -7,10 +7,7 @@
 //! for both variants, and the reference agrees with it away from edges as on solid scenes. (The
 //! stability suite's foliage probe is in `stability.rs`.)
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
 use umbra::scene::foliage::foliage_scene;
 use umbra::scene::{AlphaMode, Scene};

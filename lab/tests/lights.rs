@@ -4,10 +4,7 @@
 //! measured as the ratio of two renders at the same ground point (windowed / unwindowed, spot /
 //! point), on the GPU and in the reference, against the formula.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::render::{Renderer, View};
 use umbra::scene::shapes::{add_object, colored, plane};

@@ -5,10 +5,7 @@
 //! The same card made opaque is the control: its reference shadow is solid, about twice the
 //! checker's.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3, Vec4};
 use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
 use umbra::scene::shapes::{add_object, add_texture, colored, plane, quad};

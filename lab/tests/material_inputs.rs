@@ -2,11 +2,8 @@
 //! factor (and a non-finite or negative strength falls back to 1); the lit image shows it, on the
 //! GPU as in the reference.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::gltf_builder::{Builder, Container};
-use common::*;
+use crate::common::gltf_builder::{Builder, Container};
+use crate::common::*;
 use glam::Vec3;
 use serde_json::json;
 use std::path::PathBuf;
@@ -45,7 +42,7 @@ fn unit_quad(b: &mut Builder, x: f32) -> (usize, usize) {
     );
     (
         pos,
-        b.indices(&[0, 1, 2, 0, 2, 3], common::gltf_builder::U16),
+        b.indices(&[0, 1, 2, 0, 2, 3], crate::common::gltf_builder::U16),
     )
 }
 
@@ -220,7 +217,7 @@ fn second_set_quads() -> PathBuf {
     ] {
         img.put_pixel(x, y, image::Rgba(c));
     }
-    let image = b.image(common::gltf_builder::png(&img));
+    let image = b.image(crate::common::gltf_builder::png(&img));
     // NEAREST magnification and minification, clamped.
     let sampler = b.sampler(9728, 9728, 33071, 33071);
     let tex = b.texture(image, Some(sampler));

@@ -5,10 +5,7 @@
 //! 2048² map as the issue states; and each light must have shadow in view, so that a light
 //! casting nothing would fail. The scenes are `--synthetic room`, `sun-and-spot` and `two-suns`.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use umbra::render::{Renderer, View, ViewMode};
 use umbra::scene::synthetic::{room_scene, sun_and_spot_scene, two_suns_scene};
 use umbra::scene::Scene;

@@ -1,10 +1,7 @@
 //! The CPU ray-cast reference: BVH against brute force, and shadow accuracy of the GPU frame
 //! against exact visibility (lavapipe, validation on).
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::Vec3;
 use umbra::math::ray::Ray;
 use umbra::render::{Renderer, View, ViewMode};
@@ -46,11 +43,11 @@ fn bvh_matches_brute_force(scene: &Scene) -> usize {
 #[test]
 fn bvh_equals_brute_force_on_corpus_and_demo() {
     let dir = out_dir().join("corpus_bvh");
-    let mut scenes: Vec<Scene> = common::corpus::write_corpus(&dir)
+    let mut scenes: Vec<Scene> = crate::common::corpus::write_corpus(&dir)
         .iter()
         .map(|p| load_gltf(p).unwrap())
         .collect();
-    if let Some(extra) = common::corpus::extra_corpus() {
+    if let Some(extra) = crate::common::corpus::extra_corpus() {
         scenes.push(load_gltf(&extra.join("FlightHelmet/FlightHelmet.gltf")).unwrap());
     }
     scenes.push(demo_scene());

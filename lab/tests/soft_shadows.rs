@@ -5,10 +5,7 @@
 //! come closer to the reference's visible fraction with PCSS than with hard PCF. The same with a
 //! point lamp of 0.25 m radius (cube-map faces, perspective depths).
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
 use umbra::scene::shapes::{add_object, colored, cuboid, plane};

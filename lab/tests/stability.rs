@@ -3,10 +3,7 @@
 //! purpose (8× the bias: a contact gap; no snapping: shimmer, in the first test). And the foliage
 //! probe: leaf shadows shimmer along the suite's flythrough with maps, not with exact shadows.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use umbra::render::ScenePlanner;
 use umbra::render::{Renderer, ShadowMethod, ShadowSettings, View};
 use umbra::scene::foliage::foliage_scene;

@@ -3,10 +3,7 @@
 //! to 2, so that every pixel's texel is known analytically: with 192 pixels over 3 units of uv and
 //! 4 texels per unit, a texel is 16 pixels and no pixel centre lies on a texel boundary.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use umbra::render::{Renderer, SceneOptions, View};
 use umbra::scene::shapes::{add_object, add_texture, quad};
@@ -111,14 +108,6 @@ fn render_scene(
     let exact = ReferenceScene::new(&scene).render(&f.plan, N, N, f.plan.ambient);
     save(&f.image, &format!("sampler_{name}.png"));
     (f.image, exact.image)
-}
-
-fn largest_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
-    a.pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
-        .max()
-        .unwrap_or(0)
 }
 
 fn nearest(wrap_u: Wrap, wrap_v: Wrap) -> Sampler {
@@ -228,7 +217,7 @@ fn nearest_magnification_keeps_hard_texel_edges_and_linear_blends_them() {
     };
     let (soft, soft_exact) = render(&ctx, linear, "linear");
     let (hard_n, soft_n) = (colours(&hard), colours(&soft));
-    let diff = largest_difference(&soft, &soft_exact);
+    let diff = image_diff(&soft, &soft_exact).largest();
     eprintln!("colours: nearest {hard_n}, linear {soft_n}; linear GPU vs reference: {diff} levels");
     // Nearest: the 16 texel colours and nothing between them.
     assert_eq!(hard_n, 16);
@@ -425,7 +414,7 @@ fn texture_transform_moves_the_normal_map_too() {
         (
             (luma(&gpu, l0, l1), luma(&gpu, r0, r1)),
             (luma(&exact, l0, l1), luma(&exact, r0, r1)),
-            largest_difference(&gpu, &exact),
+            image_diff(&gpu, &exact).largest(),
         )
     };
     let (plain, plain_exact, d0) = halves(0.0);
@@ -506,7 +495,7 @@ fn occlusion_scales_the_ambient_term_only() {
         scene_with(Vec3::new(0.3, -0.2, -1.0).normalize()),
         "occlusion_lit",
     );
-    let d = largest_difference(&lit, &lit_exact);
+    let d = image_diff(&lit, &lit_exact).largest();
     eprintln!("occlusion: right/left {ratio:.4} (reference {ratio_exact:.4}, formula 0.4008); lit: GPU vs reference {d} levels");
     // Measured: 0.4009 on both (8-bit output quantisation).
     assert!((ratio - 0.4008).abs() < 0.005 && (ratio_exact - 0.4008).abs() < 0.005);

@@ -4,10 +4,7 @@
 //! the CPU reference (which composites along each ray). Shadow policy: a blended surface casts
 //! where alpha ≥ 0.5 (`BLEND_SHADOW_CUTOFF`), judged against the reference's shadow rays.
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec3, Vec4};
 use umbra::render::{Renderer, View, ViewMode};
 use umbra::scene::shapes::{add_object, colored, plane, quad};
@@ -63,15 +60,6 @@ fn levels_off(img: &image::RgbaImage, x: u32, y: u32, want: Vec3) -> f32 {
         .fold(0.0, f32::max)
 }
 
-/// Largest per-channel difference between two images over every pixel.
-fn max_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
-    a.pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..3).map(move |k| p[k].abs_diff(q[k])))
-        .max()
-        .unwrap_or(0)
-}
-
 #[test]
 fn a_half_transparent_quad_blends_over_a_known_background() {
     let red = Vec4::new(1.0, 0.0, 0.0, 0.5);
@@ -111,7 +99,7 @@ fn a_half_transparent_quad_blends_over_a_known_background() {
         levels_off(&exact.image, W / 2 - 20, y, over(red, back)),
         levels_off(&exact.image, W / 2 + 20, y, over(red, CLEAR)),
     );
-    let whole = max_diff(&f.image, &exact.image);
+    let whole = image_diff(&f.image, &exact.image).largest();
     eprintln!(
         "blend over: GPU {left} / {right} levels off, reference {ref_left} / {ref_right}; \
          GPU vs reference at most {whole} levels"
@@ -163,7 +151,7 @@ fn three_overlapping_quads_are_sorted_back_to_front() {
     // The same pixel composited in the listed (unsorted) order is far off.
     let unsorted = over(quads[2].0, over(quads[1].0, over(quads[0].0, CLEAR)));
     let wrong_order = levels_off(&f.image, x, y, unsorted);
-    let whole = max_diff(&f.image, &exact.image);
+    let whole = image_diff(&f.image, &exact.image).largest();
     eprintln!(
         "three quads at ({x}, {y}): GPU {gpu} levels off, reference {reference}; unsorted order \
          would be {wrong_order} off; GPU vs reference at most {whole} levels"

@@ -13,9 +13,7 @@ use crate::plan::settings::{
 };
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
 use crate::plan::{Viewpoint, CLEAR_COLOR};
-use crate::render::passes::camera_pass::{
-    AovTargets, CameraFrame, CameraPass, CameraTargets, Resolve,
-};
+use crate::render::passes::camera::{AovTargets, CameraFrame, CameraPass, CameraTargets, Resolve};
 use crate::render::passes::cull::CameraCull;
 use crate::render::passes::exact::{ExactFrameInputs, ExactMode, ExactPass};
 use crate::render::passes::post_aa::PostAaPass;
@@ -620,7 +618,7 @@ pub struct PassCounts {
     pub deferred_draws: usize,
     /// Draws drawn, wholly or in part, without the shadow lookup (`crate::render::passes::receivers`).
     pub unshadowed_draws: usize,
-    /// Forward draws reading the uniforms as flat inputs (`camera_pass::FLAT_FROM_PIXELS`).
+    /// Forward draws reading the uniforms as flat inputs (`camera::FLAT_FROM_PIXELS`).
     pub flat_draws: usize,
 }
 

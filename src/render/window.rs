@@ -341,12 +341,7 @@ impl WindowRenderer {
             casters: counts.casters,
             draws: counts.camera_draws,
             deferred: counts.deferred_draws,
-            shadow_views: prepared
-                .plan
-                .shadow_views
-                .iter()
-                .map(|v| (v.light, v.res, v.texel_world))
-                .collect(),
+            shadow_views: shadow_view_summary(&prepared.plan),
         };
         if fit {
             depth.transition(d, cmd, Access::TransferSrc);
@@ -362,27 +357,10 @@ impl WindowRenderer {
             self.depth_reads[f].1 =
                 Some((crate::plan::camera_projection(&view.camera, aspect), pixels));
         }
-        let shot_buffer = self.screenshot.as_ref().map(|b| b.raw);
-        let copy = |color: &mut Attachment| {
-            color.transition(d, cmd, Access::TransferSrc);
-            copy_to_buffer(
-                d,
-                cmd,
-                color.image,
-                vk::ImageAspectFlags::COLOR,
-                extent,
-                shot_buffer.expect("buffer"),
-            );
-        };
-        if want_copy && (capture == Capture::Scene || overlay.is_none()) {
-            copy(&mut color);
-        }
-        if let Some(o) = overlay {
-            record_overlay(d, cmd, &mut color, extent, o);
-            if want_copy && capture == Capture::Screen {
-                copy(&mut color);
-            }
-        }
+        let shot_buffer = want_copy
+            .then(|| self.screenshot.as_ref().map(|b| b.raw))
+            .flatten();
+        record_screenshot_and_overlay(d, cmd, &mut color, extent, overlay, (capture, shot_buffer));
         if fit || want_copy {
             transfer_to_host_barrier(d, cmd);
         }
@@ -519,6 +497,49 @@ impl WindowRenderer {
             .mapped()
             .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
         Ok(rgba_from_readback(bytes, extent.width, extent.height, bgra))
+    }
+}
+
+/// Each shadow view's (light, resolution, texel size in world units).
+fn shadow_view_summary(plan: &crate::plan::FramePlan) -> Vec<(usize, u32, f32)> {
+    plan.shadow_views
+        .iter()
+        .map(|v| (v.light, v.res, v.texel_world))
+        .collect()
+}
+
+/// Records the overlay over `color`, and with a screenshot buffer (`shot`: what to capture, where)
+/// the copy of `color` into it: before the overlay for `Capture::Scene` (or with no overlay),
+/// after it for `Capture::Screen`.
+fn record_screenshot_and_overlay(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    color: &mut Attachment,
+    extent: vk::Extent2D,
+    overlay: Option<&mut dyn Overlay>,
+    (capture, shot): (Capture, Option<vk::Buffer>),
+) {
+    let copy = |color: &mut Attachment, buffer| {
+        color.transition(d, cmd, Access::TransferSrc);
+        copy_to_buffer(
+            d,
+            cmd,
+            color.image,
+            vk::ImageAspectFlags::COLOR,
+            extent,
+            buffer,
+        );
+    };
+    if let Some(b) = shot {
+        if capture == Capture::Scene || overlay.is_none() {
+            copy(color, b);
+        }
+    }
+    if let Some(o) = overlay {
+        record_overlay(d, cmd, color, extent, o);
+        if let (Some(b), Capture::Screen) = (shot, capture) {
+            copy(color, b);
+        }
     }
 }
 

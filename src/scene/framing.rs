@@ -132,6 +132,17 @@ pub fn framed_camera(bounds: &Aabb, towards_eye: Vec3, aspect: f32) -> Camera {
     Camera::look_at(f.eye, f.target, fov_y, f.nearest * 0.5)
 }
 
+impl super::Scene {
+    /// The camera a model without one is seen through: from the front (+Z, looking towards
+    /// −Z) [`DEFAULT_ELEVATION_DEG`] above the horizontal, at the centre of
+    /// its bounds (`framing`, else `bounds()`), at the distance where the bounds' corners fill
+    /// [`FILL`] of the shorter image side ([`framed_camera`]).
+    pub fn default_camera(&self, aspect: f32) -> Camera {
+        let b = self.framing.unwrap_or_else(|| self.bounds());
+        framed_camera(&b, default_direction(), aspect)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

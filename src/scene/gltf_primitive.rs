@@ -4,9 +4,8 @@
 
 use super::gltf_input::check_attribute_types;
 use super::load_error::{corrupt, LoadError};
-use super::tangents::{
-    compute_smooth_normals, count_degenerate, fallback_tangent, generate_mikktspace,
-};
+use super::mikk::generate_mikktspace;
+use super::tangents::{compute_smooth_normals, count_degenerate, fallback_tangent};
 use super::{Primitive, Scene};
 use glam::{Vec2, Vec3, Vec4};
 use std::path::Path;
@@ -111,22 +110,7 @@ pub(super) fn read_primitive(
     let indices = finite_triangles(scene, &site, &positions, indices);
     let has_normals = prim.get(&gltf::Semantic::Normals).is_some();
     let normals = read_normals(scene, &reader, &site, &positions, &indices);
-    let (uvs, has_uvs): (Vec<Vec2>, bool) = match reader.read_tex_coords(0) {
-        Some(it) => (
-            it.into_f32()
-                .map(|v| {
-                    let v = Vec2::from_array(v);
-                    if v.is_finite() {
-                        v
-                    } else {
-                        Vec2::ZERO
-                    }
-                })
-                .collect(),
-            true,
-        ),
-        None => (vec![Vec2::ZERO; n], false),
-    };
+    let (uvs, has_uvs) = read_uvs0(&reader, n);
     let uvs1 = read_uvs1(scene, &reader, &site);
     let colors = read_colors(scene, &reader, &site);
     let deform = super::anim::load::read_deform(scene, &reader, n, &at, &label);
@@ -143,11 +127,33 @@ pub(super) fn read_primitive(
         uvs1,
         deform: deform.map(Box::new),
     };
+    tangents_and_normal_map(scene, &reader, &site, &mut p);
+    if let Some(d) = p.deform.as_deref_mut() {
+        d.positions = p.positions.clone();
+        d.normals = p.normals.clone();
+        d.tangents = p.tangents.clone();
+        d.normals_computed = !has_normals;
+    }
+    Ok(Some(p))
+}
+
+/// The primitive's tangents: stored, else MikkTSpace where its material has a normal map and it
+/// has texture coordinates, else a fallback per normal. A normal map without texture
+/// coordinates is dropped (the primitive gets a copy of its material without it).
+fn tangents_and_normal_map<'a, 's, F>(
+    scene: &mut Scene,
+    reader: &gltf::mesh::Reader<'a, 's, F>,
+    site: &Site,
+    p: &mut Primitive,
+) where
+    F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+{
+    let (at, label, material, has_uvs) = (site.at.to_string(), site.label, p.material, p.has_uvs);
     let wants_normal_map = scene.materials[material].normal_texture.is_some();
     match reader.read_tangents() {
-        Some(it) => p.tangents = stored_tangents(scene, &site, it),
+        Some(it) => p.tangents = stored_tangents(scene, site, it),
         None if wants_normal_map && has_uvs => {
-            if !generate_mikktspace(&mut p) {
+            if !generate_mikktspace(p) {
                 scene.warn(
                     "MESH_TANGENTS_FAILED",
                     at.clone(),
@@ -171,13 +177,29 @@ pub(super) fn read_primitive(
         scene.materials.push(m);
         p.material = scene.materials.len() - 1;
     }
-    if let Some(d) = p.deform.as_deref_mut() {
-        d.positions = p.positions.clone();
-        d.normals = p.normals.clone();
-        d.tangents = p.tangents.clone();
-        d.normals_computed = !has_normals;
+}
+
+/// TEXCOORD_0 (non-finite values as 0), and whether the primitive has it (zeros if not).
+fn read_uvs0<'a, 's, F>(reader: &gltf::mesh::Reader<'a, 's, F>, n: usize) -> (Vec<Vec2>, bool)
+where
+    F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+{
+    match reader.read_tex_coords(0) {
+        Some(it) => (
+            it.into_f32()
+                .map(|v| {
+                    let v = Vec2::from_array(v);
+                    if v.is_finite() {
+                        v
+                    } else {
+                        Vec2::ZERO
+                    }
+                })
+                .collect(),
+            true,
+        ),
+        None => (vec![Vec2::ZERO; n], false),
     }
-    Ok(Some(p))
 }
 
 /// Where a primitive's findings point, and its vertex count.

@@ -15,6 +15,7 @@ mod gltf_primitive;
 pub mod inspect;
 pub mod load_error;
 pub mod material;
+pub mod mikk;
 pub mod open_shapes;
 pub mod sampler;
 pub mod shapes;

@@ -549,13 +549,4 @@ impl Scene {
             message,
         });
     }
-
-    /// The camera a model without one is seen through: from the front (+Z, looking towards
-    /// −Z) [`super::framing::DEFAULT_ELEVATION_DEG`] above the horizontal, at the centre of
-    /// its bounds (`framing`, else `bounds()`), at the distance where the bounds' corners fill
-    /// [`super::framing::FILL`] of the shorter image side ([`super::framing::framed_camera`]).
-    pub fn default_camera(&self, aspect: f32) -> Camera {
-        let b = self.framing.unwrap_or_else(|| self.bounds());
-        super::framing::framed_camera(&b, super::framing::default_direction(), aspect)
-    }
 }

@@ -5,6 +5,10 @@
 pub mod animated;
 pub mod corpus;
 pub mod gltf_builder;
+pub mod image_diff;
+
+#[allow(unused_imports)]
+pub use image_diff::{image_diff, ImageDiff};
 
 use glam::{Mat4, Vec3, Vec4};
 use std::path::PathBuf;

@@ -117,8 +117,17 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
     if let Some(line) = apply_set(a, view, sun) {
         return line;
     }
-    let s = &mut view.shadow;
-    match a {
+    match step(a, view, sun) {
+        Some(set) => apply(set, view, sun),
+        None => toggle(a, view),
+    }
+}
+
+/// The setting a stepping action (a key that moves a setting to its next value) sets, or None
+/// for a toggle.
+fn step(a: Action, view: &View, sun: &mut SunAngles) -> Option<Action> {
+    let s = &view.shadow;
+    Some(match a {
         Action::SunLeft | Action::SunRight | Action::SunUp | Action::SunDown => {
             match a {
                 Action::SunLeft => sun.azimuth -= 5.0,
@@ -126,25 +135,43 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 Action::SunUp => sun.elevation = (sun.elevation + 5.0).min(90.0),
                 _ => sun.elevation = (sun.elevation - 5.0).max(-90.0),
             }
-            apply(Action::SetSun(*sun), view, sun)
+            Action::SetSun(*sun)
         }
-        Action::MapSmaller => {
-            let n = (s.map_size / 2).max(64);
-            apply(Action::SetMapSize(n), view, sun)
+        Action::MapSmaller => Action::SetMapSize((s.map_size / 2).max(64)),
+        Action::MapLarger => Action::SetMapSize((s.map_size * 2).min(8192)),
+        Action::CyclePcf => Action::SetPcf(match s.pcf {
+            Pcf::None => Pcf::P2x2,
+            Pcf::P2x2 => Pcf::P3x3,
+            Pcf::P3x3 => Pcf::P5x5,
+            Pcf::P5x5 => Pcf::None,
+        }),
+        Action::CycleView => {
+            let i = VIEW_CYCLE.iter().position(|m| *m == view.mode).unwrap_or(0);
+            Action::SetView(VIEW_CYCLE[(i + 1) % VIEW_CYCLE.len()])
         }
-        Action::MapLarger => {
-            let n = (s.map_size * 2).min(8192);
-            apply(Action::SetMapSize(n), view, sun)
+        Action::CycleCascades => Action::SetCascades((s.cascades + 1) % (MAX_CASCADES + 1)),
+        Action::CycleTonemap => Action::SetTonemap(match view.tonemap {
+            Tonemap::Neutral => Tonemap::Aces,
+            Tonemap::Aces => Tonemap::None,
+            Tonemap::None => Tonemap::Neutral,
+        }),
+        Action::ToggleMethod => Action::SetMethod(match view.shadow.method {
+            ShadowMethod::Map => ShadowMethod::Exact,
+            ShadowMethod::Exact => ShadowMethod::Map,
+        }),
+        Action::ExposureUp | Action::ExposureDown => {
+            let step = if a == Action::ExposureUp { 0.5 } else { -0.5 };
+            Action::SetExposure(view.exposure_compensation + step)
         }
-        Action::CyclePcf => {
-            let next = match s.pcf {
-                Pcf::None => Pcf::P2x2,
-                Pcf::P2x2 => Pcf::P3x3,
-                Pcf::P3x3 => Pcf::P5x5,
-                Pcf::P5x5 => Pcf::None,
-            };
-            apply(Action::SetPcf(next), view, sun)
-        }
+        _ => return None,
+    })
+}
+
+/// Applies a toggle (or the bias keys) and returns the line that reports it.
+fn toggle(a: Action, view: &mut View) -> String {
+    let on_off = |on: bool| if on { "on" } else { "off" };
+    let s = &mut view.shadow;
+    match a {
         Action::BiasUp | Action::BiasDown => {
             let k = if a == Action::BiasUp { 1.25 } else { 0.8 };
             s.constant_bias *= k;
@@ -152,21 +179,9 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
             s.normal_offset *= k;
             bias_line(s)
         }
-        Action::CycleView => {
-            let i = VIEW_CYCLE.iter().position(|m| *m == view.mode).unwrap_or(0);
-            apply(
-                Action::SetView(VIEW_CYCLE[(i + 1) % VIEW_CYCLE.len()]),
-                view,
-                sun,
-            )
-        }
         Action::ToggleShadows => {
             s.enabled = !s.enabled;
-            format!("shadows: {}", if s.enabled { "on" } else { "off" })
-        }
-        Action::CycleCascades => {
-            let n = (s.cascades + 1) % (MAX_CASCADES + 1);
-            apply(Action::SetCascades(n), view, sun)
+            format!("shadows: {}", on_off(s.enabled))
         }
         Action::ToggleDepthFit => {
             s.depth_fit = !s.depth_fit;
@@ -183,16 +198,8 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
             s.soft = !s.soft;
             format!(
                 "soft shadows (PCSS) for lights with a size: {}",
-                if s.soft { "on" } else { "off" }
+                on_off(s.soft)
             )
-        }
-        Action::CycleTonemap => {
-            let next = match view.tonemap {
-                Tonemap::Neutral => Tonemap::Aces,
-                Tonemap::Aces => Tonemap::None,
-                Tonemap::None => Tonemap::Neutral,
-            };
-            apply(Action::SetTonemap(next), view, sun)
         }
         Action::ToggleContact => {
             s.contact = !s.contact;
@@ -205,36 +212,14 @@ pub fn apply(a: Action, view: &mut View, sun: &mut SunAngles) -> String {
                 }
             )
         }
-        Action::ToggleMethod => {
-            let next = match view.shadow.method {
-                ShadowMethod::Map => ShadowMethod::Exact,
-                ShadowMethod::Exact => ShadowMethod::Map,
-            };
-            apply(Action::SetMethod(next), view, sun)
-        }
         Action::ToggleFxaa => {
             view.post_aa = match view.post_aa {
                 PostAa::None => PostAa::Fxaa,
                 PostAa::Fxaa => PostAa::None,
             };
-            format!(
-                "FXAA: {}",
-                if view.post_aa == PostAa::Fxaa {
-                    "on"
-                } else {
-                    "off"
-                }
-            )
+            format!("FXAA: {}", on_off(view.post_aa == PostAa::Fxaa))
         }
-        Action::ExposureUp | Action::ExposureDown => {
-            let step = if a == Action::ExposureUp { 0.5 } else { -0.5 };
-            apply(
-                Action::SetExposure(view.exposure_compensation + step),
-                view,
-                sun,
-            )
-        }
-        _ => unreachable!("set actions are applied by apply_set"),
+        _ => unreachable!("set and stepping actions are applied by apply_set and step"),
     }
 }
 

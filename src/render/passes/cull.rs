@@ -34,7 +34,7 @@ pub enum Entry {
     /// `fs_main`: opaque materials, lit image, no discard (early depth on llvmpipe).
     Opaque,
     /// `fs_main_flat`: `Opaque` with the uniforms as flat inputs (large triangles on CPU
-    /// devices: `camera_pass::FLAT_FROM_PIXELS`).
+    /// devices: `camera::FLAT_FROM_PIXELS`).
     OpaqueFlat,
     /// `fs_masked`: alpha-masked materials, lit image.
     Masked,

@@ -420,7 +420,7 @@ impl ExactPass {
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         let set = self.sets[slot];
-        let t = self.targets.as_mut().expect("exact targets made by ensure");
+        let mut t = self.targets.take().expect("exact targets made by ensure");
         use vk::AccessFlags2 as A;
         use vk::PipelineStageFlags2 as S;
         // The previous frame's reads and writes of the lists and samples come first.
@@ -437,7 +437,42 @@ impl ExactPass {
             ),
         );
         unsafe { d.cmd_fill_buffer(cmd, t.heads.raw, 0, vk::WHOLE_SIZE, 0) };
-        // 1. Receivers.
+        self.record_receivers(cmd, set, scene, f, &mut t);
+        let groups = (t.extent.width.div_ceil(8), t.extent.height.div_ceil(8));
+        if let ExactMode::Contact { .. } = f.mode {
+            bind(
+                d,
+                self.layout,
+                cmd,
+                (vk::PipelineBindPoint::COMPUTE, self.contact),
+                set,
+            );
+            unsafe { d.cmd_dispatch(cmd, groups.0, groups.1, 1) };
+            memory_barrier(
+                d,
+                cmd,
+                (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+                (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
+            );
+            self.targets = Some(t);
+            return;
+        }
+        self.record_binning(cmd, set, groups);
+        self.record_casters(cmd, set, scene, f);
+        self.targets = Some(t);
+    }
+
+    /// Step 1: the receivers' world positions and normals, depth-tested, into `t`.
+    fn record_receivers(
+        &self,
+        cmd: vk::CommandBuffer,
+        set: vk::DescriptorSet,
+        scene: &GpuScene,
+        f: &ExactFrameInputs,
+        t: &mut Targets,
+    ) {
+        let ctx = &self.ctx;
+        let d = &ctx.device;
         t.position.transition(d, cmd, Access::ColorAttachment);
         t.normal.transition(d, cmd, Access::ColorAttachment);
         t.depth.transition(d, cmd, Access::DepthAttachment);
@@ -470,16 +505,8 @@ impl ExactPass {
             (vk::PipelineBindPoint::GRAPHICS, self.receiver),
             set,
         );
-        set_viewport(&ctx, cmd, t.extent);
-        unsafe {
-            d.cmd_bind_vertex_buffers(
-                cmd,
-                0,
-                &[scene.positions.raw, scene.attributes.raw],
-                &[0, 0],
-            );
-            d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-        }
+        set_viewport(ctx, cmd, t.extent);
+        scene.bind_geometry(d, cmd);
         for &i in &f.receivers {
             let dr = &scene.draws[i];
             scene.bind_material(d, cmd, self.layout, 1, dr.material);
@@ -499,25 +526,13 @@ impl ExactPass {
         unsafe { d.cmd_end_rendering(cmd) };
         t.position.transition(d, cmd, Access::ComputeSampled);
         t.normal.transition(d, cmd, Access::ComputeSampled);
-        let groups = (t.extent.width.div_ceil(8), t.extent.height.div_ceil(8));
-        if let ExactMode::Contact { .. } = f.mode {
-            bind(
-                d,
-                self.layout,
-                cmd,
-                (vk::PipelineBindPoint::COMPUTE, self.contact),
-                set,
-            );
-            unsafe { d.cmd_dispatch(cmd, groups.0, groups.1, 1) };
-            memory_barrier(
-                d,
-                cmd,
-                (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
-                (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
-            );
-            return;
-        }
-        // 2. Binning.
+    }
+
+    /// Step 2: each pixel's shadow ray binned into the grid of light views (`groups` of 8×8).
+    fn record_binning(&self, cmd: vk::CommandBuffer, set: vk::DescriptorSet, groups: (u32, u32)) {
+        let d = &self.ctx.device;
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
         memory_barrier(
             d,
             cmd,
@@ -544,7 +559,21 @@ impl ExactPass {
                 A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
             ),
         );
-        // 3. Casters, into the grid (no attachments: the fragments only test and mark).
+    }
+
+    /// Step 3: the casters drawn into the grid (no attachments: the fragments only test and mark
+    /// the rays they hit), then made visible to the camera pass's fragments.
+    fn record_casters(
+        &self,
+        cmd: vk::CommandBuffer,
+        set: vk::DescriptorSet,
+        scene: &GpuScene,
+        f: &ExactFrameInputs,
+    ) {
+        let ctx = &self.ctx;
+        let d = &ctx.device;
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
         let side = grid_side(f.views.len());
         let grid = vk::Extent2D {
             width: side,
@@ -564,7 +593,7 @@ impl ExactPass {
             (vk::PipelineBindPoint::GRAPHICS, self.caster),
             set,
         );
-        set_viewport(&ctx, cmd, grid);
+        set_viewport(ctx, cmd, grid);
         unsafe {
             d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
             d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);

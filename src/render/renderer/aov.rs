@@ -8,7 +8,7 @@ use crate::gpu::context::{GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
 use crate::plan::settings::{View, ViewMode};
 use crate::plan::FramePlan;
-use crate::render::passes::camera_pass::AOV_FORMATS;
+use crate::render::passes::camera::AOV_FORMATS;
 use crate::render::targets::Attachment;
 use ash::vk;
 use gpu_allocator::MemoryLocation;

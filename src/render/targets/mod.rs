@@ -7,7 +7,7 @@ pub(crate) mod swapchain;
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::Image;
-use crate::render::passes::camera_pass::DEPTH_FORMAT;
+use crate::render::passes::camera::DEPTH_FORMAT;
 use ash::vk;
 use std::sync::Arc;
 

@@ -25,11 +25,13 @@ mod draco;
 mod meshopt;
 mod quantized;
 mod report;
+mod sniff;
 mod textures;
 
 pub use accessor::accessor_type;
 pub use report::{CompressionReport, ExtensionUse};
-pub(super) use textures::{decode_ktx2, is_ktx2};
+pub(super) use sniff::is_ktx2;
+pub(super) use textures::decode_ktx2;
 
 use super::gltf_input::read_uri;
 use super::load_error::{corrupt, invalid, LoadError};

@@ -58,9 +58,9 @@ impl CompressionReport {
         pixels: usize,
         seconds: f64,
     ) {
-        let ext = if super::is_ktx2(stored) {
+        let ext = if super::sniff::is_ktx2(stored) {
             "KHR_texture_basisu"
-        } else if stored.len() >= 12 && &stored[0..4] == b"RIFF" && &stored[8..12] == b"WEBP" {
+        } else if super::sniff::is_webp(stored) {
             "EXT_texture_webp"
         } else {
             return;

@@ -8,16 +8,6 @@
 use super::report::CompressionReport;
 use serde_json::{json, Value};
 
-/// The KTX2 file identifier.
-const KTX2_MAGIC: [u8; 12] = [
-    0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A,
-];
-
-/// Whether `data` starts as a KTX2 file does.
-pub(in crate::scene) fn is_ktx2(data: &[u8]) -> bool {
-    data.starts_with(&KTX2_MAGIC)
-}
-
 /// Points each texture with an image extension this build decodes at that image.
 pub(super) fn use_extension_sources(json: &mut Value, report: &mut CompressionReport) {
     let decodes = [

@@ -5,29 +5,30 @@
 //! saves a screenshot. Key bindings: `keys`; the panel: `crate::app::panel`.
 
 mod files;
+mod init;
+mod input;
 mod keys;
 mod ui;
 
-use crate::app::actions::{apply, next_shadow_light, SunAngles};
-use crate::app::controller::{Button, Controller, Input};
+use crate::app::actions::SunAngles;
+use crate::app::controller::{Controller, Input};
 use crate::app::overlay::EguiOverlay;
 use crate::app::panel::{Stats, Widgets};
 use crate::app::script::ScriptStep;
 use anyhow::{anyhow, Context as _};
-use keys::{key_action, script_key, AnimKey, KeyAction};
+use keys::script_key;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
-use umbra::gpu::{Context, ContextDesc, Validation};
-use umbra::render::{effective_lights, surface_extensions, Capture, DrawResult, WindowRenderer};
+use umbra::gpu::Context;
+use umbra::render::{Capture, DrawResult, WindowRenderer};
 use umbra::render::{Overlay, View};
-use umbra::scene::{LightKind, Scene};
+use umbra::scene::Scene;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event::{ElementState, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{KeyCode, PhysicalKey};
-use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
 /// Loads a model for the viewer as the command line loaded the first one (ground, pose).
@@ -167,134 +168,6 @@ impl App {
             self.error = Some(e);
         }
         el.exit();
-    }
-
-    fn init(&mut self, el: &ActiveEventLoop) -> anyhow::Result<State> {
-        #[cfg(not(feature = "sweep"))]
-        if self.opts.shadow_budget.is_some() {
-            anyhow::bail!("--shadow-budget needs umbra built with the `sweep` feature");
-        }
-        let (w, h) = self.opts.size;
-        let attrs = Window::default_attributes()
-            .with_title(format!("umbra — {}", self.opts.scene.name))
-            .with_inner_size(PhysicalSize::new(w, h));
-        let window = Arc::new(el.create_window(attrs).context("cannot create a window")?);
-        let display = window
-            .display_handle()
-            .map_err(|e| anyhow!("no display handle: {e}"))?
-            .as_raw();
-        let instance_extensions = surface_extensions(display)?;
-        let ctx = Context::new(&ContextDesc {
-            validation: Validation::required_if(self.opts.validation),
-            device: self.opts.device.clone(),
-            instance_extensions,
-            swapchain: true,
-            pipeline_cache: crate::app::pipeline_cache_path(),
-            ..Default::default()
-        })?;
-        let handle = window
-            .window_handle()
-            .map_err(|e| anyhow!("no window handle: {e}"))?
-            .as_raw();
-        let size = window.inner_size();
-        let renderer = WindowRenderer::new(
-            &ctx,
-            &self.opts.scene,
-            (display, handle),
-            (size.width, size.height),
-            self.opts.vsync,
-            &self.opts.scene_options,
-        )?;
-        let overlay = EguiOverlay::new(&ctx, &window, renderer.format())
-            .map_err(|e| eprintln!("warning: no panel: {e:#}"))
-            .ok();
-        let view = self.opts.view.clone();
-        let bounds = framing_bounds(&self.opts.scene);
-        let controller = Controller::from_camera(&view.camera, &bounds);
-        let lights = effective_lights(&self.opts.scene.lights, &view);
-        let sun_dir = lights
-            .iter()
-            .find(|l| l.kind == LightKind::Directional)
-            .map(|l| l.direction)
-            .unwrap_or(glam::Vec3::NEG_Y);
-        println!(
-            "viewer: {} on {} ({} triangles); press Esc to quit, F1 for the panel",
-            self.opts.scene.name,
-            ctx.device_name,
-            renderer.triangles()
-        );
-        let watch = self.opts.path.as_deref().and_then(|p| {
-            crate::app::reload::Watch::new(p)
-                .map_err(|e| eprintln!("warning: {}: not watched for changes: {e}", p.display()))
-                .ok()
-        });
-        let tree = self
-            .opts
-            .path
-            .as_deref()
-            .and_then(|p| files::tree_of(p, &self.opts.scene));
-        let triangles = renderer.triangles();
-        Ok(State {
-            overlay,
-            renderer,
-            #[cfg(feature = "reference")]
-            pick_renderer: None,
-            cursor: (0.0, 0.0),
-            press_at: None,
-            ctx,
-            window,
-            controller,
-            bounds,
-            view,
-            sun: SunAngles::from_direction(sun_dir),
-            camera_index: None,
-            drawn: 0,
-            rss_warm: None,
-            ticks: 0,
-            first_draw: None,
-            last_frame: Instant::now(),
-            last_title: Instant::now(),
-            frame_ms: Vec::new(),
-            cpu_ms: Vec::new(),
-            want_screenshot: false,
-            screenshot_count: 0,
-            script_pos: 0,
-            minimized: size.width == 0 || size.height == 0,
-            player: crate::app::player::Player::new(
-                self.opts.scene.rig.as_deref(),
-                self.opts.start.clone(),
-            ),
-            pose_dirty: false,
-            panel: PanelState {
-                open: self.opts.panel,
-                widgets: Widgets::default(),
-                events: Vec::new(),
-                release: None,
-                release_due: None,
-                stats: Stats {
-                    triangles,
-                    ..Default::default()
-                },
-                pick: None,
-                tree,
-                selected: None,
-                status: None,
-            },
-            watch,
-            reloads: 0,
-            waiting: None,
-            #[cfg(feature = "sweep")]
-            budget: self.opts.shadow_budget.map(|b| {
-                crate::app::budget_worker::BudgetWorker::start(
-                    self.opts.scene.clone(),
-                    b,
-                    self.opts.device.clone(),
-                    self.opts.validation,
-                )
-            }),
-            budget_value: self.opts.shadow_budget,
-            worker_problems: 0,
-        })
     }
 
     /// Runs the input script's next step when it is due (one every `SCRIPT_STEP_FRAMES` frames;
@@ -464,209 +337,6 @@ impl App {
             }
         }
         Ok(())
-    }
-
-    /// Picks at window position (`x`, `y`): reports what is there (printed and in the panel)
-    /// and highlights its primitive (nothing there: clears the highlight).
-    #[cfg(feature = "reference")]
-    fn pick(&mut self, x: f32, y: f32) {
-        let Some(s) = self.state.as_mut() else { return };
-        let size = s.window.inner_size();
-        let (w, h) = (size.width, size.height);
-        if w == 0 || h == 0 || x >= w as f32 || y >= h as f32 {
-            println!("pick: ({x:.0}, {y:.0}) is outside the {w}x{h} window");
-            return;
-        }
-        let scene = &self.opts.scene;
-        let result = (|| -> anyhow::Result<String> {
-            if s.pick_renderer.is_none() {
-                s.pick_renderer = Some(umbra::render::Renderer::with_options(
-                    &s.ctx,
-                    scene,
-                    &self.opts.scene_options,
-                )?);
-            }
-            let r = s.pick_renderer.as_mut().expect("created above");
-            let mut v = s.view.clone();
-            v.mode = umbra::render::ViewMode::Shadow;
-            v.highlight = None;
-            let frame = r.render(&v, w, h)?;
-            let reference = umbra_lab::reference::ReferenceScene::new(scene);
-            // Continuous window coordinates: pixel (i, j) spans [i, i + 1) × [j, j + 1).
-            let pick = reference.pick(&frame.plan, x, y, w, h);
-            let gpu = frame.image.get_pixel(x as u32, y as u32)[0] as f32 / 255.0;
-            s.view.highlight = pick.as_ref().map(|p| (p.instance, p.primitive));
-            Ok(crate::app::pick::describe(
-                scene,
-                &frame.plan,
-                (x, y),
-                pick.as_ref(),
-                Some(gpu),
-            ))
-        })();
-        let line = result.unwrap_or_else(|e| format!("pick: failed: {e:#}"));
-        println!("{line}");
-        s.panel.pick = Some(line);
-    }
-
-    #[cfg(not(feature = "reference"))]
-    fn pick(&mut self, x: f32, y: f32) {
-        let line = format!(
-            "pick: ({x:.0}, {y:.0}): picking needs umbra built with the `reference` feature"
-        );
-        println!("{line}");
-        if let Some(s) = self.state.as_mut() {
-            s.panel.pick = Some(line);
-        }
-    }
-
-    fn wheel(&mut self, lines: f32) {
-        if let Some(s) = self.state.as_mut() {
-            s.camera_index = None;
-            s.controller.handle(Input::Scroll(lines));
-        }
-    }
-
-    fn key(&mut self, el: &ActiveEventLoop, code: KeyCode, pressed: bool) {
-        let Some(action) = key_action(code) else {
-            return;
-        };
-        match action {
-            KeyAction::Move(k) => {
-                if let Some(s) = self.state.as_mut() {
-                    s.controller.handle(Input::Key(k, pressed));
-                }
-            }
-            _ if !pressed => {}
-            a => self.act(el, a),
-        }
-    }
-
-    /// Does what a key (or the panel's widget for it) does.
-    fn act(&mut self, el: &ActiveEventLoop, action: KeyAction) {
-        let opts = &self.opts;
-        let Some(s) = self.state.as_mut() else { return };
-        match action {
-            KeyAction::Move(_) => {}
-            KeyAction::Setting(a) => println!("{}", apply(a, &mut s.view, &mut s.sun)),
-            KeyAction::ShadowLight => {
-                let n = effective_lights(&opts.scene.lights, &s.view).len();
-                println!("{}", next_shadow_light(&mut s.view, n));
-            }
-            KeyAction::Frame => {
-                s.camera_index = None;
-                let size = s.window.inner_size();
-                s.controller.frame(
-                    &s.bounds,
-                    size.width.max(1) as f32 / size.height.max(1) as f32,
-                );
-                println!("camera: framing the scene");
-            }
-            KeyAction::ToggleFly => {
-                s.camera_index = None;
-                s.controller.toggle_mode();
-                println!("camera: {:?}", s.controller.mode);
-            }
-            KeyAction::NextCamera => {
-                if opts.scene.cameras.is_empty() {
-                    println!("camera: the scene has no cameras");
-                } else {
-                    let i = s
-                        .camera_index
-                        .map(|i| (i + 1) % opts.scene.cameras.len())
-                        .unwrap_or(0);
-                    self.use_camera(Some(i));
-                }
-            }
-            KeyAction::ToggleOrthographic => {
-                if let Some(i) = s.camera_index.take() {
-                    // Continue from the glTF camera on screen.
-                    s.controller = Controller::from_camera(&opts.scene.cameras[i], &s.bounds);
-                }
-                s.controller.toggle_projection();
-                let kind = if s.controller.orthographic {
-                    "orthographic"
-                } else {
-                    "perspective"
-                };
-                println!("camera: {kind}");
-            }
-            KeyAction::Screenshot => s.want_screenshot = true,
-            KeyAction::Anim(k) => {
-                let p = &mut s.player;
-                let line = match k {
-                    AnimKey::Toggle => p.toggle(),
-                    AnimKey::Step(n) => p.step(n),
-                    AnimKey::Speed(f) => p.scale_speed(f),
-                    AnimKey::Next => p.next_animation(),
-                };
-                s.pose_dirty = true;
-                println!("{line}");
-            }
-            KeyAction::TogglePanel => {
-                s.panel.open = !s.panel.open && s.overlay.is_some();
-                if let Some(o) = s.overlay.as_mut() {
-                    o.clear();
-                }
-                println!("panel: {}", if s.panel.open { "shown" } else { "hidden" });
-            }
-            KeyAction::Quit => el.exit(),
-        }
-    }
-
-    /// Looks through glTF camera `i` (None: back to the viewer's own camera).
-    fn use_camera(&mut self, i: Option<usize>) {
-        let opts = &self.opts;
-        let Some(s) = self.state.as_mut() else { return };
-        s.camera_index = i.filter(|&i| i < opts.scene.cameras.len());
-        match s.camera_index {
-            Some(i) => {
-                s.view.camera = opts.scene.cameras[i];
-                s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
-                let kind = if s.view.camera.is_orthographic() {
-                    "orthographic"
-                } else {
-                    "perspective"
-                };
-                println!("camera: glTF camera {i} ({kind})");
-            }
-            None => println!("camera: the viewer's"),
-        }
-    }
-
-    /// A mouse button: a left click that does not move the cursor (3 px) picks; buttons drive
-    /// the camera controller.
-    fn mouse(&mut self, state: ElementState, button: MouseButton) {
-        let b = match button {
-            MouseButton::Left => Some(Button::Left),
-            MouseButton::Right => Some(Button::Right),
-            MouseButton::Middle => Some(Button::Middle),
-            _ => None,
-        };
-        let mut click = None;
-        if let (Some(Button::Left), Some(s)) = (b, self.state.as_mut()) {
-            if state == ElementState::Pressed {
-                s.press_at = Some(s.cursor);
-            } else if let Some((px, py)) = s.press_at.take() {
-                let (cx, cy) = s.cursor;
-                if (cx - px).abs() <= 3.0 && (cy - py).abs() <= 3.0 {
-                    click = Some((cx, cy));
-                }
-            }
-        }
-        if let Some((x, y)) = click {
-            self.pick(x, y);
-        }
-        if let (Some(b), Some(s)) = (b, self.state.as_mut()) {
-            if s.camera_index.take().is_some() {
-                s.controller = Controller::from_camera(&s.view.camera, &s.bounds);
-            }
-            s.controller.handle(if state == ElementState::Pressed {
-                Input::Press(b)
-            } else {
-                Input::Release(b)
-            });
-        }
     }
 }
 
