@@ -30,12 +30,15 @@ fn main() {
         .filter(|p| p.extension().is_some_and(|x| x == "wgsl"))
         .collect();
     entries.sort();
-    let mut generated = String::new();
+    let (mut generated, mut consts) = (String::new(), String::new());
     let mut failures = Vec::new();
     for path in &entries {
         println!("cargo:rerun-if-changed={}", path.display());
         match compile(path, &out_dir) {
-            Ok(code) => generated.push_str(&code),
+            Ok((code, c)) => {
+                generated.push_str(&code);
+                consts.push_str(&c);
+            }
             Err(msg) => failures.push(msg),
         }
     }
@@ -47,6 +50,8 @@ fn main() {
         panic!("shader compilation failed:\n{}", failures.join("\n"));
     }
     std::fs::write(Path::new(&out_dir).join("shaders.rs"), generated).expect("write shaders.rs");
+    std::fs::write(Path::new(&out_dir).join("shader_consts.rs"), consts)
+        .expect("write shader_consts.rs");
 }
 
 /// A shader's source with its `#include` lines expanded, and for each line of it the file and
@@ -111,7 +116,7 @@ fn location_prefix(path: &Path, composed: &Composed, loc: Option<naga::SourceLoc
     }
 }
 
-fn compile(path: &Path, out_dir: &str) -> Result<String, String> {
+fn compile(path: &Path, out_dir: &str) -> Result<(String, String), String> {
     let composed = compose(path)?;
     let source = composed.source.as_str();
     let file = path.display().to_string();
@@ -276,7 +281,7 @@ fn pack(out_dir: &str, stem: &str, spirv: &[(usize, Vec<u8>)]) -> Result<Packed,
 
 /// The generated module of one shader: its SPIR-V variants, override bits and dependants, named
 /// constants, bindings, immediate size and entry points.
-fn reflect(shader: &Shader) -> Result<String, String> {
+fn reflect(shader: &Shader) -> Result<(String, String), String> {
     let Shader {
         file, module, info, ..
     } = *shader;
@@ -291,12 +296,27 @@ fn reflect(shader: &Shader) -> Result<String, String> {
     writeln!(code, "    #[allow(unused_imports)] use super::*;").unwrap();
     writeln!(
         code,
+        "    /// The override bits and named constants (no Vulkan: `crate::shader_consts`).\n    #[allow(unused_imports)]\n    pub use crate::shader_consts::{stem}::*;"
+    )
+    .unwrap();
+    writeln!(
+        code,
         "    /// SPIR-V of every override combination, indexed by the bit mask of `OVERRIDES`."
     )
     .unwrap();
     variants_code(shader, &mut code);
-    constants_code(module, &mut code);
     bindings_code(module, info, &layouter, &mut code);
+    let mut consts = String::new();
+    writeln!(
+        consts,
+        "/// The override bits and named constants of `{}`.",
+        file
+    )
+    .unwrap();
+    writeln!(consts, "pub mod {stem} {{").unwrap();
+    override_bits_code(shader, &mut consts);
+    constants_code(module, &mut consts);
+    writeln!(consts, "}}").unwrap();
     for ep in &module.entry_points {
         writeln!(code, "    /// Entry point `{}`.", ep.name).unwrap();
         writeln!(
@@ -308,16 +328,11 @@ fn reflect(shader: &Shader) -> Result<String, String> {
         .unwrap();
     }
     writeln!(code, "}}").unwrap();
-    Ok(code)
+    Ok((code, consts))
 }
 
-/// The SPIR-V variants, the override list, each override's bit and each override's dependants.
+/// The SPIR-V variants, packed.
 fn variants_code(shader: &Shader, code: &mut String) {
-    let Shader {
-        overrides,
-        requires,
-        ..
-    } = *shader;
     let canonical = &shader.canonical;
     let chunks: Vec<String> = shader
         .packed
@@ -354,6 +369,15 @@ fn variants_code(shader: &Shader, code: &mut String) {
         "    /// SPIR-V with every boolean override on.\n    pub fn spirv() -> Result<Vec<u8>, GpuError> {{\n        variant(VARIANT_AT.len() - 1)\n    }}"
     )
     .unwrap();
+}
+
+/// The boolean overrides, each one's variant bit and each one's dependants.
+fn override_bits_code(shader: &Shader, code: &mut String) {
+    let Shader {
+        overrides,
+        requires,
+        ..
+    } = *shader;
     writeln!(
         code,
         "    /// The boolean overrides, bit i of a variant index = `OVERRIDES[i]`.\n    #[allow(dead_code)]\n    pub const OVERRIDES: &[&str] = &[{}];",

@@ -10,9 +10,9 @@ live=target/tmp/umbra-test-output/compressed_live
 rm -rf "$live"
 # The test writes the generated models and their re-encodings (UMBRA_GLTF_TOOLS) before it judges
 # them; its verdict is read below, once the fixtures are in place.
-UMBRA_GLTF_TOOLS="$tools" cargo test --test compressed recompressed -- --nocapture >/dev/null 2>&1 || true
+UMBRA_GLTF_TOOLS="$tools" cargo test --test engine compressed::recompressed -- --nocapture >/dev/null 2>&1 || true
 mkdir -p tests/data/compressed
 rm -f tests/data/compressed/*.glb
 cp "$live"/*.glb tests/data/compressed/
 ls tests/data/compressed/*.glb | wc -l | xargs echo "fixtures written:"
-cargo test --test compressed recompressed -- --nocapture
+cargo test --test engine compressed::recompressed -- --nocapture

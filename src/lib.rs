@@ -33,6 +33,7 @@ pub(crate) mod parallel;
 pub mod plan;
 pub mod render;
 pub mod scene;
+pub(crate) mod shader_consts;
 pub mod table;
 
 pub use gpu::{Context, ContextDesc, GpuError, Validation, ValidationLog};

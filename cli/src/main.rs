@@ -598,7 +598,7 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
             if !budgeted {
                 v.shadow.pcf = pcf_of(k);
             }
-            let side = renderer.render(&v, w, h)?.plan.shadow_map_size;
+            let side = renderer.render(&v, w, h)?.plan.shadow_map_size();
             let mut frames = Vec::new();
             for _ in 0..a.repeat.max(1) {
                 frames.push(renderer.render(&v, w, h)?.stats);

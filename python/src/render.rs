@@ -479,7 +479,9 @@ impl OffscreenRenderer {
     /// Samples a pixel of the colour image on this device (`msaa` resolved).
     #[getter]
     fn samples(&self) -> PyResult<u32> {
-        Ok(self.options.resolved_samples(&*self.ctx()?))
+        Ok(self
+            .options
+            .resolved_samples(&umbra::render::device_facts(&*self.ctx()?)))
     }
 
     /// Validation messages of warning or error severity so far (with `validation=True`).

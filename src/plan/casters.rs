@@ -2,7 +2,6 @@
 //! viewpoint their faces are tested against.
 
 use crate::math::Aabb;
-use ash::vk;
 use glam::{Vec3, Vec4};
 
 /// What a draw's faces are tested against when clusters are skipped.
@@ -41,6 +40,19 @@ pub fn flat_hides_nothing(plane: Vec4, from: Viewpoint, scene: &Aabb) -> bool {
         .all(|c| s * (n.dot(*c) + plane.w) >= -tolerance)
 }
 
+/// A rectangle of a shadow-map layer, in texels: its corner and size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TexelRect {
+    /// First column.
+    pub x: u32,
+    /// First row.
+    pub y: u32,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
 /// The casters one frame draws into the shadow map, and the texels they can touch.
 #[derive(Clone, Debug)]
 pub struct CasterPlan {
@@ -48,7 +60,7 @@ pub struct CasterPlan {
     pub draws: Vec<usize>,
     /// The texels the pass clears and draws (the casters' rectangle grown by twice the lookup
     /// reach, so every texel a lookup inside `lookup` reads is written this frame).
-    pub area: vk::Rect2D,
+    pub area: TexelRect,
     /// Texel rectangle `(x0, y0, x1, y1)` outside which a lookup's footprint meets no caster
     /// texel (the casters' rectangle grown by the reach): such lookups are lit without a read.
     pub lookup: Vec4,
@@ -63,12 +75,11 @@ impl Default for CasterPlan {
     fn default() -> Self {
         Self {
             draws: Vec::new(),
-            area: vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent: vk::Extent2D {
-                    width: 1,
-                    height: 1,
-                },
+            area: TexelRect {
+                x: 0,
+                y: 0,
+                width: 1,
+                height: 1,
             },
             lookup: Vec4::new(1.0, 1.0, -1.0, -1.0),
             light: Viewpoint::Along(Vec3::NEG_Y),

@@ -4,9 +4,9 @@ use super::input::PlanScene;
 use super::settings::{Ambient, Exposure, View, UNIT_AMBIENT};
 use super::uniforms::{LightUniform, MAX_LIGHTS};
 use super::views::{soft_size, ShadowView};
-use crate::gpu::shaders::scene as sh;
 use crate::math::Aabb;
 use crate::scene::{Light, LightKind};
+use crate::shader_consts::scene as sh;
 use glam::{Vec3, Vec4};
 
 /// Elevation of the default sun used when a scene has no light (degrees): a key light from the

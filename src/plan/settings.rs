@@ -50,7 +50,7 @@ pub enum ViewMode {
 impl ViewMode {
     /// Shader constant.
     pub fn shader_value(self) -> u32 {
-        use crate::gpu::shaders::scene as sh;
+        use crate::shader_consts::scene as sh;
         match self {
             ViewMode::Lit | ViewMode::ShadowMap => sh::VIEW_LIT,
             ViewMode::Shadow => sh::VIEW_SHADOW,
@@ -340,65 +340,64 @@ impl Default for SceneOptions {
     }
 }
 
+/// What the plan needs to know of a device, as plain values (`render::device_facts` reads them
+/// from a Vulkan context): the plan never sees the device itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeviceFacts {
+    /// A CPU device (lavapipe): the defaults that pay there differ.
+    pub cpu: bool,
+    /// Sample counts (bit n set: 2ⁿ samples) that colour and depth attachments both support.
+    pub sample_counts: u32,
+    /// Whether the deferred path's formats work: D32_SFLOAT_S8_UINT as a depth-stencil
+    /// attachment, R32G32B32A32_SFLOAT as a colour attachment and sampled image.
+    pub deferred_formats: bool,
+    /// The largest sampler anisotropy, None when the feature is off.
+    pub max_anisotropy: Option<f32>,
+}
+
 impl SceneOptions {
-    /// The MSAA sample count to use on `ctx`'s device: `msaa` (or the device class's default)
+    /// The MSAA sample count to use on the device: `msaa` (or the device class's default)
     /// rounded down to a count its colour and depth attachments both support.
-    pub fn resolved_samples(&self, ctx: &crate::gpu::Context) -> u32 {
-        let cpu = ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU;
-        let wanted = self.msaa.unwrap_or(if cpu { 1 } else { 4 }).clamp(1, 64);
-        let l = &ctx.properties.limits;
-        let supported = l.framebuffer_color_sample_counts & l.framebuffer_depth_sample_counts;
+    pub fn resolved_samples(&self, device: &DeviceFacts) -> u32 {
+        let wanted = self
+            .msaa
+            .unwrap_or(if device.cpu { 1 } else { 4 })
+            .clamp(1, 64);
         // The largest power of two not above `wanted`, then down to what the device has.
         let mut n = 1u32 << wanted.ilog2();
-        while n > 1 && !supported.contains(ash::vk::SampleCountFlags::from_raw(n)) {
+        while n > 1 && device.sample_counts & n == 0 {
             n /= 2;
         }
         n.max(1)
     }
 
-    /// Whether mip chains are made on the CPU on `ctx`'s device (`cpu_mips`, or its default).
-    pub fn resolved_cpu_mips(&self, ctx: &crate::gpu::Context) -> bool {
-        self.cpu_mips
-            .unwrap_or(ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU)
+    /// Whether mip chains are made on the CPU on the device (`cpu_mips`, or its default).
+    pub fn resolved_cpu_mips(&self, device: &DeviceFacts) -> bool {
+        self.cpu_mips.unwrap_or(device.cpu)
     }
 
-    /// Whether micro-triangle draws may be shaded deferred on `ctx`'s device (`deferred`, or its
+    /// Whether micro-triangle draws may be shaded deferred on the device (`deferred`, or its
     /// default; the camera pass also needs one sample per pixel).
-    pub fn resolved_deferred(&self, ctx: &crate::gpu::Context) -> bool {
-        use ash::vk::{Format, FormatFeatureFlags as F};
-        let wanted = self
-            .deferred
-            .unwrap_or(ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU);
-        let has = |format, features| {
-            let p = unsafe {
-                ctx.instance
-                    .get_physical_device_format_properties(ctx.physical, format)
-            };
-            p.optimal_tiling_features.contains(features)
-        };
-        wanted
-            && has(Format::D32_SFLOAT_S8_UINT, F::DEPTH_STENCIL_ATTACHMENT)
-            && has(
-                Format::R32G32B32A32_SFLOAT,
-                F::COLOR_ATTACHMENT | F::SAMPLED_IMAGE,
-            )
+    pub fn resolved_deferred(&self, device: &DeviceFacts) -> bool {
+        self.deferred.unwrap_or(device.cpu) && device.deferred_formats
     }
 
-    /// Whether small receivers are drawn unshadowed beyond the casters' reach on `ctx`'s
-    /// device (`receiver_split`, or its default).
-    pub fn resolved_receiver_split(&self, ctx: &crate::gpu::Context) -> bool {
-        self.receiver_split
-            .unwrap_or(ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU)
+    /// Whether small receivers are drawn unshadowed beyond the casters' reach on the device
+    /// (`receiver_split`, or its default).
+    pub fn resolved_receiver_split(&self, device: &DeviceFacts) -> bool {
+        self.receiver_split.unwrap_or(device.cpu)
     }
 
-    /// The anisotropy to use on `ctx`'s device (1.0 = off), clamped to what it supports.
-    pub fn resolved_anisotropy(&self, ctx: &crate::gpu::Context) -> f32 {
-        if !ctx.anisotropy {
+    /// The anisotropy to use on the device (1.0 = off), clamped to what it supports.
+    pub fn resolved_anisotropy(&self, device: &DeviceFacts) -> f32 {
+        let Some(max) = device.max_anisotropy else {
             return 1.0;
-        }
-        let cpu = ctx.properties.device_type == ash::vk::PhysicalDeviceType::CPU;
-        let wanted = self.anisotropy.unwrap_or(if cpu { 1 } else { 8 }).max(1) as f32;
-        wanted.min(ctx.properties.limits.max_sampler_anisotropy.max(1.0))
+        };
+        let wanted = self
+            .anisotropy
+            .unwrap_or(if device.cpu { 1 } else { 8 })
+            .max(1) as f32;
+        wanted.min(max.max(1.0))
     }
 }
 

@@ -1,7 +1,7 @@
-//! `#[repr(C)]` mirrors of the shader structs; sizes are checked at compile time against the sizes
-//! naga computed from the WGSL (see `build.rs`).
+//! `#[repr(C)]` mirrors of the shader structs; their sizes are checked at compile time against the
+//! sizes naga computed from the WGSL (`build.rs`), in `render::pipeline`, where both are known.
 
-use crate::gpu::shaders;
+use crate::shader_consts as shaders;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec4};
 
@@ -134,15 +134,6 @@ pub struct ShadowImmediates {
     /// Model → world.
     pub world_from_model: Mat4,
 }
-
-const _: () =
-    assert!(std::mem::size_of::<FrameUniform>() == shaders::scene::FRAME_BLOCK.size as usize);
-const _: () =
-    assert!(std::mem::size_of::<MaterialUniform>() == shaders::scene::MATERIAL_BLOCK.size as usize);
-const _: () =
-    assert!(std::mem::size_of::<SceneImmediates>() == shaders::scene::IMMEDIATE_SIZE as usize);
-const _: () =
-    assert!(std::mem::size_of::<ShadowImmediates>() == shaders::shadow::IMMEDIATE_SIZE as usize);
 
 impl SceneImmediates {
     /// Immediates for a model transform (normal matrix = inverse transpose of its 3×3).

@@ -6,13 +6,13 @@ use super::casters::CasterPlan;
 use super::input::{PlanScene, PlanTarget};
 use super::settings::{HeldLight, Pcf, ShadowFit, ShadowSettings, View, MAX_CASCADES};
 use super::uniforms::{ShadowViewUniform, MAX_SHADOW_VIEWS};
-use crate::gpu::shaders::scene as sh;
 use crate::math::shadow_fit::{
     cascade_splits, fit_directional, fit_point_faces, fit_spot, frustum_box_intersection, widened,
     CameraFrustum, DirectionalFit, DirectionalFitInput,
 };
 use crate::math::Aabb;
 use crate::scene::{Camera, Light, LightKind};
+use crate::shader_consts::scene as sh;
 use glam::{Mat4, Vec4};
 
 /// Weight of logarithmic against uniform cascade splits (`cascade_splits`) under a perspective

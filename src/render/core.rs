@@ -2,6 +2,7 @@
 //! passes, the frame plan, and GPU timestamps, with one slot per frame in flight. Both targets
 //! record exactly the same commands, so the window and the capture give the same pixels.
 
+use super::device::device_facts;
 use super::gpu_scene::GpuScene;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
@@ -78,16 +79,17 @@ impl FrameCore {
         let receiver_bounds = gpu.draws.iter().map(|d| d.world_bounds).collect();
         let mut shadow = ShadowPass::new(ctx)?;
         shadow.set_caching(options.shadow_cache);
-        let samples = options.resolved_samples(ctx);
+        let device = device_facts(ctx);
+        let samples = options.resolved_samples(&device);
         let camera = CameraPass::new(
             ctx,
             &gpu,
             color_format,
             samples,
             slots,
-            options.resolved_deferred(ctx),
+            options.resolved_deferred(&device),
         )?;
-        let receiver_split = options.resolved_receiver_split(ctx);
+        let receiver_split = options.resolved_receiver_split(&device);
         let post = PostAaPass::new(ctx, color_format)?;
         let query_pool = unsafe {
             ctx.device.create_query_pool(
@@ -139,13 +141,7 @@ impl FrameCore {
         width: u32,
         height: u32,
     ) -> Result<Prepared, GpuError> {
-        let map_size = if view.shadow.enabled {
-            view.shadow.clamped_map_size()
-        } else {
-            1
-        };
         let mut v = view.rebased(self.origin);
-        v.shadow.map_size = map_size;
         // Exact shadows judge every receiver pixel themselves: one view (the map's single
         // cascade, for the pixels they do not judge) and hard.
         let exact_asked = view.shadow.enabled
@@ -184,7 +180,7 @@ impl FrameCore {
         }
         let layers = plan.shadow_views.len().max(1) as u32;
         self.shadow
-            .ensure_map(plan.shadow_map_size, format, layers)?;
+            .ensure_map(plan.shadow_map_size(), format, layers)?;
         self.shadow.ensure_masked(&self.gpu, format)?;
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         let casters = if plan.shadows_on {

@@ -5,6 +5,7 @@
 //! public types are re-exported here.
 
 pub(crate) mod core;
+mod device;
 pub(crate) mod gpu_scene;
 pub(crate) mod passes;
 pub(crate) mod pipeline;
@@ -16,11 +17,12 @@ pub(crate) mod targets;
 pub(crate) mod window;
 
 pub use crate::plan::{
-    effective_lights, metered_illuminance, Ambient, Background, Exposure, FramePlan, HeldLight,
-    Pcf, PostAa, SceneOptions, ScenePlanner, ShadowFit, ShadowFormat, ShadowHold, ShadowMethod,
-    ShadowSettings, ShadowView, Tonemap, View, ViewMode, MAX_CASCADES, MAX_LIGHTS,
+    effective_lights, metered_illuminance, Ambient, Background, DeviceFacts, Exposure, FramePlan,
+    HeldLight, Pcf, PostAa, SceneOptions, ScenePlanner, ShadowFit, ShadowFormat, ShadowHold,
+    ShadowMethod, ShadowSettings, ShadowView, Tonemap, View, ViewMode, MAX_CASCADES, MAX_LIGHTS,
     MAX_SHADOW_VIEWS, SUPERSAMPLE_FACTORS, UNIT_AMBIENT,
 };
+pub use device::device_facts;
 pub use renderer::{view_axis_depths, Aovs, FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 #[cfg(feature = "viewer")]
 pub use window::{

@@ -289,3 +289,35 @@ pub fn depth_clear_attachment(
             },
         })
 }
+
+/// `r` as Vulkan's rectangle.
+pub(crate) fn texel_rect(r: crate::plan::TexelRect) -> vk::Rect2D {
+    vk::Rect2D {
+        offset: vk::Offset2D {
+            x: r.x as i32,
+            y: r.y as i32,
+        },
+        extent: vk::Extent2D {
+            width: r.width,
+            height: r.height,
+        },
+    }
+}
+
+// The uniform blocks and immediates the plan writes are the size the shaders read.
+const _: () = assert!(
+    std::mem::size_of::<crate::plan::uniforms::FrameUniform>()
+        == crate::gpu::shaders::scene::FRAME_BLOCK.size as usize
+);
+const _: () = assert!(
+    std::mem::size_of::<crate::plan::uniforms::MaterialUniform>()
+        == crate::gpu::shaders::scene::MATERIAL_BLOCK.size as usize
+);
+const _: () = assert!(
+    std::mem::size_of::<crate::plan::uniforms::SceneImmediates>()
+        == crate::gpu::shaders::scene::IMMEDIATE_SIZE as usize
+);
+const _: () = assert!(
+    std::mem::size_of::<crate::plan::uniforms::ShadowImmediates>()
+        == crate::gpu::shaders::shadow::IMMEDIATE_SIZE as usize
+);

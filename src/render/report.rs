@@ -65,7 +65,7 @@ pub fn plan_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
         ShadowFormat::D16 => 2u64,
         _ => 4,
     };
-    let size = plan.shadow_map_size as u64;
+    let size = plan.shadow_map_size() as u64;
     let mut near = view.camera.near;
     let views: Vec<Value> = plan
         .primary_views()

@@ -27,8 +27,6 @@ pub struct FramePlan {
     /// Whether a shadowed light has a size: its lookups are soft (PCSS), and every lookup may
     /// read up to [`lookup_reach`] texels from its centre.
     pub soft: bool,
-    /// Side of the shadow map in texels.
-    pub shadow_map_size: u32,
     /// The shadow map's depth format (`ShadowFormat::Auto` resolved: never `Auto`).
     pub shadow_format: ShadowFormat,
     /// The camera's world position.
@@ -81,6 +79,12 @@ pub struct FramePlan {
 }
 
 impl FramePlan {
+    /// Side of the shadow map's layers in texels: the map size, or more where the automatic
+    /// setting doubled a view (held once, in the uniform block the shader reads).
+    pub fn shadow_map_size(&self) -> u32 {
+        self.uniform.shadow.x as u32
+    }
+
     /// The plan with each shadow view's casters (`casters[i]` for `shadow_views[i]`, from the
     /// renderer's scene), their lookup rectangles packed into the uniform block: the one place
     /// a plan is completed, before anything is recorded.
@@ -327,6 +331,15 @@ pub fn resolve_format(settings: &ShadowSettings, views: &[ShadowView]) -> Shadow
 
 /// Plans a frame for `view` of `scene` rendered into `target`: pure, no GPU.
 pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FramePlan {
+    // The one place the map size is settled: clamped into `ShadowSettings::MAP_SIZES`, 1
+    // without shadows (the layers' side, `FramePlan::shadow_map_size`, follows from it).
+    let mut settled = view.clone();
+    settled.shadow.map_size = if view.shadow.enabled {
+        view.shadow.clamped_map_size()
+    } else {
+        1
+    };
+    let view = &settled;
     let PlanTarget {
         aspect, hw_compare, ..
     } = *target;
@@ -405,7 +418,6 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         uniform: u,
         shadows_on,
         soft,
-        shadow_map_size: size,
         shadow_format,
         camera_position: view.camera.position(),
         orthographic: view.camera.is_orthographic(),
@@ -454,7 +466,7 @@ fn frame_variant_bits(
     views: usize,
     soft: bool,
 ) -> usize {
-    use crate::gpu::shaders::scene as sh;
+    use crate::shader_consts::scene as sh;
     let mut bits = 0;
     if one_sun {
         bits |= sh::BIT_ONE_SUN;

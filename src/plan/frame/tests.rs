@@ -104,7 +104,7 @@ fn default_sun_and_override() {
     assert_eq!(p.lights[0].direction, Vec3::NEG_Y);
     assert_eq!(p.uniform.modes[3], 1);
     // One light, shadows on, PCF 2×2 by hand (hw_compare false).
-    use crate::gpu::shaders::scene as sh;
+    use crate::shader_consts::scene as sh;
     let want = sh::BIT_ONE_SUN | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0;
     assert_eq!(p.shader_variant, want);
     // Cascades: four views, nearest first, each ending where the next blends in.
@@ -148,12 +148,12 @@ fn the_automatic_setting_doubles_one_map_before_it_splits_into_cascades() {
     let p = plan(&v, 6000);
     assert!(ratio_at(6000) < 4.0);
     assert_eq!((p.shadow_views.len(), p.shadow_views[0].res), (1, 2048));
-    assert_eq!(p.shadow_map_size, 2048);
+    assert_eq!(p.shadow_map_size(), 2048);
     // Ratio 4.5: one map of twice the side, half the texel (within the fit's rounding).
     let p = plan(&v, 7000);
     assert!(ratio_at(7000) > 4.0 && ratio_at(7000) < 5.0);
     assert_eq!((p.shadow_views.len(), p.shadow_views[0].res), (1, 4096));
-    assert_eq!(p.shadow_map_size, 4096);
+    assert_eq!(p.shadow_map_size(), 4096);
     assert_eq!(p.uniform.shadow.x, 4096.0);
     let half = p.shadow_views[0].texel_world / (texel * 0.5);
     assert!(
@@ -165,15 +165,15 @@ fn the_automatic_setting_doubles_one_map_before_it_splits_into_cascades() {
     assert!(ratio_at(8500) > 5.0);
     assert_eq!(p.shadow_views.len(), 2);
     assert!(p.shadow_views.iter().all(|sv| sv.res == 2048));
-    assert_eq!(p.shadow_map_size, 2048);
+    assert_eq!(p.shadow_map_size(), 2048);
     // A fixed count, or a map already at the largest doubled side, is never doubled.
     let mut fixed = v.clone();
     fixed.shadow.cascades = 1;
-    assert_eq!(plan(&fixed, 7000).shadow_map_size, 2048);
+    assert_eq!(plan(&fixed, 7000).shadow_map_size(), 2048);
     let mut big = v.clone();
     big.shadow.map_size = 4096;
     let p = plan(&big, 15000);
-    assert_eq!((p.shadow_views.len(), p.shadow_map_size), (2, 4096));
+    assert_eq!((p.shadow_views.len(), p.shadow_map_size()), (2, 4096));
 }
 
 #[test]
@@ -259,8 +259,8 @@ fn every_casting_light_gets_views_while_they_last() {
     let firsts: Vec<f32> = p.uniform.lights[..6].iter().map(|l| l.shadow.x).collect();
     assert_eq!(firsts, [0.0, 4.0, -1.0, 10.0, -1.0, -1.0]);
     assert_eq!(
-        p.shader_variant & crate::gpu::shaders::scene::BIT_MANY_VIEWS,
-        crate::gpu::shaders::scene::BIT_MANY_VIEWS
+        p.shader_variant & crate::shader_consts::scene::BIT_MANY_VIEWS,
+        crate::shader_consts::scene::BIT_MANY_VIEWS
     );
     // The shown light: the first shadowed one, or the one asked for if it has views.
     assert_eq!(p.shadow_light, Some(0));

@@ -160,7 +160,7 @@ pub(super) fn upload_textures(
     // Mip chains computed here (`SceneOptions::cpu_mips`: by default on CPU devices), a few
     // textures at a time on all cores (a 2048² chain is 21 MiB, dropped once uploaded), or
     // blitted on the device.
-    let cpu_mips = options.resolved_cpu_mips(ctx);
+    let cpu_mips = options.resolved_cpu_mips(&crate::render::device_facts(ctx));
     let batch = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut textures: Vec<Image> = Vec::new();
     let mut tex_index: HashMap<TextureJob, usize> = HashMap::new();

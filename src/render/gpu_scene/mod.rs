@@ -212,7 +212,7 @@ impl GpuScene {
         options: &SceneOptions,
         origin: glam::Vec3,
     ) -> Result<Self, GpuError> {
-        let anisotropy = options.resolved_anisotropy(ctx);
+        let anisotropy = options.resolved_anisotropy(&crate::render::device_facts(ctx));
         let Geometry {
             positions,
             attrs,

@@ -125,7 +125,7 @@ mod tests {
         LayerKey::new(
             &Mat4::from_translation(glam::Vec3::new(x, 0.0, 0.0)),
             &plan,
-            plan.area,
+            crate::render::pipeline::texel_rect(plan.area),
             (1.0, 0.1),
             statics,
         )

@@ -8,9 +8,10 @@ use crate::gpu::Image;
 use crate::math::Aabb;
 use crate::plan::settings::{ShadowFormat, ShadowSettings};
 use crate::plan::uniforms::ShadowImmediates;
-use crate::plan::{flat_hides_nothing, CasterPlan, Viewpoint};
+use crate::plan::{flat_hides_nothing, CasterPlan, TexelRect, Viewpoint};
 use crate::render::gpu_scene::{vertex_layout, GpuScene};
 use crate::render::passes::shadow_cache::{split_moving, LayerKey, LayerWork, ShadowCache};
+use crate::render::pipeline::texel_rect;
 use crate::render::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
     PipelineDesc, Stencil,
@@ -115,15 +116,11 @@ pub fn plan_casters(
         (ax1.ceil() as u32).max(ax0 + 1),
         (ay1.ceil() as u32).max(ay0 + 1),
     );
-    plan.area = vk::Rect2D {
-        offset: vk::Offset2D {
-            x: ax0 as i32,
-            y: ay0 as i32,
-        },
-        extent: vk::Extent2D {
-            width: ax1 - ax0,
-            height: ay1 - ay0,
-        },
+    plan.area = TexelRect {
+        x: ax0,
+        y: ay0,
+        width: ax1 - ax0,
+        height: ay1 - ay0,
     };
     plan
 }
@@ -257,7 +254,8 @@ impl ShadowPass {
             self.pipeline = depth_pipeline(&self.ctx, self.layout, self.module, false, fmt)?;
             self.pipeline_format = fmt;
         }
-        let size = size.clamp(1, *ShadowSettings::MAP_SIZES.end());
+        // The plan settled the size (`plan_frame`): clamped into `ShadowSettings::MAP_SIZES`.
+        debug_assert!((1..=*ShadowSettings::MAP_SIZES.end()).contains(&size));
         // More layers than needed are kept: a frame that needs fewer cascades (the automatic
         // count changes as the camera moves) reuses the map.
         if self.map.as_ref().is_some_and(|m| {
@@ -392,7 +390,7 @@ impl ShadowPass {
                 light_clip_from_world,
                 casters,
                 eye_near,
-                area: casters.area,
+                area: texel_rect(casters.area),
             };
             if !self.caching {
                 drawn += self.draw_layer(cmd, scene, s, &t, &casters.draws, true);
