@@ -4,3 +4,48 @@
 //! them beside each shader's SPIR-V and bindings.
 
 include!(concat!(env!("OUT_DIR"), "/shader_consts.rs"));
+
+bitflags::bitflags! {
+    /// A pipeline variant of the scene shader (`shaders/scene.wgsl`): which of its boolean
+    /// overrides are on, as Bevy's `MeshPipelineKey` names a mesh pipeline. The material sets
+    /// the texture bits, the frame the light, shadow and filter bits; `bits()` indexes the
+    /// variant's SPIR-V (`gpu::shaders::scene::variant`).
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    pub struct VariantKey: usize {
+        /// A base-colour texture is sampled.
+        const HAS_BASE_TEX = scene::BIT_HAS_BASE_TEX;
+        /// A normal map is sampled.
+        const HAS_NORMAL_MAP = scene::BIT_HAS_NORMAL_MAP;
+        /// Metallic-roughness, occlusion or emissive textures are sampled.
+        const HAS_OTHER_TEX = scene::BIT_HAS_OTHER_TEX;
+        /// One directional light shades (no point or spot code).
+        const ONE_SUN = scene::BIT_ONE_SUN;
+        /// The shadow map is sampled.
+        const SHADOWS = scene::BIT_SHADOWS;
+        /// Hardware depth comparison (a linearly filtered comparison sampler).
+        const HW_COMPARE = scene::BIT_HW_COMPARE;
+        /// PCF kernel, low bit (2×2: 0b01, 3×3: 0b10, 5×5: 0b11).
+        const PCF_BIT0 = scene::BIT_PCF_BIT0;
+        /// PCF kernel, high bit.
+        const PCF_BIT1 = scene::BIT_PCF_BIT1;
+        /// More than one shadow view (cascades, several lights).
+        const MANY_VIEWS = scene::BIT_MANY_VIEWS;
+        /// Soft shadows (PCSS).
+        const SOFT = scene::BIT_SOFT;
+        /// Exact shadows: the exact pass's verdicts are read.
+        const EXACT = scene::BIT_EXACT;
+    }
+}
+
+impl VariantKey {
+    /// The texture bits: what a material's variant sets.
+    pub const TEXTURES: Self = Self::HAS_BASE_TEX
+        .union(Self::HAS_NORMAL_MAP)
+        .union(Self::HAS_OTHER_TEX);
+    /// `SHADOWS` and the bits that only mean something with it (declared `// requires SHADOWS`
+    /// in the shader).
+    pub const WITH_SHADOWS: Self = Self::from_bits_retain(scene::WITH_SHADOWS);
+}
+
+// Every override the shader declares has a named bit.
+const _: () = assert!(VariantKey::all().bits() == (1 << scene::OVERRIDES.len()) - 1);

@@ -9,22 +9,28 @@
 
 pub(crate) mod camera;
 pub(crate) mod casters;
+pub(crate) mod exact;
 pub(crate) mod frame;
 pub(crate) mod input;
 pub(crate) mod lights;
+pub(crate) mod reach;
 pub(crate) mod settings;
+pub(crate) mod sight;
 pub(crate) mod uniforms;
 pub(crate) mod views;
 
 pub use camera::{camera_projection, fitting_frustum};
 pub use casters::{flat_hides_nothing, CasterPlan, TexelRect, Viewpoint};
+pub use exact::{ExactMode, ExactPlan, CONTACT_TEXELS, CONTACT_THICKNESS};
 pub use frame::{plan_frame, resolve_format, FramePlan, ScenePlanner, CLEAR_COLOR};
 pub use input::{PlanScene, PlanTarget};
 pub use lights::{effective_lights, exposure_scale, metered_illuminance};
+pub use reach::ShadowReach;
 pub use settings::{
     Ambient, Background, DeviceFacts, Exposure, HeldLight, Pcf, PostAa, SceneOptions, ShadowFit,
     ShadowFormat, ShadowHold, ShadowMethod, ShadowSettings, Tonemap, View, ViewMode, AUTO_GROUND,
     AUTO_SKY, GROUND_TINT, MAX_CASCADES, SKY_TINT, SUPERSAMPLE_FACTORS, UNIT_AMBIENT,
 };
+pub use sight::Sight;
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
 pub use views::{lookup_reach, soft_size, ShadowView};

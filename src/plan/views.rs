@@ -43,7 +43,7 @@ pub struct ShadowView {
     /// For cascades: the view depths (near, far) their light's cascades were split over.
     pub depth_range: Option<(f32, f32)>,
     /// The casters the shadow pass draws into this view and the texels they touch (none until
-    /// the renderer plans them: [`super::FramePlan::with_casters`]).
+    /// `plan_frame` plans them with the views).
     pub casters: CasterPlan,
 }
 

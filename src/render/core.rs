@@ -6,32 +6,22 @@ use super::device::device_facts;
 use super::gpu_scene::GpuScene;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::gpu::shaders::scene as sh;
 use crate::math::shadow_fit::spot_near;
-use crate::plan::frame::PixelVerdicts;
 use crate::plan::settings::{
-    Background, PostAa, SceneOptions, ShadowFormat, ShadowMethod, ShadowSettings, View, ViewMode,
+    Background, PostAa, SceneOptions, ShadowFormat, ShadowSettings, View, ViewMode,
 };
+use crate::plan::ExactPlan;
+use crate::plan::CLEAR_COLOR;
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
-use crate::plan::{Viewpoint, CLEAR_COLOR};
 use crate::render::passes::camera::{AovTargets, CameraFrame, CameraPass, CameraTargets, Resolve};
 use crate::render::passes::cull::CameraCull;
-use crate::render::passes::exact::{ExactFrameInputs, ExactMode, ExactPass};
+use crate::render::passes::exact::ExactPass;
 use crate::render::passes::post_aa::PostAaPass;
-use crate::render::passes::receivers::ShadowReach;
-use crate::render::passes::shadow_pass::{plan_casters, ShadowPass};
+use crate::render::passes::shadow_pass::ShadowPass;
 use crate::render::targets::{Attachment, MsaaTargets};
 use crate::scene::{Light, Scene};
 use ash::vk;
 use std::sync::Arc;
-
-/// How far a contact shadow ray marches, in texels of the shown light's finest shadow view, and
-/// how thick (a fraction of that) a surface of the depth image is taken to be. Chosen on
-/// FlightHelmet + ground, the demo and the close-up at 640×360 from 4, 8 and 16 texels and
-/// thicknesses of 0.25 and 1 (16 steps): 8 and 0.25 misclassified least on two of the three
-/// (`docs/exact-shadows.md`). `shaders/exact.wgsl` marches them in 8 steps.
-const CONTACT_TEXELS: f32 = 8.0;
-const CONTACT_THICKNESS: f32 = 0.25;
 
 /// Scene + passes + per-slot uniforms and timestamps.
 pub struct FrameCore {
@@ -57,6 +47,8 @@ pub struct FrameCore {
     timestamps_written: Vec<bool>,
     /// World bounds of every draw (the receivers cascades are split over).
     receiver_bounds: Vec<crate::math::Aabb>,
+    /// Each draw's world plane where it is flat (index-aligned with `receiver_bounds`).
+    receiver_planes: Vec<Option<glam::Vec4>>,
     /// What the GPU's world coordinates are relative to ([`Scene::render_origin`]): draws,
     /// lights and the planned matrices; views are rebased in [`FrameCore::prepare`].
     pub origin: glam::Vec3,
@@ -77,6 +69,7 @@ impl FrameCore {
         let origin = scene.render_origin();
         let gpu = GpuScene::new(ctx, scene, options, origin)?;
         let receiver_bounds = gpu.draws.iter().map(|d| d.world_bounds).collect();
+        let receiver_planes = gpu.draws.iter().map(|d| d.world_plane).collect();
         let mut shadow = ShadowPass::new(ctx)?;
         shadow.set_caching(options.shadow_cache);
         let device = device_facts(ctx);
@@ -114,6 +107,7 @@ impl FrameCore {
             query_pool,
             timestamps_written: vec![false; slots],
             receiver_bounds,
+            receiver_planes,
             receiver_split,
         })
     }
@@ -123,6 +117,7 @@ impl FrameCore {
     pub fn set_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
         self.gpu.update_pose(scene)?;
         self.receiver_bounds = self.gpu.draws.iter().map(|d| d.world_bounds).collect();
+        self.receiver_planes = self.gpu.draws.iter().map(|d| d.world_plane).collect();
         self.lights = scene
             .lights
             .iter()
@@ -142,19 +137,11 @@ impl FrameCore {
         height: u32,
     ) -> Result<Prepared, GpuError> {
         let mut v = view.rebased(self.origin);
-        // Exact shadows judge every receiver pixel themselves: one view (the map's single
-        // cascade, for the pixels they do not judge) and hard.
-        let exact_asked = view.shadow.enabled
-            && view.shadow.method == ShadowMethod::Exact
-            && self.ctx.fragment_stores;
-        if exact_asked {
-            v.shadow.cascades = 1;
-            v.shadow.soft = false;
-        }
         let scene = PlanScene {
             lights: &self.lights,
             bounds: &self.gpu.bounds,
             receivers: &self.receiver_bounds,
+            planes: &self.receiver_planes,
             origin: self.origin,
         };
         // The image's pixel footprint: a supersampled frame's samples share their pixel's maps,
@@ -163,6 +150,8 @@ impl FrameCore {
             aspect: width as f32 / height.max(1) as f32,
             height_px: height / view.supersample.max(1),
             hw_compare,
+            exact_capable: self.ctx.fragment_stores,
+            receiver_split: self.receiver_split,
         };
         // An automatic format is resolved by the plan; planned again in the rare case that the
         // chosen format filters differently from D32 (hardware comparison is a plan input).
@@ -183,37 +172,18 @@ impl FrameCore {
             .ensure_map(plan.shadow_map_size(), format, layers)?;
         self.shadow.ensure_masked(&self.gpu, format)?;
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
-        let casters = if plan.shadows_on {
-            plan.shadow_views
-                .iter()
-                .map(|sv| {
-                    plan_casters(
-                        &self.gpu,
-                        &sv.light_clip_from_world,
-                        plan.light_source(sv.light),
-                        sv.res,
-                        crate::plan::lookup_reach(view.shadow.pcf, plan.soft),
-                        view.mode == ViewMode::ShadowMap,
-                    )
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let mut plan = plan.with_casters(casters);
         let extent = vk::Extent2D { width, height };
-        let contact_asked =
-            !exact_asked && view.shadow.enabled && view.shadow.contact && self.ctx.fragment_stores;
-        let exact = if exact_asked || contact_asked {
-            self.prepare_exact(slot, view, &mut plan, extent, contact_asked)?
-        } else {
-            None
-        };
-        let exact_samples = exact.as_ref().and(self.exact.as_ref().map(|e| e.samples()));
+        if let Some(e) = &plan.exact {
+            self.prepare_exact(slot, e, extent)?;
+        }
+        let exact_samples = plan
+            .exact
+            .as_ref()
+            .and(self.exact.as_ref().map(|e| e.samples()));
         self.camera
             .bind_shadow_map(slot, map_view, hw, exact_samples);
         self.camera.write_frame(slot, &plan.uniform)?;
-        let cull = camera_cull(view, &plan, extent, self.receiver_split);
+        let cull = camera_cull(view, &plan);
         let sky = view.mode == ViewMode::Lit && plan.background == Background::Sky;
         let camera = self.camera.plan_frame(
             &self.gpu,
@@ -229,7 +199,6 @@ impl FrameCore {
         }
         Ok(Prepared {
             post_aa,
-            exact,
             plan,
             camera,
             extent,
@@ -239,95 +208,20 @@ impl FrameCore {
         })
     }
 
-    /// The exact pass's inputs for `plan` (and its shader bit set) for exact shadows, or with
-    /// `contact` contact shadows, when they apply: exact shadows need one shadowed directional
-    /// or spot light with one view; contact shadows a shown shadowed light and hard shadows
-    /// (they march `CONTACT_TEXELS` of its finest view). Makes the pass and its targets.
+    /// Makes the exact pass (once) and its targets at `extent`, and writes slot `slot`'s inputs
+    /// from the plan's `exact`.
     fn prepare_exact(
         &mut self,
         slot: usize,
-        view: &View,
-        plan: &mut FramePlan,
+        exact: &ExactPlan,
         extent: vk::Extent2D,
-        contact: bool,
-    ) -> Result<Option<ExactFrameInputs>, GpuError> {
-        let bits = plan.shader_variant;
-        let shown = plan.shadow_light.and_then(|i| {
-            plan.shadow_views
-                .iter()
-                .position(|v| v.light == i)
-                .map(|first| (i, first))
-        });
-        let Some((shown, first)) = shown.filter(|_| plan.shadows_on && bits & sh::BIT_SHADOWS != 0)
-        else {
-            return Ok(None);
-        };
-        // Exact: the shown light's views are the frame's, one (a sun's single map, a spot
-        // light) or a point light's six faces.
-        let only_shown = plan.shadow_views.iter().all(|v| v.light == shown);
-        let point = plan.lights[shown].kind == crate::scene::LightKind::Point;
-        let views = plan.shadow_views.len();
-        let mode = match contact {
-            false if only_shown && (views == 1 || (point && views == 6)) => ExactMode::Exact,
-            true if bits & sh::BIT_SOFT == 0 => {
-                let length = CONTACT_TEXELS * plan.shadow_views[first].texel_world;
-                ExactMode::Contact {
-                    length,
-                    thickness: CONTACT_THICKNESS * length,
-                }
-            }
-            _ => return Ok(None),
-        };
-        let (light, positional) = match plan.light_source(shown) {
-            Viewpoint::Eye(p) => (p, true),
-            Viewpoint::Along(d) => (d, false),
-        };
-        let cam = &view.camera;
-        let aspect = extent.width as f32 / extent.height.max(1) as f32;
-        let half = cam.half_extent_at(cam.near, aspect);
-        let inputs = ExactFrameInputs {
-            mode,
-            views: plan
-                .shadow_views
-                .iter()
-                .map(|v| v.light_clip_from_world)
-                .collect(),
-            light,
-            positional,
-            // The CPU reference's ray offset: 2·10⁻⁵ of the scene's diagonal.
-            eps: (self.gpu.bounds.diagonal() * 2e-5).max(1e-6),
-            clip_from_world: plan.clip_from_world,
-            eye: (
-                plan.camera_position,
-                (cam.near * cam.near + half.length_squared()).sqrt(),
-            ),
-            receivers: (0..self.gpu.draws.len()).collect(),
-            casters: match mode {
-                ExactMode::Exact => {
-                    let mut all: Vec<usize> = plan
-                        .shadow_views
-                        .iter()
-                        .flat_map(|v| v.casters.draws.iter().copied())
-                        .collect();
-                    all.sort_unstable();
-                    all.dedup();
-                    all
-                }
-                ExactMode::Contact { .. } => Vec::new(),
-            },
-        };
+    ) -> Result<(), GpuError> {
         if self.exact.is_none() {
             self.exact = Some(ExactPass::new(&self.ctx, &self.gpu, self.slots)?);
         }
         let pass = self.exact.as_mut().expect("made above");
         pass.ensure(&self.gpu, extent)?;
-        pass.write_frame(slot, &inputs)?;
-        plan.shader_variant |= sh::BIT_EXACT;
-        plan.verdicts = Some(match mode {
-            ExactMode::Exact => PixelVerdicts::Exact,
-            ExactMode::Contact { .. } => PixelVerdicts::Contact,
-        });
-        Ok(Some(inputs))
+        pass.write_frame(slot, exact)
     }
 
     /// Records the shadow pass and the camera pass of a prepared frame with timestamps (the
@@ -381,7 +275,7 @@ impl FrameCore {
         let casters = self
             .shadow
             .record(cmd, &self.gpu, &frame.shadow, &views, near);
-        if let (Some(inputs), Some(pass)) = (&frame.exact, self.exact.as_mut()) {
+        if let (Some(inputs), Some(pass)) = (&plan.exact, self.exact.as_mut()) {
             pass.record(cmd, slot, &self.gpu, inputs);
         }
         unsafe {
@@ -505,60 +399,21 @@ impl FrameCore {
     }
 }
 
-/// The debug entry `mode` draws the scene with (`None`: the lit image, or the shadow map drawn
-/// full-screen).
-/// What the camera pass culls and draws with for `view` planned as `plan` at `extent`; with
-/// `receiver_split`, the reach of a single shadow view (`crate::render::passes::receivers`).
-fn camera_cull(
-    view: &View,
-    plan: &FramePlan,
-    extent: vk::Extent2D,
-    receiver_split: bool,
-) -> CameraCull {
-    let aspect = extent.width as f32 / extent.height.max(1) as f32;
-    let cam = &view.camera;
-    let half = cam.half_extent_at(cam.near, aspect);
-    let single_view = plan.shadow_views.len() == 1;
-    let bits = plan.shader_variant;
-    let shadow_reach = (receiver_split
-        && view.mode == ViewMode::Lit
-        && plan.shadows_on
-        && single_view
-        && bits & sh::BIT_SHADOWS != 0
-        && bits & sh::BIT_MANY_VIEWS == 0)
-        .then(|| {
-            let sv = &plan.shadow_views[0];
-            let apex = match plan.light_source(sv.light) {
-                Viewpoint::Eye(p) => Some(p),
-                Viewpoint::Along(_) => None,
-            };
-            ShadowReach::new(
-                &sv.light_clip_from_world,
-                sv.casters.lookup,
-                sv.res as f32,
-                view.shadow.normal_offset.abs() + view.shadow.constant_bias.abs(),
-                sv.texel_world,
-                apex,
-            )
-        });
+/// What the camera pass culls and draws with for `view` planned as `plan` (its sight).
+fn camera_cull(view: &View, plan: &FramePlan) -> CameraCull {
     CameraCull {
-        shadow_reach,
+        shadow_reach: plan.sight.shadow_reach.clone(),
         clip_from_world: plan.clip_from_world,
-        eye: (
-            plan.camera_position,
-            (cam.near * cam.near + half.length_squared()).sqrt(),
-        ),
-        viewpoint: if cam.is_orthographic() {
-            Viewpoint::Along(cam.forward())
-        } else {
-            Viewpoint::Eye(plan.camera_position)
-        },
+        eye: plan.sight.eye,
+        viewpoint: plan.sight.viewpoint,
         frame_bits: plan.shader_variant,
         debug_view: is_debug_view(view.mode),
         highlight: view.highlight,
     }
 }
 
+/// The debug entry `mode` draws the scene with (`None`: the lit image, or the shadow map drawn
+/// full-screen).
 fn is_debug_view(mode: ViewMode) -> Option<crate::render::passes::cull::Entry> {
     use crate::render::passes::cull::Entry;
     match mode {
@@ -585,8 +440,6 @@ pub struct Prepared {
     mode: ViewMode,
     /// FXAA after the camera pass (`View::post_aa`, lit images only).
     post_aa: bool,
-    /// The exact shadow pass's inputs, when the frame runs it (`ShadowMethod::Exact`).
-    exact: Option<ExactFrameInputs>,
 }
 
 /// The images one frame is recorded into. With `msaa` the camera pass draws into its

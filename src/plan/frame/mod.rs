@@ -2,17 +2,22 @@
 //! (`super::lights`) and shadow views (`super::views`), and the frame uniform block.
 
 use super::camera::camera_projection;
-use super::casters::{CasterPlan, Viewpoint};
+use super::casters::{plan_casters, Viewpoint};
+use super::exact::{exact_asked, ExactMode, ExactPlan};
 use super::input::{PlanScene, PlanTarget};
 use super::lights::{effective_lights, light_uniforms, metering};
 use super::settings::{
     Ambient, Background, Exposure, HeldLight, Pcf, ShadowFormat, ShadowHold, ShadowSettings,
-    Tonemap, View,
+    Tonemap, View, ViewMode,
 };
+use super::sight::Sight;
 use super::uniforms::{FrameUniform, MAX_LIGHTS};
+use super::views::lookup_reach;
 use super::views::{far_view_depth, shadow_views, view_uniforms, ShadowView};
 use crate::math::Aabb;
 use crate::scene::{Light, LightKind};
+use crate::shader_consts::VariantKey;
+use finish::{choose_exact, sight};
 use glam::{Mat4, Vec3, Vec4};
 
 pub use super::settings::CLEAR_COLOR;
@@ -35,10 +40,12 @@ pub struct FramePlan {
     pub orthographic: bool,
     /// The scene shader's variant bits this frame sets (one light, shadows sampled, comparison
     /// path, PCF kernel); each draw adds its material's bits.
-    pub(crate) shader_variant: usize,
+    pub(crate) shader_variant: VariantKey,
     /// What decided the shown light's visibility per pixel beside the maps, when anything did
     /// (set when the frame is prepared on the device).
-    pub(crate) verdicts: Option<PixelVerdicts>,
+    pub(crate) exact: Option<ExactPlan>,
+    /// What the camera culls with (eye, viewpoint, the shadow view's reach).
+    pub sight: Sight,
     /// Lights shading this frame.
     pub lights: Vec<Light>,
     /// The shadowed light whose visibility `--view shadow` writes (and whose views the shadow
@@ -85,15 +92,20 @@ impl FramePlan {
         self.uniform.shadow.x as u32
     }
 
-    /// The plan with each shadow view's casters (`casters[i]` for `shadow_views[i]`, from the
-    /// renderer's scene), their lookup rectangles packed into the uniform block: the one place
-    /// a plan is completed, before anything is recorded.
-    pub fn with_casters(mut self, casters: Vec<CasterPlan>) -> FramePlan {
-        for (c, (view, cp)) in self.shadow_views.iter_mut().zip(casters).enumerate() {
-            self.uniform.views[c].rect = cp.lookup;
-            view.casters = cp;
+    /// Plans each shadow view's casters among `scene`'s draws and packs their lookup rectangles
+    /// into the uniform block (`full`: every view's whole square is drawn, the map debug view).
+    fn plan_casters(&mut self, scene: &PlanScene, pcf: Pcf, full: bool) {
+        if !self.shadows_on {
+            return;
         }
-        self
+        let reach = lookup_reach(pcf, self.soft);
+        for c in 0..self.shadow_views.len() {
+            let v = &self.shadow_views[c];
+            let light = self.light_source(v.light);
+            let cp = plan_casters(scene, &v.light_clip_from_world, light, v.res, reach, full);
+            self.uniform.views[c].rect = cp.lookup;
+            self.shadow_views[c].casters = cp;
+        }
     }
 
     /// The eye and the unit forward direction the cascades were split from (the fitting camera's,
@@ -196,13 +208,13 @@ impl FramePlan {
     /// Whether the frame's shadowed light is judged by the exact pass
     /// ([`crate::plan::ShadowMethod::Exact`]) rather than its map.
     pub fn exact_shadows(&self) -> bool {
-        self.verdicts == Some(PixelVerdicts::Exact)
+        matches!(&self.exact, Some(e) if e.mode == ExactMode::Exact)
     }
 
     /// Whether contact shadows darkened the shown light's creases this frame
     /// ([`crate::plan::ShadowSettings::contact`]).
     pub fn contact_shadows(&self) -> bool {
-        self.verdicts == Some(PixelVerdicts::Contact)
+        matches!(&self.exact, Some(e) if matches!(e.mode, ExactMode::Contact { .. }))
     }
 
     /// Whether light `i` is shadowed by the map this frame (shadows on and it has views).
@@ -291,6 +303,7 @@ impl ScenePlanner {
                 lights: &self.lights,
                 bounds: &self.bounds,
                 receivers: &self.receivers,
+                planes: &[],
                 origin: self.origin,
             },
             &view.rebased(self.origin),
@@ -298,6 +311,8 @@ impl ScenePlanner {
                 aspect: w as f32 / h.max(1) as f32,
                 height_px: h,
                 hw_compare: false,
+                exact_capable: true,
+                receiver_split: false,
             },
         )
     }
@@ -331,21 +346,12 @@ pub fn resolve_format(settings: &ShadowSettings, views: &[ShadowView]) -> Shadow
 
 /// Plans a frame for `view` of `scene` rendered into `target`: pure, no GPU.
 pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FramePlan {
-    // The one place the map size is settled: clamped into `ShadowSettings::MAP_SIZES`, 1
-    // without shadows (the layers' side, `FramePlan::shadow_map_size`, follows from it).
-    let mut settled = view.clone();
-    settled.shadow.map_size = if view.shadow.enabled {
-        view.shadow.clamped_map_size()
-    } else {
-        1
-    };
-    let view = &settled;
+    let view = &settled(view, target);
     let PlanTarget {
         aspect, hw_compare, ..
     } = *target;
     let bounds = scene.bounds;
     let lights = effective_lights(scene.lights, view);
-    let fit_camera = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
     let proj = camera_projection(&view.camera, aspect);
     let clip_from_world = proj * view.camera.view_from_world();
     let (views, unshadowed) = shadow_views(&lights, scene, view, target);
@@ -363,65 +369,38 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
     let (ambient, metered_lux, exposure) = metering(&lights, scene, view);
     let unlit_scale = (view.exposure == Exposure::Auto)
         .then(|| view.exposure_compensation.clamp(-64.0, 64.0).exp2());
-    let u = FrameUniform {
-        clip_from_world,
-        world_from_clip: clip_from_world.as_dmat4().inverse().as_mat4(),
-        camera_position: view.camera.position().extend(1.0),
-        ambient_sky: ambient.sky.extend(0.0),
-        ambient_ground: ambient.ground.extend(0.0),
-        shadow: Vec4::new(
-            size as f32,
-            view.shadow.normal_offset,
-            far_view_depth(&view.camera, bounds),
-            if shadows_on { 1.0 } else { 0.0 },
-        ),
-        // No shown light: an index the shader's light loop never reaches. xyz: the eye the
-        // cascades were split from (the fitting camera, which is the view's unless a test or
-        // the stability suite fits the shadows to another camera).
-        shadow_light: fit_camera
-            .position()
-            .extend(shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32)),
-        bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
-        camera_forward: (fit_camera
-            .view_from_world()
-            .inverse()
-            .transform_vector3(Vec3::NEG_Z))
-        .normalize_or(Vec3::NEG_Z)
-        .extend(0.0),
-        eye_forward: view
-            .camera
-            .forward()
-            .extend(if view.camera.is_orthographic() {
-                1.0
-            } else {
-                0.0
-            }),
-        modes: [
-            view.mode.shader_value(),
-            view.shadow.pcf.taps(),
-            hw_compare as u32,
-            lights.len() as u32,
-        ],
-        output: Vec4::new(
+    let u = frame_uniform(
+        view,
+        &UniformInputs {
+            clip_from_world,
+            map_size: size,
+            far: far_view_depth(&view.camera, bounds),
+            shadows_on,
+            shadow_light,
+            hw_compare,
+            lights: &lights,
+            views: &views,
+            ambient,
             exposure,
-            view.tonemap.shader_value(),
-            unlit_scale.unwrap_or(1.0),
-            if unlit_scale.is_some() { 1.0 } else { 0.0 },
-        ),
-        lights: light_uniforms(&lights, &views, view),
-        views: view_uniforms(&views),
-    };
+            unlit_scale,
+        },
+    );
     // Soft where a shadowed light's uniform carries a size (set above).
     let soft = shadows_on && u.lights.iter().any(|l| l.direction.w > 0.0);
     let shadow_format = resolve_format(&view.shadow, &views);
-    FramePlan {
+    let mut plan = FramePlan {
         uniform: u,
         shadows_on,
         soft,
         shadow_format,
         camera_position: view.camera.position(),
         orthographic: view.camera.is_orthographic(),
-        verdicts: None,
+        exact: None,
+        sight: Sight {
+            eye: (Vec3::ZERO, 0.0),
+            viewpoint: Viewpoint::Along(Vec3::NEG_Z),
+            shadow_reach: None,
+        },
         shader_variant: frame_variant_bits(
             lights.len() == 1 && lights[0].kind == LightKind::Directional,
             shadows_on,
@@ -442,16 +421,101 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         background: view.background,
         unlit_scale,
         metered_lux,
+    };
+    plan.plan_casters(scene, view.shadow.pcf, view.mode == ViewMode::ShadowMap);
+    plan.exact = choose_exact(&plan, view, scene, aspect, target.exact_capable);
+    if plan.exact.is_some() {
+        plan.shader_variant |= VariantKey::EXACT;
     }
+    plan.sight = sight(&plan, view, aspect, target.receiver_split);
+    plan
 }
 
-/// What decides the shown light's visibility per pixel beside the maps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum PixelVerdicts {
-    /// Exact shadows: the exact pass's verdict replaces the maps where it judged.
-    Exact,
-    /// Contact shadows: dark where a contact ray found a caster, the maps elsewhere.
-    Contact,
+/// `view` as the plan reads it: the map size settled (the one place: clamped into
+/// `ShadowSettings::MAP_SIZES`, 1 without shadows; the layers' side,
+/// `FramePlan::shadow_map_size`, follows from it), and with exact shadows on a device that
+/// draws them one view (the map's single cascade, for the pixels they do not judge), hard.
+fn settled(view: &View, target: &PlanTarget) -> View {
+    let mut v = view.clone();
+    v.shadow.map_size = if view.shadow.enabled {
+        view.shadow.clamped_map_size()
+    } else {
+        1
+    };
+    if exact_asked(view, target.exact_capable) {
+        v.shadow.cascades = 1;
+        v.shadow.soft = false;
+    }
+    v
+}
+
+/// What the frame's uniform block is made from, beside the view.
+struct UniformInputs<'a> {
+    clip_from_world: Mat4,
+    map_size: u32,
+    /// The farthest view depth of the scene.
+    far: f32,
+    shadows_on: bool,
+    shadow_light: Option<usize>,
+    hw_compare: bool,
+    lights: &'a [Light],
+    views: &'a [ShadowView],
+    ambient: Ambient,
+    exposure: f32,
+    unlit_scale: Option<f32>,
+}
+
+/// The frame's uniform block.
+fn frame_uniform(view: &View, f: &UniformInputs) -> FrameUniform {
+    let fit_camera = view.shadow_fit_camera.as_ref().unwrap_or(&view.camera);
+    FrameUniform {
+        clip_from_world: f.clip_from_world,
+        world_from_clip: f.clip_from_world.as_dmat4().inverse().as_mat4(),
+        camera_position: view.camera.position().extend(1.0),
+        ambient_sky: f.ambient.sky.extend(0.0),
+        ambient_ground: f.ambient.ground.extend(0.0),
+        shadow: Vec4::new(
+            f.map_size as f32,
+            view.shadow.normal_offset,
+            f.far,
+            if f.shadows_on { 1.0 } else { 0.0 },
+        ),
+        // No shown light: an index the shader's light loop never reaches. xyz: the eye the
+        // cascades were split from (the fitting camera, which is the view's unless a test or
+        // the stability suite fits the shadows to another camera).
+        shadow_light: fit_camera
+            .position()
+            .extend(f.shadow_light.map_or(MAX_LIGHTS as f32 + 1.0, |i| i as f32)),
+        bias: Vec4::new(view.shadow.constant_bias, 0.0, 0.0, 0.0),
+        camera_forward: (fit_camera
+            .view_from_world()
+            .inverse()
+            .transform_vector3(Vec3::NEG_Z))
+        .normalize_or(Vec3::NEG_Z)
+        .extend(0.0),
+        eye_forward: view
+            .camera
+            .forward()
+            .extend(if view.camera.is_orthographic() {
+                1.0
+            } else {
+                0.0
+            }),
+        modes: [
+            view.mode.shader_value(),
+            view.shadow.pcf.taps(),
+            f.hw_compare as u32,
+            f.lights.len() as u32,
+        ],
+        output: Vec4::new(
+            f.exposure,
+            view.tonemap.shader_value(),
+            f.unlit_scale.unwrap_or(1.0),
+            if f.unlit_scale.is_some() { 1.0 } else { 0.0 },
+        ),
+        lights: light_uniforms(f.lights, f.views, view),
+        views: view_uniforms(f.views),
+    }
 }
 
 /// The scene shader's frame variant bits: one directional light and nothing else (a constant
@@ -465,27 +529,26 @@ fn frame_variant_bits(
     pcf: Pcf,
     views: usize,
     soft: bool,
-) -> usize {
-    use crate::shader_consts::scene as sh;
-    let mut bits = 0;
+) -> VariantKey {
+    let mut bits = VariantKey::empty();
     if one_sun {
-        bits |= sh::BIT_ONE_SUN;
+        bits |= VariantKey::ONE_SUN;
     }
     // The filter, comparison path and cascades mean nothing without a map (one shader for all).
     if !shadows_on {
         return bits;
     }
-    bits |= sh::BIT_SHADOWS
+    bits |= VariantKey::SHADOWS
         | match pcf {
-            Pcf::None => 0,
-            Pcf::P2x2 => sh::BIT_PCF_BIT0,
-            Pcf::P3x3 => sh::BIT_PCF_BIT1,
-            Pcf::P5x5 => sh::BIT_PCF_BIT0 | sh::BIT_PCF_BIT1,
+            Pcf::None => VariantKey::empty(),
+            Pcf::P2x2 => VariantKey::PCF_BIT0,
+            Pcf::P3x3 => VariantKey::PCF_BIT1,
+            Pcf::P5x5 => VariantKey::PCF_BIT0 | VariantKey::PCF_BIT1,
         };
     for (on, bit) in [
-        (hw_compare, sh::BIT_HW_COMPARE),
-        (views > 1, sh::BIT_MANY_VIEWS),
-        (soft, sh::BIT_SOFT),
+        (hw_compare, VariantKey::HW_COMPARE),
+        (views > 1, VariantKey::MANY_VIEWS),
+        (soft, VariantKey::SOFT),
     ] {
         if on {
             bits |= bit;
@@ -493,6 +556,8 @@ fn frame_variant_bits(
     }
     bits
 }
+
+mod finish;
 
 #[cfg(test)]
 mod tests;

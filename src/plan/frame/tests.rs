@@ -13,12 +13,15 @@ fn plan_at(
         lights,
         bounds,
         receivers,
+        planes: &[],
         origin: Vec3::ZERO,
     };
     let target = PlanTarget {
         aspect,
         height_px,
         hw_compare: false,
+        exact_capable: true,
+        receiver_split: false,
     };
     plan_frame(&scene, view, &target)
 }
@@ -104,13 +107,13 @@ fn default_sun_and_override() {
     assert_eq!(p.lights[0].direction, Vec3::NEG_Y);
     assert_eq!(p.uniform.modes[3], 1);
     // One light, shadows on, PCF 2×2 by hand (hw_compare false).
-    use crate::shader_consts::scene as sh;
-    let want = sh::BIT_ONE_SUN | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0;
+    use crate::shader_consts::VariantKey as K;
+    let want = K::ONE_SUN | K::SHADOWS | K::PCF_BIT0;
     assert_eq!(p.shader_variant, want);
     // Cascades: four views, nearest first, each ending where the next blends in.
     v.shadow.cascades = 4;
     let p = plan_at(&s.lights, &s.bounds(), &[], &v, 1.5, 720);
-    assert_eq!(p.shader_variant, want | sh::BIT_MANY_VIEWS);
+    assert_eq!(p.shader_variant, want | K::MANY_VIEWS);
     assert_eq!(p.shadow_views.len(), 4);
     for w in p.shadow_views.windows(2) {
         assert!(w[0].blend < w[0].far && w[0].far < w[1].far, "{w:?}");
@@ -120,7 +123,7 @@ fn default_sun_and_override() {
     // Without shadows the filter, comparison and cascade bits mean nothing: one shader.
     v.shadow.enabled = false;
     let p = plan_at(&s.lights, &s.bounds(), &[], &v, 1.5, 720);
-    assert_eq!(p.shader_variant, sh::BIT_ONE_SUN);
+    assert_eq!(p.shader_variant, K::ONE_SUN);
     // One point light is not a sun: the general light loop.
     let point = [Light {
         kind: LightKind::Point,
@@ -130,7 +133,7 @@ fn default_sun_and_override() {
     v.sun_direction = None;
     let p = plan_at(&point, &s.bounds(), &[], &v, 1.5, 720);
     assert_eq!(p.lights.len(), 1);
-    assert_eq!(p.shader_variant & sh::BIT_ONE_SUN, 0);
+    assert!(!p.shader_variant.contains(K::ONE_SUN));
 }
 #[test]
 fn the_automatic_setting_doubles_one_map_before_it_splits_into_cascades() {
@@ -259,8 +262,8 @@ fn every_casting_light_gets_views_while_they_last() {
     let firsts: Vec<f32> = p.uniform.lights[..6].iter().map(|l| l.shadow.x).collect();
     assert_eq!(firsts, [0.0, 4.0, -1.0, 10.0, -1.0, -1.0]);
     assert_eq!(
-        p.shader_variant & crate::shader_consts::scene::BIT_MANY_VIEWS,
-        crate::shader_consts::scene::BIT_MANY_VIEWS
+        p.shader_variant & crate::shader_consts::VariantKey::MANY_VIEWS,
+        crate::shader_consts::VariantKey::MANY_VIEWS
     );
     // The shown light: the first shadowed one, or the one asked for if it has views.
     assert_eq!(p.shadow_light, Some(0));

@@ -5,6 +5,7 @@ use super::*;
 use crate::math::Aabb;
 use crate::plan::uniforms::SceneImmediates;
 use crate::scene::{AlphaMode, Scene};
+use crate::shader_consts::VariantKey;
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 
@@ -71,7 +72,7 @@ pub struct Draw {
     /// pass tests alpha).
     pub alpha: AlphaDraw,
     /// The material's shader variant bits (`material_variant_bits`).
-    pub material_bits: usize,
+    pub material_bits: VariantKey,
     /// The primitive is closed and consistently wound (`scene::topology::is_closed`): seen from
     /// outside its bounds, culling back faces changes no pixel even if it is double-sided.
     pub closed: bool,
@@ -181,7 +182,7 @@ pub(super) fn build_draws(
                     Some(AlphaMode::Blend) => AlphaDraw::Blended,
                     _ => AlphaDraw::Opaque,
                 },
-                material_bits: mat.map_or(0, material_variant_bits),
+                material_bits: mat.map_or(VariantKey::empty(), material_variant_bits),
                 mean_area: r.area
                     * glam::Mat3::from_mat4(world_from_model)
                         .determinant()

@@ -9,6 +9,7 @@ use crate::plan::settings::SceneOptions;
 use crate::plan::uniforms::MaterialUniform;
 use crate::render::samplers::SamplerCache;
 use crate::scene::{AlphaMode, Material, Scene, TextureRef, BLEND_SHADOW_CUTOFF};
+use crate::shader_consts::VariantKey;
 use ash::vk;
 use glam::Vec4;
 use std::collections::HashMap;
@@ -119,17 +120,16 @@ pub(super) fn reads_texcoord0_only(m: &crate::scene::Material) -> bool {
 /// The scene shader's variant bits for a material: which texture slots it fills (the shader
 /// leaves out the fetch of an empty slot, whose default texture is white, a factor of 1, so the
 /// result is the same) and whether it is normal-mapped.
-pub fn material_variant_bits(m: &crate::scene::Material) -> usize {
-    use crate::gpu::shaders::scene as sh;
-    let mut bits = 0;
+pub fn material_variant_bits(m: &crate::scene::Material) -> VariantKey {
+    let mut bits = VariantKey::empty();
     for (filled, bit) in [
-        (m.base_color_texture.is_some(), sh::BIT_HAS_BASE_TEX),
-        (m.normal_texture.is_some(), sh::BIT_HAS_NORMAL_MAP),
+        (m.base_color_texture.is_some(), VariantKey::HAS_BASE_TEX),
+        (m.normal_texture.is_some(), VariantKey::HAS_NORMAL_MAP),
         (
             m.metallic_roughness_texture.is_some()
                 || m.emissive_texture.is_some()
                 || m.occlusion_texture.is_some(),
-            sh::BIT_HAS_OTHER_TEX,
+            VariantKey::HAS_OTHER_TEX,
         ),
     ] {
         if filled {

@@ -12,6 +12,7 @@ pub use draws::{AlphaDraw, Draw, IndexRange};
 pub use geometry::{vertex_layout, VertexAttributes};
 pub use materials::material_variant_bits;
 
+use crate::shader_consts::VariantKey;
 use draws::build_draws;
 use geometry::{pack_geometry, vertex_attributes, Geometry, PrimitiveRange};
 use materials::{
@@ -59,7 +60,7 @@ pub struct GpuScene {
     pub frustum_culling: bool,
     /// The distinct (material variant bits, alpha treatment) pairs of the draws: the camera
     /// pipelines the scene needs per frame variant.
-    pub pipeline_keys: Vec<(usize, AlphaDraw)>,
+    pub pipeline_keys: Vec<(VariantKey, AlphaDraw)>,
     /// Per mesh, per primitive: where its vertices and indices are.
     ranges: Vec<Vec<PrimitiveRange>>,
     /// What the draws' world coordinates are relative to.
@@ -222,7 +223,7 @@ impl GpuScene {
         } = pack_geometry(scene, options);
         let moving = scene.moving_instances();
         let (draws, triangles, bounds) = build_draws(scene, &ranges, origin, &moving);
-        let mut pipeline_keys: Vec<(usize, AlphaDraw)> =
+        let mut pipeline_keys: Vec<(VariantKey, AlphaDraw)> =
             draws.iter().map(|d| (d.material_bits, d.alpha)).collect();
         pipeline_keys.sort_unstable();
         pipeline_keys.dedup();

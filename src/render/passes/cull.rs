@@ -1,9 +1,10 @@
 //! What the camera pass is told per frame: which draws it records and with which fragment
 //! entry point.
 
+use crate::plan::ShadowReach;
 use crate::plan::Viewpoint;
 use crate::render::gpu_scene::AlphaDraw;
-use crate::render::passes::receivers::ShadowReach;
+use crate::shader_consts::VariantKey;
 use glam::{Mat4, Vec3};
 
 /// What the camera pass needs per frame to do only the work the frame needs: the camera's world →
@@ -18,7 +19,7 @@ pub struct CameraCull {
     /// for skipping clusters that face away and flat draws that hide nothing.
     pub viewpoint: Viewpoint,
     /// The frame's shader variant bits (`FramePlan::shader_variant`).
-    pub frame_bits: usize,
+    pub frame_bits: VariantKey,
     /// A debug view's entry (`Entry::Debug` or `Entry::Overdraw`); `None` for the lit image.
     pub debug_view: Option<Entry>,
     /// The (instance, primitive) drawn tinted (`View::highlight`).

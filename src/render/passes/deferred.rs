@@ -21,6 +21,7 @@ use crate::gpu::Image;
 use crate::render::gpu_scene::{AlphaDraw, Draw};
 use crate::render::passes::cull::CameraCull;
 use crate::render::passes::screen::{pixels_per_triangle, screen_rect, PixelRect};
+use crate::shader_consts::VariantKey;
 use ash::vk;
 use glam::Mat4;
 use std::collections::{HashMap, HashSet};
@@ -55,14 +56,14 @@ pub const GBUFFER_TARGETS: usize = 2;
 
 /// The shader variant of `fs_gbuffer` for a draw of material variant `material_bits`: its
 /// texture slots only (the G-buffer pass reads no light, shadow or frame setting).
-pub fn gbuffer_variant(material_bits: usize) -> usize {
-    material_bits & (sh::BIT_HAS_BASE_TEX | sh::BIT_HAS_NORMAL_MAP | sh::BIT_HAS_OTHER_TEX)
+pub fn gbuffer_variant(material_bits: VariantKey) -> VariantKey {
+    material_bits & VariantKey::TEXTURES
 }
 
 /// The G-buffer targets, from the last, that `fs_gbuffer`'s variant `gbuffer_variant` leaves
 /// alone: an untextured material's depth, normal and flags fit target a, so b is masked.
-pub fn gbuffer_targets_masked(gbuffer_variant: usize) -> usize {
-    usize::from(gbuffer_variant == 0)
+pub fn gbuffer_targets_masked(gbuffer_variant: VariantKey) -> usize {
+    usize::from(gbuffer_variant.is_empty())
 }
 
 /// Stencil marks are 8 bits; mark 0 is "not deferred".
@@ -131,7 +132,7 @@ pub struct Resolved {
     /// Stencil value its deferred draws write (1–255).
     pub mark: u32,
     /// `Draw::material_bits`.
-    pub material_bits: usize,
+    pub material_bits: VariantKey,
     /// Where its deferred draws can be on screen.
     pub rect: PixelRect,
 }
@@ -335,7 +336,7 @@ mod tests {
             double_sided: false,
             mirrored: false,
             alpha: AlphaDraw::Opaque,
-            material_bits: 0,
+            material_bits: VariantKey::empty(),
             closed: true,
             deferrable: true,
             mean_area,
@@ -350,7 +351,7 @@ mod tests {
             clip_from_world: perspective_infinite_reversed(90f32.to_radians(), 1.0, 0.1),
             eye: (Vec3::ZERO, 0.1),
             viewpoint: crate::plan::Viewpoint::Eye(Vec3::ZERO),
-            frame_bits: 0,
+            frame_bits: VariantKey::empty(),
             debug_view: None,
             highlight: None,
             shadow_reach: None,

@@ -24,6 +24,7 @@ use crate::gpu::resources::Buffer;
 use crate::gpu::shaders::{allocate_sets, create_module, exact as sh, set_layout_for};
 use crate::gpu::Image;
 use crate::plan::Viewpoint;
+use crate::plan::{ExactMode, ExactPlan};
 use crate::render::gpu_scene::{vertex_layout, GpuScene};
 use crate::render::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
@@ -32,7 +33,7 @@ use crate::render::pipeline::{
 use crate::render::targets::Attachment;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec4};
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
@@ -86,44 +87,6 @@ struct ExactFrame {
 struct ExactImmediates {
     world_from_model: Mat4,
     extra: Mat4,
-}
-
-/// What the pass decides.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ExactMode {
-    /// Exact shadows: every receiver's shadow ray against the caster triangles.
-    Exact,
-    /// Contact shadows: each ray marched `length` (world units; per unit of distance to a light
-    /// with a position) through the receivers as a depth image, surfaces `thickness` thick.
-    Contact {
-        /// March length.
-        length: f32,
-        /// Thickness of what the depth image shows.
-        thickness: f32,
-    },
-}
-
-/// What one frame's exact pass needs from its plan.
-pub struct ExactFrameInputs {
-    /// Exact or contact shadows.
-    pub mode: ExactMode,
-    /// The light's view (clip from world) the grid covers, or a point light's six cube faces
-    /// (a grid each).
-    pub views: Vec<Mat4>,
-    /// The direction a directional light's rays travel, or a spot or point light's position.
-    pub light: Vec3,
-    /// A light with a position (spot, or point for contact shadows), else directional.
-    pub positional: bool,
-    /// Shadow rays start this far off the surface and ignore hits nearer (world units).
-    pub eps: f32,
-    /// The camera's clip from world.
-    pub clip_from_world: Mat4,
-    /// The camera's position and near-plane reach (back-face culling, as the camera pass).
-    pub eye: (Vec3, f32),
-    /// Draws the receivers pass draws (the camera pass's visible draws).
-    pub receivers: Vec<usize>,
-    /// Draws that cast.
-    pub casters: Vec<usize>,
 }
 
 /// The images and buffers of one image size.
@@ -377,7 +340,7 @@ impl ExactPass {
     }
 
     /// Writes slot `slot`'s frame uniform (its previous frame must have completed).
-    pub fn write_frame(&mut self, slot: usize, f: &ExactFrameInputs) -> Result<(), GpuError> {
+    pub fn write_frame(&mut self, slot: usize, f: &ExactPlan) -> Result<(), GpuError> {
         let extent = self
             .targets
             .as_ref()
@@ -410,13 +373,7 @@ impl ExactPass {
     /// Records the three steps for slot `slot` (after [`ExactPass::ensure`] and
     /// [`ExactPass::write_frame`]); the samples are then ready for the camera pass's fragment
     /// shaders.
-    pub fn record(
-        &mut self,
-        cmd: vk::CommandBuffer,
-        slot: usize,
-        scene: &GpuScene,
-        f: &ExactFrameInputs,
-    ) {
+    pub fn record(&mut self, cmd: vk::CommandBuffer, slot: usize, scene: &GpuScene, f: &ExactPlan) {
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         let set = self.sets[slot];
@@ -468,7 +425,7 @@ impl ExactPass {
         cmd: vk::CommandBuffer,
         set: vk::DescriptorSet,
         scene: &GpuScene,
-        f: &ExactFrameInputs,
+        f: &ExactPlan,
         t: &mut Targets,
     ) {
         let ctx = &self.ctx;
@@ -568,7 +525,7 @@ impl ExactPass {
         cmd: vk::CommandBuffer,
         set: vk::DescriptorSet,
         scene: &GpuScene,
-        f: &ExactFrameInputs,
+        f: &ExactPlan,
     ) {
         let ctx = &self.ctx;
         let d = &ctx.device;

@@ -14,156 +14,18 @@
 //! Only frames with one shadow view use it (a single map of a directional light or a spot
 //! light's; cascades and cube faces keep the shadowed shader everywhere).
 
-use crate::gpu::shaders::scene as sh;
-use crate::math::Aabb;
+use crate::plan::ShadowReach;
 use crate::render::gpu_scene::Draw;
 use crate::render::passes::screen::{points_rect, screen_rect, PixelRect};
+use crate::shader_consts::VariantKey;
 use ash::vk;
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat4, Vec2};
 
 /// Draws of more triangles keep the shadowed shader everywhere: each split draws the geometry
 /// again for every scissor (up to five times) on llvmpipe's single geometry thread (~11 ms per
 /// 100 k triangles there, so at most ~0.5 ms for four more passes over 1,024). Not swept: the
 /// draws the benchmarks split are grounds of 2 triangles.
 pub const SPLIT_MAX_TRIANGLES: u32 = 1024;
-
-/// Texels added to the normal offset and constant bias when growing the reach (rounding).
-const SLACK_TEXELS: f32 = 1.0;
-
-/// The world region where a frame's single shadow view can return less than 1: the points whose
-/// lookup point (the point moved by its normal offset and bias) projects inside the casters'
-/// rectangle, in front of a spot light.
-#[derive(Clone, Debug)]
-pub struct ShadowReach {
-    /// Half-spaces `n·p + d ≥ 0` with unit `n`, before growing by the lookup offset.
-    planes: Vec<Vec4>,
-    /// A perspective view's apex (the spot light), where its side planes meet.
-    apex: Option<Vec3>,
-    /// How far a lookup point can lie from its point, in texels of the view.
-    offset_texels: f32,
-    /// World size of a texel (directional), or per unit distance from the light (spot).
-    texel_world: f32,
-}
-
-impl ShadowReach {
-    /// The reach of a view `light_clip_from_world` whose `size`-texel square has its casters'
-    /// lookup rectangle `lookup` (texels `(x0, y0, x1, y1)`, rows down; empty when `x0 > x1`),
-    /// lookups moved up to `offset_texels` texels (normal offset + constant bias) of
-    /// `texel_world` each; `apex` is the spot light's position (None for a directional light).
-    pub fn new(
-        light_clip_from_world: &Mat4,
-        lookup: Vec4,
-        size: f32,
-        offset_texels: f32,
-        texel_world: f32,
-        apex: Option<Vec3>,
-    ) -> Self {
-        let never = Vec4::new(0.0, 0.0, 0.0, -1.0);
-        let with = |planes| Self {
-            planes,
-            apex,
-            offset_texels: offset_texels.max(0.0) + SLACK_TEXELS,
-            texel_world,
-        };
-        if !(lookup.x <= lookup.z && lookup.y <= lookup.w) {
-            // An empty casters' rectangle: every lookup is lit.
-            return with(vec![never]);
-        }
-        let m = light_clip_from_world;
-        let (rx, ry, rw) = (m.row(0), m.row(1), m.row(3));
-        // Texel u = (ndc.x / 2 + 1/2)·size, v = (1/2 − ndc.y / 2)·size; with w > 0:
-        // u ≥ x0 ⇔ clip.x − a·clip.w ≥ 0 (a = 2·x0/size − 1), and so on.
-        let ndc_x = |t: f32| 2.0 * t / size - 1.0;
-        let ndc_y = |t: f32| 1.0 - 2.0 * t / size;
-        let mut raw = vec![
-            rx - ndc_x(lookup.x) * rw,
-            ndc_x(lookup.z) * rw - rx,
-            ndc_y(lookup.y) * rw - ry,
-            ry - ndc_y(lookup.w) * rw,
-        ];
-        if apex.is_some() {
-            // A lookup at or behind the light's plane is lit.
-            raw.push(rw);
-        }
-        // Unit normals; a constant row (an orthographic w) holds everywhere or nowhere.
-        let planes = raw
-            .into_iter()
-            .filter_map(|p| {
-                let n = p.truncate().length();
-                if n > 1e-12 {
-                    Some(p / n)
-                } else {
-                    (p.w < 0.0).then_some(never)
-                }
-            })
-            .collect();
-        with(planes)
-    }
-
-    /// The corners of the part of `bounds` whose points may have a lookup that reads a caster
-    /// (a superset: the planes grown by the largest lookup offset over `bounds`); None when
-    /// no point of `bounds` can.
-    pub fn clip(&self, bounds: &Aabb) -> Option<Vec<Vec3>> {
-        let scale = match self.apex {
-            Some(a) => bounds
-                .corners()
-                .iter()
-                .map(|c| c.distance(a))
-                .fold(0.0, f32::max),
-            None => 1.0,
-        };
-        let grow = self.offset_texels * self.texel_world * scale;
-        let planes: Vec<Vec4> = self.planes.iter().map(|p| *p + Vec4::W * grow).collect();
-        let mut corners = Vec::new();
-        for face in box_faces(bounds) {
-            let mut poly = face.to_vec();
-            for p in &planes {
-                poly = clip_polygon(&poly, *p);
-                if poly.is_empty() {
-                    break;
-                }
-            }
-            corners.extend(poly);
-        }
-        // Vertices on no face of the box: only a spot light's apex, where its planes meet.
-        if let Some(a) = self.apex.filter(|a| bounds.contains(*a, 0.0)) {
-            corners.push(a);
-        }
-        (!corners.is_empty()).then_some(corners)
-    }
-}
-
-/// The six faces of `b` as quads.
-fn box_faces(b: &Aabb) -> [[Vec3; 4]; 6] {
-    let c = b.corners();
-    // corners(): bit 0 → x max, bit 1 → y max, bit 2 → z max.
-    let quad = |i: [usize; 4]| [c[i[0]], c[i[1]], c[i[2]], c[i[3]]];
-    [
-        quad([0, 2, 6, 4]),
-        quad([1, 3, 7, 5]),
-        quad([0, 1, 5, 4]),
-        quad([2, 3, 7, 6]),
-        quad([0, 1, 3, 2]),
-        quad([4, 5, 7, 6]),
-    ]
-}
-
-/// The part of convex polygon `poly` where `plane·(p, 1) ≥ 0` (Sutherland–Hodgman).
-fn clip_polygon(poly: &[Vec3], plane: Vec4) -> Vec<Vec3> {
-    let f = |p: Vec3| plane.truncate().dot(p) + plane.w;
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for (i, &a) in poly.iter().enumerate() {
-        let b = poly[(i + 1) % poly.len()];
-        let (fa, fb) = (f(a), f(b));
-        if fa >= 0.0 {
-            out.push(a);
-        }
-        if (fa >= 0.0) != (fb >= 0.0) {
-            out.push(a + (b - a) * (fa / (fa - fb)));
-        }
-    }
-    out
-}
 
 /// How one draw is shaded against the reach.
 #[derive(Clone, Debug, PartialEq)]
@@ -224,8 +86,8 @@ pub fn split(
 
 /// The shader variant of `bits` without shadows: the SHADOWS override and those that mean
 /// nothing without it off (the canonical index of that SPIR-V).
-pub fn unshadowed(bits: usize) -> usize {
-    bits & !sh::WITH_SHADOWS
+pub fn unshadowed(bits: VariantKey) -> VariantKey {
+    bits - VariantKey::WITH_SHADOWS
 }
 
 fn intersect(a: vk::Rect2D, b: vk::Rect2D) -> vk::Rect2D {
@@ -273,6 +135,8 @@ fn bands(outer: vk::Rect2D, inner: vk::Rect2D) -> Vec<vk::Rect2D> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::Aabb;
+    use glam::{Vec3, Vec4};
 
     /// A sun straight down (-y), its ortho view ±10 units: x → ndc x, z → ndc y.
     fn sun_down() -> Mat4 {
@@ -378,7 +242,8 @@ mod tests {
 
     #[test]
     fn unshadowed_variant_clears_the_shadow_bits() {
-        let bits = sh::BIT_ONE_SUN | sh::BIT_SHADOWS | sh::BIT_PCF_BIT0 | sh::BIT_SOFT;
-        assert_eq!(unshadowed(bits), sh::BIT_ONE_SUN);
+        let bits =
+            VariantKey::ONE_SUN | VariantKey::SHADOWS | VariantKey::PCF_BIT0 | VariantKey::SOFT;
+        assert_eq!(unshadowed(bits), VariantKey::ONE_SUN);
     }
 }

@@ -10,6 +10,7 @@ mod frame;
 mod pipelines;
 mod record;
 
+use crate::shader_consts::VariantKey;
 use aov::aov_draws;
 use frame::flat_inputs_fit;
 use pipelines::Formats;
@@ -72,9 +73,9 @@ pub struct CameraPass {
     /// The G-buffer targets, at the last deferring frame's size.
     gbuffer: Option<GBuffer>,
     /// Shader modules of the override variants created so far (by variant index).
-    variant_modules: HashMap<usize, vk::ShaderModule>,
+    variant_modules: HashMap<VariantKey, vk::ShaderModule>,
     /// Scene pipelines created so far, by (variant index, entry point).
-    pipelines: HashMap<(usize, Entry), vk::Pipeline>,
+    pipelines: HashMap<(VariantKey, Entry), vk::Pipeline>,
     map_pipeline: vk::Pipeline,
     /// The background where nothing was drawn (`fs_sky`).
     sky_pipeline: vk::Pipeline,

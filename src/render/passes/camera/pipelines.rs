@@ -9,6 +9,7 @@ use crate::render::passes::cull::Entry;
 use crate::render::passes::deferred::{self, GBuffer, GBUFFER_FORMAT, GBUFFER_TARGETS};
 use crate::render::passes::receivers::{self, Split};
 use crate::render::pipeline::{create_pipeline, ColorBlend, Depth, PipelineDesc, Stencil};
+use crate::shader_consts::VariantKey;
 use ash::vk;
 
 impl CameraPass {
@@ -25,7 +26,7 @@ impl CameraPass {
     ) -> Result<(), GpuError> {
         let cull = &frame.cull;
         let (frame_bits, debug_view) = (cull.frame_bits, cull.debug_view);
-        let mut keys: Vec<(usize, Entry)> = scene
+        let mut keys: Vec<(VariantKey, Entry)> = scene
             .pipeline_keys
             .iter()
             .map(|&(bits, alpha)| (bits | frame_bits, Entry::of(alpha, debug_view)))
@@ -71,10 +72,10 @@ impl CameraPass {
     }
 
     /// Creates the pipelines of `keys` (variant, entry) not made yet.
-    fn build_pipelines(&mut self, keys: Vec<(usize, Entry)>) -> Result<(), GpuError> {
+    fn build_pipelines(&mut self, keys: Vec<(VariantKey, Entry)>) -> Result<(), GpuError> {
         // Modules first (cheap), then the missing pipelines compiled in parallel: on lavapipe
         // each is an LLVM compile of its shaders, the largest part of a cold first frame.
-        let mut missing: Vec<(usize, Entry, vk::ShaderModule)> = Vec::new();
+        let mut missing: Vec<(VariantKey, Entry, vk::ShaderModule)> = Vec::new();
         for (variant, entry) in keys {
             if self.pipelines.contains_key(&(variant, entry))
                 || missing.iter().any(|m| (m.0, m.1) == (variant, entry))
@@ -86,8 +87,8 @@ impl CameraPass {
                 None => {
                     let m = create_module(
                         &self.ctx,
-                        &sh::variant(variant)?,
-                        &format!("scene.wgsl variant {variant}"),
+                        &sh::variant(variant.bits())?,
+                        &format!("scene.wgsl variant {}", variant.bits()),
                     )?;
                     self.variant_modules.insert(variant, m);
                     m
@@ -154,12 +155,12 @@ fn scene_pipeline(
     ctx: &Context,
     layout: vk::PipelineLayout,
     formats: Formats,
-    variant: usize,
+    variant: VariantKey,
     entry: Entry,
     module: vk::ShaderModule,
 ) -> Result<vk::Pipeline, GpuError> {
     let (bindings, attributes) = vertex_layout();
-    let name = format!("camera pipeline variant {variant} {entry:?}");
+    let name = format!("camera pipeline variant {} {entry:?}", variant.bits());
     let resolve = entry == Entry::Resolve;
     let gbuffer = entry == Entry::GBuffer;
     let aov = entry == Entry::Aov;

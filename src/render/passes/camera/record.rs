@@ -9,6 +9,7 @@ use crate::render::passes::cull::{CameraCull, Entry};
 use crate::render::passes::deferred::{self, DeferPlan};
 use crate::render::passes::receivers::{self, Split};
 use crate::render::pipeline::{depth_clear_attachment, set_viewport};
+use crate::shader_consts::VariantKey;
 use ash::vk;
 
 impl CameraPass {
@@ -308,7 +309,7 @@ impl CameraPass {
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
         plan: &DeferPlan,
-        frame_bits: usize,
+        frame_bits: VariantKey,
         extent: vk::Extent2D,
     ) {
         let Some(gbuffer) = self.gbuffer.as_ref() else {
@@ -349,7 +350,7 @@ pub(super) fn full_rect(extent: vk::Extent2D) -> vk::Rect2D {
 
 /// The (variant, scissor) of each piece a draw of variant `bits` is drawn in (`None`: the whole
 /// image): the unshadowed variant where `split` says the lookup cannot shadow anything.
-fn pieces(bits: usize, split: Split) -> Vec<(usize, Option<vk::Rect2D>)> {
+fn pieces(bits: VariantKey, split: Split) -> Vec<(VariantKey, Option<vk::Rect2D>)> {
     match split {
         Split::Shadowed => vec![(bits, None)],
         Split::Unshadowed => vec![(receivers::unshadowed(bits), None)],

@@ -1,0 +1,136 @@
+//! The plan finished at birth: after the shadow views, their casters (`FramePlan::plan_casters`),
+//! the exact method's choice and the camera's sight are made here, inside `plan_frame`, so
+//! nothing fills the plan in after it is made.
+
+use super::FramePlan;
+use crate::plan::casters::Viewpoint;
+use crate::plan::exact::{exact_asked, ExactMode, ExactPlan, CONTACT_TEXELS, CONTACT_THICKNESS};
+use crate::plan::input::PlanScene;
+use crate::plan::reach::ShadowReach;
+use crate::plan::settings::{View, ViewMode};
+use crate::plan::sight::Sight;
+use crate::scene::LightKind;
+use crate::shader_consts::VariantKey;
+
+/// The exact pass of a frame planned as `plan` for `view` (relative to the plan's origin) of
+/// `scene` at `aspect`, when it applies: exact shadows need one shadowed directional or spot
+/// light with one view (or a point light's six); contact shadows a shown shadowed light and
+/// hard shadows (they march `CONTACT_TEXELS` of its finest view).
+pub(super) fn choose_exact(
+    plan: &FramePlan,
+    view: &View,
+    scene: &PlanScene,
+    aspect: f32,
+    capable: bool,
+) -> Option<ExactPlan> {
+    let exact = exact_asked(view, capable);
+    let contact = !exact && view.shadow.enabled && view.shadow.contact && capable;
+    if !exact && !contact {
+        return None;
+    }
+    let bits = plan.shader_variant;
+    let (shown, first) = plan
+        .shadow_light
+        .and_then(|i| {
+            plan.shadow_views
+                .iter()
+                .position(|v| v.light == i)
+                .map(|first| (i, first))
+        })
+        .filter(|_| plan.shadows_on && bits.contains(VariantKey::SHADOWS))?;
+    // Exact: the shown light's views are the frame's, one (a sun's single map, a spot
+    // light) or a point light's six faces.
+    let only_shown = plan.shadow_views.iter().all(|v| v.light == shown);
+    let point = plan.lights[shown].kind == LightKind::Point;
+    let views = plan.shadow_views.len();
+    let mode = match contact {
+        false if only_shown && (views == 1 || (point && views == 6)) => ExactMode::Exact,
+        true if !bits.contains(VariantKey::SOFT) => {
+            let length = CONTACT_TEXELS * plan.shadow_views[first].texel_world;
+            ExactMode::Contact {
+                length,
+                thickness: CONTACT_THICKNESS * length,
+            }
+        }
+        _ => return None,
+    };
+    let (light, positional) = match plan.light_source(shown) {
+        Viewpoint::Eye(p) => (p, true),
+        Viewpoint::Along(d) => (d, false),
+    };
+    let cam = &view.camera;
+    let half = cam.half_extent_at(cam.near, aspect);
+    Some(ExactPlan {
+        mode,
+        views: plan
+            .shadow_views
+            .iter()
+            .map(|v| v.light_clip_from_world)
+            .collect(),
+        light,
+        positional,
+        // The CPU reference's ray offset: 2·10⁻⁵ of the scene's diagonal.
+        eps: (scene.bounds.diagonal() * 2e-5).max(1e-6),
+        clip_from_world: plan.clip_from_world,
+        eye: (
+            plan.camera_position,
+            (cam.near * cam.near + half.length_squared()).sqrt(),
+        ),
+        receivers: (0..scene.receivers.len()).collect(),
+        casters: match mode {
+            ExactMode::Exact => {
+                let mut all: Vec<usize> = plan
+                    .shadow_views
+                    .iter()
+                    .flat_map(|v| v.casters.draws.iter().copied())
+                    .collect();
+                all.sort_unstable();
+                all.dedup();
+                all
+            }
+            ExactMode::Contact { .. } => Vec::new(),
+        },
+    })
+}
+
+/// The sight of `view` planned as `plan` at `aspect`; with `receiver_split`, the reach of a
+/// single shadow view.
+pub(super) fn sight(plan: &FramePlan, view: &View, aspect: f32, receiver_split: bool) -> Sight {
+    let cam = &view.camera;
+    let half = cam.half_extent_at(cam.near, aspect);
+    let single_view = plan.shadow_views.len() == 1;
+    let bits = plan.shader_variant;
+    let shadow_reach = (receiver_split
+        && view.mode == ViewMode::Lit
+        && plan.shadows_on
+        && single_view
+        && bits.contains(VariantKey::SHADOWS)
+        && !bits.contains(VariantKey::MANY_VIEWS))
+    .then(|| {
+        let sv = &plan.shadow_views[0];
+        let apex = match plan.light_source(sv.light) {
+            Viewpoint::Eye(p) => Some(p),
+            Viewpoint::Along(_) => None,
+        };
+        ShadowReach::new(
+            &sv.light_clip_from_world,
+            sv.casters.lookup,
+            sv.res as f32,
+            view.shadow.normal_offset.abs() + view.shadow.constant_bias.abs(),
+            sv.texel_world,
+            apex,
+        )
+    });
+    Sight {
+        eye: (
+            plan.camera_position,
+            (cam.near * cam.near + half.length_squared()).sqrt(),
+        ),
+        viewpoint: if cam.is_orthographic() {
+            Viewpoint::Along(cam.forward())
+        } else {
+            Viewpoint::Eye(plan.camera_position)
+        },
+        shadow_reach,
+    }
+}
