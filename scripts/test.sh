@@ -30,9 +30,10 @@ step fmt cargo fmt --all -- --check
 step "module graph" python3 scripts/imports.py
 # The shape: no source file over 800 lines, no function over 120 (the figures printed).
 step "shape gate" python3 scripts/sizes.py --gate 800 120
-step clippy cargo clippy --all-targets --quiet -- -D warnings
+# Every crate (the Python extension too: checked, not linked) in one run, then the engine and
+# the lab without their default features.
+step clippy cargo clippy --workspace --all-targets --quiet -- -D warnings
 step "clippy, no default features" cargo clippy --no-default-features --all-targets --quiet -- -D warnings
-step "clippy, python" cargo clippy -p umbra-python --all-targets --quiet -- -D warnings
 step "cargo test" cargo test --all-targets
 step "doc tests" cargo test --doc
 # umbra as a user's dev-dependency with default-features = false (shares this target dir).

@@ -34,11 +34,11 @@ pub mod plan;
 pub mod render;
 pub mod scene;
 pub(crate) mod shader_consts;
-pub mod table;
 
 pub use gpu::{Context, ContextDesc, GpuError, Validation, ValidationLog};
-pub use render::{
-    FramePlan, FrameStats, Pcf, RenderedFrame, Renderer, SceneOptions, ShadowFit, ShadowFormat,
-    ShadowHold, ShadowMethod, ShadowSettings, View, ViewMode,
+pub use plan::{
+    FramePlan, Pcf, SceneOptions, ShadowFit, ShadowFormat, ShadowHold, ShadowMethod,
+    ShadowSettings, View, ViewMode,
 };
+pub use render::{FrameStats, RenderedFrame, Renderer};
 pub use scene::{demo::demo_scene, load_gltf, Camera, Light, LightKind, LoadError, Scene};

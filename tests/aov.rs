@@ -5,7 +5,8 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec3, Vec4};
-use umbra::render::{Renderer, View};
+use umbra::plan::View;
+use umbra::render::Renderer;
 use umbra::scene::shapes::{add_object, add_texture, colored, quad};
 use umbra::scene::{AlphaMode, Camera, Material, Scene, Texture, TextureRef};
 

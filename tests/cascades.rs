@@ -9,7 +9,8 @@ use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
-use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::{RenderedFrame, Renderer};
 use umbra::scene::synthetic::{town_boxes, town_scene, town_sun};
 use umbra::scene::Camera;
 

@@ -12,7 +12,8 @@ use crate::common::corpus::{extra_corpus, models_under, write_corpus};
 use crate::common::*;
 use glam::{Mat4, Vec3};
 use std::path::{Path, PathBuf};
-use umbra::render::{Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::shapes::{add_object, colored, plane};
 use umbra::scene::{load_gltf, Camera, Scene};
 
@@ -252,7 +253,6 @@ fn live_cases(tools: &Path, original: &Path, dir: &Path) -> Vec<(PathBuf, PathBu
 
 #[test]
 fn recompressed_models_render_like_their_originals() {
-    let ctx = context();
     let mut cases = committed_cases(&out_dir().join("compressed_originals"));
     let committed = cases.len();
     if let Some(tools) = std::env::var_os("UMBRA_GLTF_TOOLS").map(PathBuf::from) {
@@ -260,12 +260,30 @@ fn recompressed_models_render_like_their_originals() {
         std::fs::create_dir_all(&dir).unwrap();
         let mut originals = write_corpus(&out_dir().join("compressed_live_originals"));
         originals.extend(extra_corpus().map(|d| models_under(&d)).unwrap_or_default());
-        for o in originals {
-            cases.extend(live_cases(&tools, &o, &dir));
-        }
+        // The tools run on every core, in order, before the device is taken (the other GPU
+        // tests draw meanwhile).
+        let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
+        let per = originals.len().div_ceil(threads).max(1);
+        let encoded: Vec<Vec<_>> = std::thread::scope(|s| {
+            let jobs: Vec<_> = originals
+                .chunks(per)
+                .map(|chunk| {
+                    let (tools, dir) = (&tools, &dir);
+                    s.spawn(move || {
+                        chunk
+                            .iter()
+                            .flat_map(|o| live_cases(tools, o, dir))
+                            .collect()
+                    })
+                })
+                .collect();
+            jobs.into_iter().map(|j| j.join().unwrap()).collect()
+        });
+        cases.extend(encoded.into_iter().flatten());
     } else {
         eprintln!("UMBRA_GLTF_TOOLS not set: the committed fixtures only");
     }
+    let ctx = context();
     let (mut rows, mut failures) = (Vec::new(), Vec::new());
     for (original, encoded, setting) in &cases {
         let v = judge(&ctx, original, encoded);

@@ -4,7 +4,7 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec3};
-use umbra::render::SceneOptions;
+use umbra::plan::SceneOptions;
 use umbra::scene::foliage::foliage_scene;
 use umbra::scene::shapes::{add_object, add_texture, colored, quad, uv_sphere};
 use umbra::scene::synthetic::double_sided_scene;

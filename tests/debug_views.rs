@@ -6,7 +6,8 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec3};
-use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::{RenderedFrame, Renderer};
 use umbra::scene::shapes::{add_object, colored, cuboid, plane, quad};
 use umbra::scene::synthetic::town_scene;
 use umbra::scene::{Camera, Material, Scene};

@@ -5,7 +5,7 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use umbra::render::SceneOptions;
+use umbra::plan::SceneOptions;
 use umbra::scene::shapes::{add_object, add_texture, colored, quad, uv_sphere};
 use umbra::scene::synthetic::double_sided_scene;
 use umbra::scene::{Camera, Light, LightKind, Material, Scene, Texture, TextureRef, UvTransform};

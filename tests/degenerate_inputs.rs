@@ -5,7 +5,8 @@ use crate::common::*;
 use base64::Engine as _;
 use serde_json::json;
 use std::path::PathBuf;
-use umbra::render::{Renderer, View};
+use umbra::plan::View;
+use umbra::render::Renderer;
 use umbra::scene::load_gltf;
 
 fn write_gltf(

@@ -6,7 +6,8 @@
 use crate::common::corpus::{extra_corpus, models_under, write_corpus};
 use crate::common::*;
 use std::path::{Path, PathBuf};
-use umbra::render::{Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::{load_gltf, shapes::add_ground, Scene};
 
 const W: u32 = 160;

@@ -4,7 +4,8 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec2, Vec3};
-use umbra::render::{Renderer, View};
+use umbra::plan::View;
+use umbra::render::Renderer;
 use umbra::scene::demo::bump_normal_map;
 use umbra::scene::mikk::generate_mikktspace;
 use umbra::scene::shapes::{add_object, add_texture, quad};

@@ -3,7 +3,8 @@
 
 use crate::common::*;
 use glam::{Mat4, Quat, Vec3};
-use umbra::render::{Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::shapes::{add_object, colored, plane, quad};
 use umbra::scene::{
     blinn_phong_params, demo::demo_scene, shade_blinn_phong, Camera, Light, Material, Scene,

@@ -9,7 +9,8 @@ use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
-use umbra::render::{Renderer, ShadowFormat, ShadowSettings, View, ViewMode};
+use umbra::plan::{ShadowFormat, ShadowSettings, View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::shapes::{add_object, colored, cuboid};
 use umbra::scene::{Camera, Light, LightKind, Scene};
 

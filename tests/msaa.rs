@@ -8,7 +8,8 @@
 use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::plan::{FramePlan, ScenePlanner};
-use umbra::render::{PostAa, Renderer, SceneOptions, View};
+use umbra::plan::{PostAa, SceneOptions, View};
+use umbra::render::Renderer;
 use umbra::scene::shapes::{add_object, colored, cuboid, plane, uv_sphere};
 use umbra::scene::{Camera, Light, Scene};
 

@@ -6,7 +6,7 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec3};
-use umbra::render::SceneOptions;
+use umbra::plan::SceneOptions;
 use umbra::scene::demo::demo_scene;
 use umbra::scene::shapes::{add_object, colored, cuboid, uv_sphere};
 use umbra::scene::{Camera, Light, LightKind, Scene};

@@ -335,7 +335,7 @@ fn stability(a: app::cli::StabilityArgs) -> anyhow::Result<()> {
         .next()
         .map(|v| v.1)
         .ok_or_else(|| anyhow::anyhow!("{}: no view", scene.name))?;
-    let view = umbra::render::View::new(camera);
+    let view = umbra::plan::View::new(camera);
     let wall =
         (a.builtin || spec == "stability").then_some(umbra::scene::synthetic::STABILITY_WALL_HALF);
     let ctx = offscreen_context(a.validation, a.device.clone())?;
@@ -508,8 +508,8 @@ fn inspect(a: app::cli::InspectArgs) -> anyhow::Result<()> {
     let view = make_view(&scene, &a.view)?;
     let mut report = umbra::scene::inspect::document_report(&a.scene, &scene)?;
     let (w, h) = a.view.size;
-    report["shadow_plan"] = umbra::render::report::plan_report(&scene, &view, w, h);
-    report["exposure"] = umbra::render::report::exposure_report(&scene, &view, w, h);
+    report["shadow_plan"] = umbra::plan::report::plan_report(&scene, &view, w, h);
+    report["exposure"] = umbra::plan::report::exposure_report(&scene, &view, w, h);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -538,7 +538,7 @@ fn fmt_ms(ms: f64) -> String {
 }
 
 /// The anti-aliasing a frame gets, as a parenthesis after its size (empty without any).
-fn anti_aliasing(samples: u32, view: &umbra::render::View) -> String {
+fn anti_aliasing(samples: u32, view: &umbra::plan::View) -> String {
     let mut parts = Vec::new();
     if samples > 1 {
         parts.push(format!("{samples}× MSAA"));
@@ -547,7 +547,7 @@ fn anti_aliasing(samples: u32, view: &umbra::render::View) -> String {
         let s = view.supersample;
         parts.push(format!("{s}×{s} supersampled"));
     }
-    if view.post_aa == umbra::render::PostAa::Fxaa {
+    if view.post_aa == umbra::plan::PostAa::Fxaa {
         parts.push("FXAA".to_string());
     }
     if parts.is_empty() {

@@ -13,7 +13,8 @@ use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use umbra::math::tonemap::ev100_from_exposure;
-use umbra::render::{Exposure, Renderer, View};
+use umbra::plan::{Exposure, View};
+use umbra::render::Renderer;
 use umbra::scene::shapes::{cuboid, plane, uv_sphere};
 use umbra::scene::{load_gltf, Primitive, Scene};
 use umbra_lab::reference::ReferenceScene;
@@ -206,10 +207,7 @@ fn tone_mapped_image_matches_the_reference() {
     let ctx = context();
     let (lux, _, _) = scenes();
     let mut r = Renderer::new(&ctx, &lux).unwrap();
-    for tonemap in [
-        umbra::render::Tonemap::Neutral,
-        umbra::render::Tonemap::Aces,
-    ] {
+    for tonemap in [umbra::plan::Tonemap::Neutral, umbra::plan::Tonemap::Aces] {
         let mut v = view(&lux);
         v.tonemap = tonemap;
         let f = r.render(&v, W, H).unwrap();

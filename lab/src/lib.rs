@@ -13,5 +13,6 @@
 pub mod analysis;
 pub mod reference;
 pub mod score;
+pub mod table;
 
 pub use score::{score, Scored};

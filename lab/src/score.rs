@@ -4,7 +4,8 @@
 use crate::reference::metrics::{classify, summarise, Classified, Metrics};
 use crate::reference::raycast::{ReferenceFrame, ReferenceScene};
 use umbra::gpu::GpuError;
-use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::{RenderedFrame, Renderer};
 
 /// A scored frame.
 pub struct Scored {

@@ -74,7 +74,7 @@ fn interior_misclassified(f: &RenderedFrame, scene: &Scene) -> (usize, usize) {
 /// The shadow-visibility view of the same frame, with depth.
 fn shadow_frame(ctx: &std::sync::Arc<umbra::Context>, scene: &Scene, v: &View) -> RenderedFrame {
     let mut v = v.clone();
-    v.mode = umbra::render::ViewMode::Shadow;
+    v.mode = umbra::plan::ViewMode::Shadow;
     render(ctx, scene, &v)
 }
 

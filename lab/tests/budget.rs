@@ -3,7 +3,8 @@
 //! by the full-image comparison, and a budget of 0 takes exact shadows.
 
 use crate::common::*;
-use umbra::render::{Renderer, View};
+use umbra::plan::View;
+use umbra::render::Renderer;
 use umbra::scene::synthetic::town_scene;
 use umbra_lab::analysis::budget::{self, PROBE_STRIDE};
 use umbra_lab::analysis::grid::Grid;

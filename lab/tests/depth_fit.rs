@@ -8,7 +8,8 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec3};
-use umbra::render::{Renderer, View};
+use umbra::plan::View;
+use umbra::render::Renderer;
 use umbra::scene::shapes::{add_object, colored, cuboid};
 use umbra::scene::{Camera, Light, Scene};
 use umbra_lab::reference::{misclassified_by_depth, ReferenceScene};

@@ -9,7 +9,8 @@
 
 use crate::common::*;
 use umbra::plan::ShadowMethod;
-use umbra::render::{Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::{demo::demo_scene, load_gltf, shapes::add_ground, synthetic, Scene};
 use umbra_lab::reference::{compare, Metrics, ReferenceScene};
 

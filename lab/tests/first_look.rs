@@ -10,7 +10,8 @@ use crate::common::*;
 use glam::Vec3;
 use serde_json::json;
 use std::path::PathBuf;
-use umbra::render::{Exposure, Renderer, View, ViewMode};
+use umbra::plan::{Exposure, View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::{load_gltf, Scene};
 use umbra_lab::reference::ReferenceScene;
 

@@ -8,7 +8,8 @@
 //! stability suite's foliage probe is in `stability.rs`.)
 
 use crate::common::*;
-use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::{RenderedFrame, Renderer};
 use umbra::scene::foliage::foliage_scene;
 use umbra::scene::{AlphaMode, Scene};
 use umbra_lab::reference::{classify, PixelClass, ReferenceScene};

@@ -7,7 +7,8 @@ use crate::common::*;
 use glam::Vec3;
 use serde_json::json;
 use std::path::PathBuf;
-use umbra::render::{Renderer, View};
+use umbra::plan::View;
+use umbra::render::Renderer;
 use umbra::scene::{load_gltf, Camera};
 use umbra_lab::reference::ReferenceScene;
 

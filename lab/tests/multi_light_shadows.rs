@@ -6,7 +6,8 @@
 //! casting nothing would fail. The scenes are `--synthetic room`, `sun-and-spot` and `two-suns`.
 
 use crate::common::*;
-use umbra::render::{Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::synthetic::{room_scene, sun_and_spot_scene, two_suns_scene};
 use umbra::scene::Scene;
 use umbra_lab::reference::{classify, PixelClass, ReferenceScene};

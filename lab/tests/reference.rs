@@ -4,7 +4,8 @@
 use crate::common::*;
 use glam::Vec3;
 use umbra::math::ray::Ray;
-use umbra::render::{Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::{demo::demo_scene, load_gltf, Scene};
 use umbra_lab::reference::{compare, ReferenceScene};
 

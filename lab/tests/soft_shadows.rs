@@ -7,7 +7,8 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec3};
-use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::{RenderedFrame, Renderer};
 use umbra::scene::shapes::{add_object, colored, cuboid, plane};
 use umbra::scene::{Camera, Light, Scene};
 use umbra_lab::reference::{flip, ReferenceFrame, ReferenceScene};

@@ -4,8 +4,9 @@
 //! probe: leaf shadows shimmer along the suite's flythrough with maps, not with exact shadows.
 
 use crate::common::*;
-use umbra::render::ScenePlanner;
-use umbra::render::{Renderer, ShadowMethod, ShadowSettings, View};
+use umbra::plan::ScenePlanner;
+use umbra::plan::{ShadowMethod, ShadowSettings, View};
+use umbra::render::Renderer;
 use umbra::scene::foliage::foliage_scene;
 use umbra::scene::synthetic::{stability_scene, STABILITY_WALL_HALF};
 use umbra::scene::AlphaMode;

@@ -6,7 +6,8 @@
 
 use crate::common::*;
 use glam::{Mat4, Vec3, Vec4};
-use umbra::render::{Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::shapes::{add_object, colored, plane, quad};
 use umbra::scene::{AlphaMode, Camera, Light, Material, Scene};
 use umbra_lab::reference::{classify, PixelClass, ReferenceScene};

@@ -11,7 +11,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::sync::Arc;
-use umbra::render::{Renderer, SceneOptions, View, ViewMode};
+use umbra::plan::{SceneOptions, View, ViewMode};
+use umbra::render::Renderer;
 use umbra::scene::anim::Playing;
 use umbra::{Context, ContextDesc, Validation};
 

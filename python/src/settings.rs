@@ -6,7 +6,7 @@ use glam::Vec3;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use umbra::render::{Background, Exposure, PostAa, ShadowFit, Tonemap, View, SUPERSAMPLE_FACTORS};
+use umbra::plan::{Background, Exposure, PostAa, ShadowFit, Tonemap, View, SUPERSAMPLE_FACTORS};
 
 /// What a frame is rendered with besides the view: the error budget, the light whose visibility
 /// `shadow` holds, and the scene's time.
@@ -83,7 +83,7 @@ pub fn apply(view: &mut View, settings: Option<&Bound<'_, PyDict>>) -> PyResult<
             "pcf" => s.pcf = text()?.parse().map_err(|e| invalid(&name, e))?,
             "cascades" => {
                 let n: u32 = v.extract()?;
-                if n > umbra::render::MAX_CASCADES {
+                if n > umbra::plan::MAX_CASCADES {
                     return Err(invalid(&name, format!("{n} is above 4")));
                 }
                 s.cascades = n;

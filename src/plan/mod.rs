@@ -14,6 +14,7 @@ pub(crate) mod frame;
 pub(crate) mod input;
 pub(crate) mod lights;
 pub(crate) mod reach;
+pub mod report;
 pub(crate) mod settings;
 pub(crate) mod sight;
 pub(crate) mod uniforms;

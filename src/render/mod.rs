@@ -2,7 +2,7 @@
 //! pipelines and samplers, the scene's GPU copy (`gpu_scene`), the frame scheduler (`core`:
 //! prepare, then record) and the offscreen and window renderers. The passes record what a
 //! [`crate::plan::FramePlan`] says. Passes, pipelines and uniform layouts are internal; the
-//! public types are re-exported here.
+//! plan's types (`View`, `SceneOptions`, …) are spelled `umbra::plan::…`, the renderers' here.
 
 pub(crate) mod core;
 mod device;
@@ -10,18 +10,11 @@ pub(crate) mod gpu_scene;
 pub(crate) mod passes;
 pub(crate) mod pipeline;
 pub(crate) mod renderer;
-pub mod report;
 pub(crate) mod samplers;
 pub(crate) mod targets;
 #[cfg(feature = "viewer")]
 pub(crate) mod window;
 
-pub use crate::plan::{
-    effective_lights, metered_illuminance, Ambient, Background, DeviceFacts, Exposure, FramePlan,
-    HeldLight, Pcf, PostAa, SceneOptions, ScenePlanner, ShadowFit, ShadowFormat, ShadowHold,
-    ShadowMethod, ShadowSettings, ShadowView, Tonemap, View, ViewMode, MAX_CASCADES, MAX_LIGHTS,
-    MAX_SHADOW_VIEWS, SUPERSAMPLE_FACTORS, UNIT_AMBIENT,
-};
 pub use device::device_facts;
 pub use renderer::{view_axis_depths, Aovs, FrameStats, RenderedFrame, Renderer, MAX_SIDE};
 #[cfg(feature = "viewer")]

@@ -84,7 +84,7 @@ pub fn context_with(desc: ContextDesc) -> TestContext {
 pub fn render_with(
     ctx: &std::sync::Arc<Context>,
     scene: &umbra::scene::Scene,
-    options: &umbra::render::SceneOptions,
+    options: &umbra::plan::SceneOptions,
     view: &umbra::View,
     (w, h): (u32, u32),
 ) -> umbra::RenderedFrame {
@@ -142,7 +142,7 @@ pub fn pixel_ray(clip_from_world: &Mat4, x: u32, y: u32, w: u32, h: u32) -> (Vec
 /// The point of the ground plane y = 0 seen at pixel (x, y) of a `w`×`h` frame planned by `plan`,
 /// when the reference's first hit there (`distance`, from the eye) is that plane.
 pub fn ground_point(
-    plan: &umbra::render::FramePlan,
+    plan: &umbra::plan::FramePlan,
     distance: &[f32],
     (x, y): (u32, u32),
     (w, h): (u32, u32),

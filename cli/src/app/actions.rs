@@ -3,7 +3,7 @@
 //! widget that sets the same value leave the same view, so they draw the same frame.
 
 use glam::Vec3;
-use umbra::render::{Pcf, PostAa, ShadowMethod, Tonemap, View, ViewMode, MAX_CASCADES};
+use umbra::plan::{Pcf, PostAa, ShadowMethod, Tonemap, View, ViewMode, MAX_CASCADES};
 use umbra::scene::Light;
 
 /// What a key or a panel widget does to the view.
@@ -299,7 +299,7 @@ fn horizon_note(elevation: f32) -> &'static str {
 }
 
 /// The biases, as printed.
-fn bias_line(s: &umbra::render::ShadowSettings) -> String {
+fn bias_line(s: &umbra::plan::ShadowSettings) -> String {
     format!(
         "bias: constant {:.2} texels, slope {:.2}, normal offset {:.2} texels",
         s.constant_bias, s.slope_bias, s.normal_offset

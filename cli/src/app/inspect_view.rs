@@ -1,7 +1,7 @@
 //! `umbra inspect`'s text and Markdown views of the JSON report (`scene::inspect`).
 
 use serde_json::Value;
-use umbra::table::Table;
+use umbra_lab::table::Table;
 
 /// A JSON value as a short cell: strings bare, null as "–", arrays joined, floats to 4 digits.
 fn cell(v: &Value) -> String {

@@ -6,7 +6,8 @@
 use super::actions::{Action, SunAngles, VIEW_CYCLE};
 use super::scene_tree::SceneTree;
 use std::collections::HashMap;
-use umbra::render::{FrameSummary, Pcf, ShadowMethod, Tonemap, View, MAX_CASCADES};
+use umbra::plan::{Pcf, ShadowMethod, Tonemap, View, MAX_CASCADES};
+use umbra::render::FrameSummary;
 
 /// Frame figures, averaged over the last quarter second.
 #[derive(Clone, Debug, Default)]
@@ -364,7 +365,7 @@ fn light_section(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: &
             if let Some(t) = choice(ui, w, "tone curve (T)", "tonemap", v.tonemap, &curves) {
                 out.push(Command::Set(Action::SetTonemap(t)));
             }
-            let name = |m: umbra::render::ViewMode| format!("{m:?}").to_lowercase();
+            let name = |m: umbra::plan::ViewMode| format!("{m:?}").to_lowercase();
             egui::ComboBox::from_label("view (V)")
                 .selected_text(name(v.mode))
                 .show_ui(ui, |ui| {

@@ -2,7 +2,7 @@
 //! message for clap on bad input.
 
 use glam::Vec3;
-use umbra::render::{Background, Exposure};
+use umbra::plan::{Background, Exposure};
 
 /// A frame rate within 0.001..=10000.
 pub(crate) fn parse_fps(s: &str) -> Result<f32, String> {

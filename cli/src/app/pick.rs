@@ -2,7 +2,7 @@
 //! material, triangle, position, normal) and, per light, the exact ray-cast verdict next to the
 //! GPU's (the shadow-visibility view read at that pixel for the shadow-mapped light).
 
-use umbra::render::FramePlan;
+use umbra::plan::FramePlan;
 use umbra::scene::{LightKind, Scene};
 use umbra_lab::reference::Pick;
 

@@ -1,7 +1,7 @@
 //! What a sweep runs: the shadow configurations of a grid, and the views of a scene.
 
 use glam::Vec3;
-use umbra::render::{Pcf, ShadowFit, ShadowFormat, ShadowMethod, ShadowSettings};
+use umbra::plan::{Pcf, ShadowFit, ShadowFormat, ShadowMethod, ShadowSettings};
 use umbra::scene::{Camera, Scene};
 
 /// Bias presets: (name, constant texels, slope, normal offset texels).

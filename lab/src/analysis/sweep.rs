@@ -7,7 +7,8 @@ use crate::reference::{ReferenceFrame, ReferenceScene};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use umbra::gpu::GpuError;
-use umbra::render::{FrameStats, Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::{FrameStats, Renderer};
 use umbra::scene::Camera;
 
 /// PSNR written for identical images (instead of ∞, which JSON cannot hold).
@@ -202,7 +203,7 @@ fn run_batch(
     }
     todo.sort_by_key(|c| {
         (
-            c.shadow.format == umbra::render::ShadowFormat::D32,
+            c.shadow.format == umbra::plan::ShadowFormat::D32,
             c.shadow.map_size,
         )
     });
@@ -234,7 +235,7 @@ fn run_batch(
         for (k, c) in todo.iter().enumerate() {
             let v = view_of(c, ViewMode::Lit);
             let map = (
-                c.shadow.format == umbra::render::ShadowFormat::D32,
+                c.shadow.format == umbra::plan::ShadowFormat::D32,
                 c.shadow.map_size,
             );
             if last_map != Some(map) {
@@ -254,7 +255,7 @@ fn run_batch(
         // pass of one frame and the camera pass of another counts twice).
         let gpu = median_split(&st);
         let bytes = match c.shadow.format {
-            umbra::render::ShadowFormat::D16 => 2.0,
+            umbra::plan::ShadowFormat::D16 => 2.0,
             // `auto` may take either: its memory is D32's at most.
             _ => 4.0,
         };

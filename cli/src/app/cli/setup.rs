@@ -4,7 +4,7 @@
 use super::*;
 use anyhow::{anyhow, bail};
 use std::path::PathBuf;
-use umbra::render::{ShadowFit, ShadowFormat, ShadowSettings, View};
+use umbra::plan::{ShadowFit, ShadowFormat, ShadowSettings, View};
 use umbra::scene::anim::Playing;
 use umbra::scene::{demo::demo_scene, load_gltf, Camera, Scene};
 
@@ -187,8 +187,8 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
 }
 
 /// Upload options from arguments.
-pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
-    umbra::render::SceneOptions {
+pub fn scene_options(a: &ViewArgs) -> umbra::plan::SceneOptions {
+    umbra::plan::SceneOptions {
         anisotropy: a.anisotropy,
         culling: !a.no_culling,
         msaa: a.msaa,
@@ -201,8 +201,8 @@ pub fn scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
 
 /// Upload options for runs of many frames (the viewer, image sequences): the shadow cache on
 /// unless `--shadow-cache off`.
-pub fn animated_scene_options(a: &ViewArgs) -> umbra::render::SceneOptions {
-    umbra::render::SceneOptions {
+pub fn animated_scene_options(a: &ViewArgs) -> umbra::plan::SceneOptions {
+    umbra::plan::SceneOptions {
         shadow_cache: a.shadow_cache.unwrap_or(true),
         ..scene_options(a)
     }
@@ -270,7 +270,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     v.post_aa = a.post_aa.parse().unwrap_or_default();
     v.supersample = a.ssaa;
     if let Some(i) = a.shadow_light {
-        let n = umbra::render::effective_lights(&scene.lights, &v).len();
+        let n = umbra::plan::effective_lights(&scene.lights, &v).len();
         if i >= n {
             bail!("--shadow-light {i}: the scene has {n} light(s) (0..{n})");
         }

@@ -6,7 +6,7 @@ use crate::app::parse::{
 };
 use clap::{Args, ValueEnum};
 use glam::Vec3;
-use umbra::render::{Background, Exposure, Pcf, ShadowSettings, Tonemap, ViewMode};
+use umbra::plan::{Background, Exposure, Pcf, ShadowSettings, Tonemap, ViewMode};
 
 /// PCF kernels.
 #[derive(Clone, Copy, Debug, ValueEnum)]

@@ -4,7 +4,7 @@ use super::*;
 use crate::app::actions::{apply, next_shadow_light};
 use crate::app::controller::{Button, Controller, Input};
 use keys::{key_action, AnimKey, KeyAction};
-use umbra::render::effective_lights;
+use umbra::plan::effective_lights;
 use winit::event::{ElementState, MouseButton};
 use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::KeyCode;
@@ -32,7 +32,7 @@ impl App {
             }
             let r = s.pick_renderer.as_mut().expect("created above");
             let mut v = s.view.clone();
-            v.mode = umbra::render::ViewMode::Shadow;
+            v.mode = umbra::plan::ViewMode::Shadow;
             v.highlight = None;
             let frame = r.render(&v, w, h)?;
             let reference = umbra_lab::reference::ReferenceScene::new(scene);

@@ -21,8 +21,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 use umbra::gpu::Context;
+use umbra::plan::View;
+use umbra::render::Overlay;
 use umbra::render::{Capture, DrawResult, WindowRenderer};
-use umbra::render::{Overlay, View};
 use umbra::scene::Scene;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -48,7 +49,7 @@ pub struct ViewerOptions {
     /// Window inner size.
     pub size: (u32, u32),
     /// Upload options (texture filtering).
-    pub scene_options: umbra::render::SceneOptions,
+    pub scene_options: umbra::plan::SceneOptions,
     /// FIFO presentation (vsync).
     pub vsync: bool,
     /// Render this many frames, then exit (with `screenshot`, save the last one).

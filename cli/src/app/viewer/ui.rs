@@ -5,7 +5,7 @@ use super::keys::{AnimKey, KeyAction};
 use super::App;
 use crate::app::actions::Action;
 use crate::app::panel::{panel, Command, PanelModel, Widgets};
-use umbra::render::effective_lights;
+use umbra::plan::effective_lights;
 use winit::event_loop::ActiveEventLoop;
 
 impl App {

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::reference::ReferenceScene;
-use umbra::render::{ScenePlanner, View};
+use umbra::plan::{ScenePlanner, View};
 use umbra::scene::Scene;
 
 /// Most candidates rendered to verify a choice.
@@ -52,7 +52,7 @@ pub fn measure(
 ) -> Result<f64, umbra::gpu::GpuError> {
     let mut v = view.clone();
     v.shadow = c.shadow;
-    v.mode = umbra::render::ViewMode::Shadow;
+    v.mode = umbra::plan::ViewMode::Shadow;
     renderer.set_read_depth(true);
     let f = renderer.render(&v, probe.width, probe.height);
     renderer.set_read_depth(false);

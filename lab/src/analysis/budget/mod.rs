@@ -29,7 +29,7 @@ pub use choose::*;
 
 use crate::reference::{Probe, ReferenceScene};
 use glam::Vec3;
-use umbra::render::{FramePlan, ScenePlanner, ShadowSettings, View};
+use umbra::plan::{FramePlan, ScenePlanner, ShadowSettings, View};
 use umbra::scene::{LightKind, Scene};
 
 /// Probes every this many pixels in x and y. 1: every pixel, so a verified candidate's

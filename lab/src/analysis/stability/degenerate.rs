@@ -10,7 +10,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use serde::Serialize;
 use std::sync::Arc;
 use umbra::gpu::{Context, GpuError};
-use umbra::render::{SceneOptions, View, ViewMode};
+use umbra::plan::{SceneOptions, View, ViewMode};
 use umbra::scene::shapes::{add_object, colored};
 use umbra::scene::{Camera, Light, Primitive, Scene};
 

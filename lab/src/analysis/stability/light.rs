@@ -10,7 +10,8 @@ use umbra::math::projection::pixel_to_ndc;
 use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
 use umbra::plan::ScenePlanner;
-use umbra::render::{Renderer, View};
+use umbra::plan::View;
+use umbra::render::Renderer;
 use umbra::scene::{Camera, Light};
 
 /// Sun elevations (degrees), log-spaced near the horizon.

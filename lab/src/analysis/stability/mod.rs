@@ -24,7 +24,8 @@ pub mod shimmer;
 use crate::reference::{classify, Classified, PixelClass, ReferenceFrame, ReferenceScene};
 use serde::Serialize;
 use umbra::gpu::GpuError;
-use umbra::render::{RenderedFrame, Renderer, View, ViewMode};
+use umbra::plan::{View, ViewMode};
+use umbra::render::{RenderedFrame, Renderer};
 
 /// Schema name of `stability.json`.
 pub const SCHEMA: &str = "umbra-stability/1";
@@ -245,7 +246,7 @@ pub fn classify_view(
 /// Shadow texels around a lookup that can decide it: the filter's reach, the normal offset (which
 /// moves the lookup across the light by up to that many texels) and one for rasterising casters
 /// at texel centres.
-pub fn lookup_reach_texels(s: &umbra::render::ShadowSettings, soft: bool) -> f32 {
+pub fn lookup_reach_texels(s: &umbra::plan::ShadowSettings, soft: bool) -> f32 {
     umbra::plan::lookup_reach(s.pcf, soft) as f32 + s.normal_offset.max(0.0) + 1.0
 }
 
@@ -282,7 +283,7 @@ pub fn near_casters(
         .map(|l| l.position);
     for (&i, probe) in idx.iter().zip(probes) {
         let Some(p) = probe else { continue };
-        let holds = |v: &&umbra::render::ShadowView| {
+        let holds = |v: &&umbra::plan::ShadowView| {
             let q = umbra::math::shadow_fit::project(&v.light_clip_from_world, p.position);
             q.x.abs() <= 1.0 && q.y.abs() <= 1.0 && (0.0..=1.0).contains(&q.z)
         };
@@ -303,7 +304,7 @@ pub fn near_casters(
 pub fn classify_scene(
     ctx: &std::sync::Arc<umbra::gpu::Context>,
     scene: &umbra::scene::Scene,
-    options: &umbra::render::SceneOptions,
+    options: &umbra::plan::SceneOptions,
     view: &View,
     size: (u32, u32),
 ) -> Result<(Counts, RenderedFrame, Renderer), GpuError> {

@@ -16,7 +16,8 @@ use glam::Vec3;
 use serde::Serialize;
 use umbra::gpu::GpuError;
 use umbra::math::Aabb;
-use umbra::render::{Renderer, SceneOptions, ShadowHold, View};
+use umbra::plan::{SceneOptions, ShadowHold, View};
+use umbra::render::Renderer;
 use umbra::scene::anim::{add_mover, Playing};
 use umbra::scene::shapes::{colored, cuboid};
 use umbra::scene::{Light, Scene};
@@ -168,7 +169,7 @@ pub fn motion(
 ) -> Result<Vec<MotionSeries>, GpuError> {
     let (size, quick) = (opts.size, opts.quick);
     let n = frames(quick);
-    let sun = umbra::render::effective_lights(&scene.lights, view)
+    let sun = umbra::plan::effective_lights(&scene.lights, view)
         .iter()
         .find(|l| l.kind == umbra::scene::LightKind::Directional)
         .map_or(Vec3::NEG_Y, |l| l.direction);

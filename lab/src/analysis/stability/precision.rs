@@ -15,7 +15,7 @@ use serde::Serialize;
 use std::sync::Arc;
 use umbra::gpu::{Context, GpuError};
 use umbra::math::precision::{relative_gap, DepthMapping};
-use umbra::render::{SceneOptions, View};
+use umbra::plan::{SceneOptions, View};
 use umbra::scene::{LightKind, Scene};
 
 /// Distances from the origin (scene units) of the translated cases; 0 is the reference case.

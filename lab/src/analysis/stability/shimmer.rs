@@ -16,7 +16,8 @@ use umbra::math::bezier::CubicBezier;
 use umbra::math::projection::pixel_to_ndc;
 use umbra::math::Aabb;
 use umbra::plan::camera_projection;
-use umbra::render::{Renderer, ShadowFit, ShadowHold, ShadowMethod, ShadowSettings, View};
+use umbra::plan::{ShadowFit, ShadowHold, ShadowMethod, ShadowSettings, View};
+use umbra::render::Renderer;
 use umbra::scene::Camera;
 
 /// A shadow method the path is flown with.

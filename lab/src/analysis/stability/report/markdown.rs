@@ -2,8 +2,8 @@
 
 use super::*;
 use crate::analysis::stability::EDGE_ON_DEGREES;
+use crate::table::Table;
 use std::fmt::Write as _;
-use umbra::table::Table;
 
 /// The cells of a flip series: mean and worst flipped fraction, mean points per frame.
 pub(super) fn flip_cells(mean: f64, max: f64, points: &[usize]) -> [String; 3] {

@@ -30,7 +30,8 @@ use std::path::Path;
 use std::sync::Arc;
 use umbra::gpu::{Context, GpuError};
 use umbra::plan::ScenePlanner;
-use umbra::render::{Renderer, SceneOptions, View};
+use umbra::plan::{SceneOptions, View};
+use umbra::render::Renderer;
 use umbra::scene::Scene;
 
 /// Flipped points per frame allowed with snapping.
@@ -147,7 +148,7 @@ pub fn contact_elevations(quick: bool) -> Vec<f32> {
     }
 }
 
-fn describe(s: &umbra::render::ShadowSettings) -> String {
+fn describe(s: &umbra::plan::ShadowSettings) -> String {
     format!(
         "map {} {:?} {:?}, bias constant {} slope {} normal {}, fit {:?}, snap {}, cascades {}",
         s.map_size,
