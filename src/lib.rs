@@ -41,4 +41,6 @@ pub use plan::{
     ShadowSettings, View, ViewMode,
 };
 pub use render::{FrameStats, RenderedFrame, Renderer};
-pub use scene::{demo::demo_scene, load_gltf, Camera, Light, LightKind, LoadError, Scene};
+pub use scene::{
+    built::demo::demo_scene, gltf::load_gltf, gltf::LoadError, Camera, Light, LightKind, Scene,
+};

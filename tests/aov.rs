@@ -7,7 +7,7 @@ use crate::common::*;
 use glam::{Mat4, Vec3, Vec4};
 use umbra::plan::View;
 use umbra::render::Renderer;
-use umbra::scene::shapes::{add_object, add_texture, colored, quad};
+use umbra::scene::built::shapes::{add_object, add_texture, colored, quad};
 use umbra::scene::{AlphaMode, Camera, Material, Scene, Texture, TextureRef};
 
 const W: u32 = 160;
@@ -127,7 +127,7 @@ fn depth_ids_and_normals_read_what_the_geometry_says() {
 #[test]
 fn close_up_models_cover_a_third_of_the_frame() {
     let ctx = context();
-    let scene = umbra::scene::synthetic::close_up_scene();
+    let scene = umbra::scene::built::synthetic::close_up_scene();
     let mut r = Renderer::new(&ctx, &scene).unwrap();
     let (w, h) = (640, 360);
     let view = View::new(scene.cameras[0]);

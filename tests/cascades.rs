@@ -1,5 +1,5 @@
 //! Cascaded shadow maps on a scene as large as a town, seen from eye height (lavapipe,
-//! validation on; `scene::synthetic::town_scene`): a 2 km ground with buildings up to a kilometre
+//! validation on; `scene::built::synthetic::town_scene`): a 2 km ground with buildings up to a kilometre
 //! away and a bench-sized box six metres in front of the camera. One map fitted to the view spends its texels over a kilometre of
 //! depth and loses the near shadow; four cascades keep it. Judged against exact visibility: every
 //! ground pixel's ray towards the sun against the boxes, away from shadow edges (EDGE_TEXELS
@@ -11,7 +11,7 @@ use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
 use umbra::plan::{View, ViewMode};
 use umbra::render::{RenderedFrame, Renderer};
-use umbra::scene::synthetic::{town_boxes, town_scene, town_sun};
+use umbra::scene::built::synthetic::{town_boxes, town_scene, town_sun};
 use umbra::scene::Camera;
 
 const EDGE_TEXELS: f32 = 3.0;

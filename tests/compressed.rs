@@ -14,8 +14,8 @@ use glam::{Mat4, Vec3};
 use std::path::{Path, PathBuf};
 use umbra::plan::{View, ViewMode};
 use umbra::render::Renderer;
-use umbra::scene::shapes::{add_object, colored, plane};
-use umbra::scene::{load_gltf, Camera, Scene};
+use umbra::scene::built::shapes::{add_object, colored, plane};
+use umbra::scene::{gltf::load_gltf, Camera, Scene};
 
 const W: u32 = 200;
 const H: u32 = 150;
@@ -353,7 +353,7 @@ fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
 fn load_edited(
     fixture: &str,
     edit: impl Fn(&mut serde_json::Value, &mut Vec<u8>),
-) -> Result<Scene, umbra::scene::LoadError> {
+) -> Result<Scene, umbra::scene::gltf::LoadError> {
     let (mut json, mut bin) = glb_parts(&std::fs::read(fixtures().join(fixture)).unwrap());
     edit(&mut json, &mut bin);
     // A name of its own: the tests run in parallel and edit the same fixtures.
@@ -375,7 +375,7 @@ fn compressed_view(json: &serde_json::Value, ext: &str, mode: &str) -> usize {
 }
 
 /// The one-line error of a load that must fail.
-fn error_of(r: Result<Scene, umbra::scene::LoadError>) -> String {
+fn error_of(r: Result<Scene, umbra::scene::gltf::LoadError>) -> String {
     let e = r.expect_err("the broken file must not load").to_string();
     assert!(!e.contains('\n'), "one line: {e}");
     e

@@ -5,9 +5,9 @@
 use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::plan::SceneOptions;
-use umbra::scene::foliage::foliage_scene;
-use umbra::scene::shapes::{add_object, add_texture, colored, quad, uv_sphere};
-use umbra::scene::synthetic::double_sided_scene;
+use umbra::scene::built::foliage::foliage_scene;
+use umbra::scene::built::shapes::{add_object, add_texture, colored, quad, uv_sphere};
+use umbra::scene::built::synthetic::double_sided_scene;
 use umbra::scene::{AlphaMode, Camera, Material, Scene, Texture, TextureRef};
 use umbra::{Renderer, View, ViewMode};
 
@@ -38,7 +38,7 @@ fn changed_pixels(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
 }
 
 /// The foliage scene, its leaves blended and masked: with culling its shadow pass draws each
-/// crown's cards cut to where their alpha can pass (`scene::trim`), and the lit and shadow views
+/// crown's cards cut to where their alpha can pass (`scene::mesh::trim`), and the lit and shadow views
 /// are the same to the bit as with whole cards. (The shadow-map view is not: without culling
 /// the flat ground casts too.)
 #[test]

@@ -8,8 +8,8 @@ use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::plan::{View, ViewMode};
 use umbra::render::{RenderedFrame, Renderer};
-use umbra::scene::shapes::{add_object, colored, cuboid, plane, quad};
-use umbra::scene::synthetic::town_scene;
+use umbra::scene::built::shapes::{add_object, colored, cuboid, plane, quad};
+use umbra::scene::built::synthetic::town_scene;
 use umbra::scene::{Camera, Material, Scene};
 
 const SIZE: u32 = 160;

@@ -6,8 +6,8 @@
 use crate::common::*;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use umbra::plan::SceneOptions;
-use umbra::scene::shapes::{add_object, add_texture, colored, quad, uv_sphere};
-use umbra::scene::synthetic::double_sided_scene;
+use umbra::scene::built::shapes::{add_object, add_texture, colored, quad, uv_sphere};
+use umbra::scene::built::synthetic::double_sided_scene;
 use umbra::scene::{Camera, Light, LightKind, Material, Scene, Texture, TextureRef, UvTransform};
 use umbra::{Renderer, View};
 
@@ -227,7 +227,7 @@ fn deferred_double_sided_scene_matches_forward() {
 #[test]
 fn open_double_sided_models_defer_at_a_close_view_and_match_forward() {
     let ctx = context();
-    let scene = umbra::scene::synthetic::close_up_scene();
+    let scene = umbra::scene::built::synthetic::close_up_scene();
     let view = View::new(scene.cameras[0]);
     let on = render_at(&ctx, &scene, true, &view, (1280, 720));
     let off = render_at(&ctx, &scene, false, &view, (1280, 720));

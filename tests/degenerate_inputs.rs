@@ -7,7 +7,7 @@ use serde_json::json;
 use std::path::PathBuf;
 use umbra::plan::View;
 use umbra::render::Renderer;
-use umbra::scene::load_gltf;
+use umbra::scene::gltf::load_gltf;
 
 fn write_gltf(
     name: &str,

@@ -8,7 +8,7 @@ use crate::common::*;
 use std::path::{Path, PathBuf};
 use umbra::plan::{View, ViewMode};
 use umbra::render::Renderer;
-use umbra::scene::{load_gltf, shapes::add_ground, Scene};
+use umbra::scene::{built::shapes::add_ground, gltf::load_gltf, Scene};
 
 const W: u32 = 160;
 const H: u32 = 120;

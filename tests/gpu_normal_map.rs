@@ -6,9 +6,9 @@ use crate::common::*;
 use glam::{Mat4, Vec2, Vec3};
 use umbra::plan::View;
 use umbra::render::Renderer;
-use umbra::scene::demo::bump_normal_map;
-use umbra::scene::mikk::generate_mikktspace;
-use umbra::scene::shapes::{add_object, add_texture, quad};
+use umbra::scene::built::demo::bump_normal_map;
+use umbra::scene::built::shapes::{add_object, add_texture, quad};
+use umbra::scene::mesh::mikk::generate_mikktspace;
 use umbra::scene::{Camera, Light, Material, Primitive, Scene, TextureRef};
 
 const BUMPS: u32 = 4;

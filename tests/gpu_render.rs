@@ -5,9 +5,9 @@ use crate::common::*;
 use glam::{Mat4, Quat, Vec3};
 use umbra::plan::{View, ViewMode};
 use umbra::render::Renderer;
-use umbra::scene::shapes::{add_object, colored, plane, quad};
+use umbra::scene::built::shapes::{add_object, colored, plane, quad};
 use umbra::scene::{
-    blinn_phong_params, demo::demo_scene, shade_blinn_phong, Camera, Light, Material, Scene,
+    blinn_phong_params, built::demo::demo_scene, shade_blinn_phong, Camera, Light, Material, Scene,
 };
 
 #[test]
@@ -231,7 +231,7 @@ fn mirrored_instances_keep_their_outside() {
         add_object(
             &mut s,
             name,
-            umbra::scene::shapes::cuboid(Vec3::splat(0.5)),
+            umbra::scene::built::shapes::cuboid(Vec3::splat(0.5)),
             m,
             Mat4::from_scale(scale),
         );

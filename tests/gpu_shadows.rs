@@ -11,7 +11,7 @@ use umbra::math::ray::{ray_aabb, Ray};
 use umbra::math::Aabb;
 use umbra::plan::{ShadowFormat, ShadowSettings, View, ViewMode};
 use umbra::render::Renderer;
-use umbra::scene::shapes::{add_object, colored, cuboid};
+use umbra::scene::built::shapes::{add_object, colored, cuboid};
 use umbra::scene::{Camera, Light, LightKind, Scene};
 
 /// Width of the unjudged band around exact shadow edges, in shadow texels.

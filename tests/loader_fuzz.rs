@@ -2,7 +2,7 @@
 //! load or fail with an error, without a panic (even one caught internally) or a hang.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
-use umbra::scene::load_gltf;
+use umbra::scene::gltf::load_gltf;
 
 static PANICS: AtomicUsize = AtomicUsize::new(0);
 /// Panics inside a third-party decoder (Draco, Basis Universal) on a broken stream: contained
@@ -65,7 +65,7 @@ fn mutate(rng: &mut Rng, src: &[u8]) -> Vec<u8> {
 #[test]
 fn corrupted_files_never_panic() {
     std::panic::set_hook(Box::new(|info| {
-        if umbra::scene::compressed::in_third_party_decoder() {
+        if umbra::scene::gltf::compressed::in_third_party_decoder() {
             DECODER_PANICS.fetch_add(1, Ordering::SeqCst);
             eprintln!("decoder panic (contained): {info}");
         } else {

@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 use umbra::plan::{FramePlan, ScenePlanner};
 use umbra::plan::{PostAa, SceneOptions, View};
 use umbra::render::Renderer;
-use umbra::scene::shapes::{add_object, colored, cuboid, plane, uv_sphere};
+use umbra::scene::built::shapes::{add_object, colored, cuboid, plane, uv_sphere};
 use umbra::scene::{Camera, Light, Scene};
 
 const W: u32 = 240;

@@ -7,8 +7,8 @@
 use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::plan::SceneOptions;
-use umbra::scene::demo::demo_scene;
-use umbra::scene::shapes::{add_object, colored, cuboid, uv_sphere};
+use umbra::scene::built::demo::demo_scene;
+use umbra::scene::built::shapes::{add_object, colored, cuboid, uv_sphere};
 use umbra::scene::{Camera, Light, LightKind, Scene};
 use umbra::View;
 

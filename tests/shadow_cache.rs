@@ -6,7 +6,7 @@ use crate::common::{assert_validation_clean, context, image_diff};
 use glam::Vec3;
 use umbra::plan::SceneOptions;
 use umbra::scene::anim::Playing;
-use umbra::scene::synthetic::by_name;
+use umbra::scene::built::synthetic::by_name;
 use umbra::{Renderer, View};
 
 const W: u32 = 640;

@@ -336,8 +336,8 @@ fn stability(a: app::cli::StabilityArgs) -> anyhow::Result<()> {
         .map(|v| v.1)
         .ok_or_else(|| anyhow::anyhow!("{}: no view", scene.name))?;
     let view = umbra::plan::View::new(camera);
-    let wall =
-        (a.builtin || spec == "stability").then_some(umbra::scene::synthetic::STABILITY_WALL_HALF);
+    let wall = (a.builtin || spec == "stability")
+        .then_some(umbra::scene::built::synthetic::STABILITY_WALL_HALF);
     let ctx = offscreen_context(a.validation, a.device.clone())?;
     let bar = indicatif::ProgressBar::new(report::planned_steps(a.quick, wall.is_some()));
     bar.set_style(

@@ -15,8 +15,8 @@ use std::process::Command;
 use umbra::math::tonemap::ev100_from_exposure;
 use umbra::plan::{Exposure, View};
 use umbra::render::Renderer;
-use umbra::scene::shapes::{cuboid, plane, uv_sphere};
-use umbra::scene::{load_gltf, Primitive, Scene};
+use umbra::scene::built::shapes::{cuboid, plane, uv_sphere};
+use umbra::scene::{gltf::load_gltf, Primitive, Scene};
 use umbra_lab::reference::ReferenceScene;
 
 const W: u32 = 320;

@@ -9,8 +9,8 @@ use crate::common::{assert_validation_clean, context, project, save};
 use glam::{Mat4, Quat, Vec3};
 use std::path::PathBuf;
 use umbra::scene::anim::Playing;
-use umbra::scene::shapes::{add_object, colored, plane};
-use umbra::scene::{load_gltf, Camera, Scene};
+use umbra::scene::built::shapes::{add_object, colored, plane};
+use umbra::scene::{gltf::load_gltf, Camera, Scene};
 use umbra::{RenderedFrame, Renderer, View};
 use umbra_lab::reference::{classify, PixelClass, ReferenceScene};
 
@@ -347,7 +347,7 @@ fn fox_walks_and_its_shadow_follows() {
     let rig = scene.rig.clone().expect("Fox has a rig");
     let names: Vec<&str> = rig.animations.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["Survey", "Walk", "Run"]);
-    umbra::scene::shapes::add_ground(&mut scene);
+    umbra::scene::built::shapes::add_ground(&mut scene);
     let mut v = view(Vec3::ZERO, Vec3::X, 45.0);
     v.camera = scene.default_camera(W as f32 / H as f32);
     let mut shadows = Vec::new();

@@ -5,7 +5,7 @@
 use crate::common::*;
 use umbra::plan::View;
 use umbra::render::Renderer;
-use umbra::scene::synthetic::town_scene;
+use umbra::scene::built::synthetic::town_scene;
 use umbra_lab::analysis::budget::{self, PROBE_STRIDE};
 use umbra_lab::analysis::grid::Grid;
 use umbra_lab::analysis::sweep::{run_view, Row, Sink, SweepOptions, SweepView};
@@ -78,7 +78,7 @@ fn budget_choice_measures_within_budget_on_the_town() {
 #[test]
 fn a_budget_of_zero_takes_exact_shadows() {
     let ctx = context();
-    let scene = umbra::scene::synthetic::grazing_scene();
+    let scene = umbra::scene::built::synthetic::grazing_scene();
     let reference = ReferenceScene::new(&scene);
     let mut renderer = Renderer::new(&ctx, &scene).unwrap();
     let view = View::new(scene.cameras[0]);

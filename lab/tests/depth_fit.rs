@@ -10,7 +10,7 @@ use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::plan::View;
 use umbra::render::Renderer;
-use umbra::scene::shapes::{add_object, colored, cuboid};
+use umbra::scene::built::shapes::{add_object, colored, cuboid};
 use umbra::scene::{Camera, Light, Scene};
 use umbra_lab::reference::{misclassified_by_depth, ReferenceScene};
 use umbra_lab::score;

@@ -11,7 +11,9 @@ use crate::common::*;
 use umbra::plan::ShadowMethod;
 use umbra::plan::{View, ViewMode};
 use umbra::render::Renderer;
-use umbra::scene::{demo::demo_scene, load_gltf, shapes::add_ground, synthetic, Scene};
+use umbra::scene::{
+    built::demo::demo_scene, built::shapes::add_ground, built::synthetic, gltf::load_gltf, Scene,
+};
 use umbra_lab::reference::{compare, Metrics, ReferenceScene};
 
 const W: u32 = 640;

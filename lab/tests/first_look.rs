@@ -12,7 +12,7 @@ use serde_json::json;
 use std::path::PathBuf;
 use umbra::plan::{Exposure, View, ViewMode};
 use umbra::render::Renderer;
-use umbra::scene::{load_gltf, Scene};
+use umbra::scene::{gltf::load_gltf, Scene};
 use umbra_lab::reference::ReferenceScene;
 
 /// A box of half-size `half` centred at the origin of its node (24 vertices, outward normals).
@@ -179,7 +179,7 @@ fn ground_pixels(scene: &Scene, f: &umbra::RenderedFrame, y: f32) -> Vec<(u32, u
 fn a_model_without_lights_casts_a_visible_shadow_on_its_ground() {
     let (_, pole) = boards().remove(1);
     let mut scene = load_gltf(&pole).unwrap();
-    umbra::scene::shapes::add_ground(&mut scene);
+    umbra::scene::built::shapes::add_ground(&mut scene);
     let ground_y = scene.bounds().min.y;
     let mut view = View::new(scene.default_camera(W as f32 / H as f32));
     let lit = render(&scene, &view);

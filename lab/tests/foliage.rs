@@ -10,7 +10,7 @@
 use crate::common::*;
 use umbra::plan::{View, ViewMode};
 use umbra::render::{RenderedFrame, Renderer};
-use umbra::scene::foliage::foliage_scene;
+use umbra::scene::built::foliage::foliage_scene;
 use umbra::scene::{AlphaMode, Scene};
 use umbra_lab::reference::{classify, PixelClass, ReferenceScene};
 

@@ -8,7 +8,7 @@ use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::plan::View;
 use umbra::render::Renderer;
-use umbra::scene::shapes::{add_object, colored, plane};
+use umbra::scene::built::shapes::{add_object, colored, plane};
 use umbra::scene::{Camera, Light, LightKind, Scene};
 use umbra_lab::reference::ReferenceScene;
 

@@ -9,7 +9,7 @@ use crate::common::*;
 use glam::{Mat4, Vec3, Vec4};
 use umbra::plan::{View, ViewMode};
 use umbra::render::{RenderedFrame, Renderer};
-use umbra::scene::shapes::{add_object, add_texture, colored, plane, quad};
+use umbra::scene::built::shapes::{add_object, add_texture, colored, plane, quad};
 use umbra::scene::{AlphaMode, Camera, Light, Material, Scene, Texture, TextureRef};
 use umbra_lab::reference::{classify, PixelClass, ReferenceScene};
 

@@ -9,7 +9,7 @@ use serde_json::json;
 use std::path::PathBuf;
 use umbra::plan::View;
 use umbra::render::Renderer;
-use umbra::scene::{load_gltf, Camera};
+use umbra::scene::{gltf::load_gltf, Camera};
 use umbra_lab::reference::ReferenceScene;
 
 fn tmp(name: &str) -> PathBuf {

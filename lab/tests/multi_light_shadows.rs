@@ -8,7 +8,7 @@
 use crate::common::*;
 use umbra::plan::{View, ViewMode};
 use umbra::render::Renderer;
-use umbra::scene::synthetic::{room_scene, sun_and_spot_scene, two_suns_scene};
+use umbra::scene::built::synthetic::{room_scene, sun_and_spot_scene, two_suns_scene};
 use umbra::scene::Scene;
 use umbra_lab::reference::{classify, PixelClass, ReferenceScene};
 

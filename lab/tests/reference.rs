@@ -6,7 +6,7 @@ use glam::Vec3;
 use umbra::math::ray::Ray;
 use umbra::plan::{View, ViewMode};
 use umbra::render::Renderer;
-use umbra::scene::{demo::demo_scene, load_gltf, Scene};
+use umbra::scene::{built::demo::demo_scene, gltf::load_gltf, Scene};
 use umbra_lab::reference::{compare, ReferenceScene};
 
 struct Rng(u64);

@@ -9,7 +9,7 @@ use crate::common::*;
 use glam::{Mat4, Vec3};
 use umbra::plan::{View, ViewMode};
 use umbra::render::{RenderedFrame, Renderer};
-use umbra::scene::shapes::{add_object, colored, cuboid, plane};
+use umbra::scene::built::shapes::{add_object, colored, cuboid, plane};
 use umbra::scene::{Camera, Light, Scene};
 use umbra_lab::reference::{flip, ReferenceFrame, ReferenceScene};
 

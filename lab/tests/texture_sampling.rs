@@ -7,10 +7,10 @@ use crate::common::*;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use umbra::plan::{SceneOptions, View};
 use umbra::render::Renderer;
-use umbra::scene::shapes::{add_object, add_texture, quad};
+use umbra::scene::built::shapes::{add_object, add_texture, quad};
 use umbra::scene::{
-    load_gltf, Camera, Filter, Light, Material, Sampler, Scene, Texture, TextureRef, UvTransform,
-    Wrap,
+    gltf::load_gltf, Camera, Filter, Light, Material, Sampler, Scene, Texture, TextureRef,
+    UvTransform, Wrap,
 };
 use umbra_lab::reference::ReferenceScene;
 

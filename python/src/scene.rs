@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3, Vec4};
 use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
-use umbra::scene::shapes::{add_object, add_texture, primitive_from_arrays, MeshArrays};
+use umbra::scene::built::shapes::{add_object, add_texture, primitive_from_arrays, MeshArrays};
 use umbra::scene::{AlphaMode, Light, LightKind, Material, Scene, Texture, TextureRef};
 
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
@@ -312,7 +312,7 @@ impl PyScene {
     /// Adds a grey ground plane under the scene, wide enough for its shadows (the command line's
     /// `--ground`); returns its instance index.
     fn add_ground(&mut self) -> usize {
-        umbra::scene::shapes::add_ground(&mut self.scene);
+        umbra::scene::built::shapes::add_ground(&mut self.scene);
         self.geometry += 1;
         self.scene.instances.len() - 1
     }

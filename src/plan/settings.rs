@@ -296,7 +296,7 @@ pub struct SceneOptions {
     pub anisotropy: Option<u32>,
     /// Skip work that cannot change the image: draws outside the camera's view, back faces of
     /// closed double-sided meshes seen from outside, and the clear parts of lone cutout cards in
-    /// the shadow passes (`crate::scene::trim`). On by default; off only to measure what it
+    /// the shadow passes (`crate::scene::mesh::trim`). On by default; off only to measure what it
     /// saves.
     pub culling: bool,
     /// Multisample anti-aliasing: samples per pixel of the camera pass (1, 2, 4 or 8). `None`:

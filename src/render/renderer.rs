@@ -214,7 +214,7 @@ impl Renderer {
     }
 
     /// Draws whose shadow casters are their lone cutout cards cut to their alpha
-    /// (`scene::trim`; only with `SceneOptions::culling`).
+    /// (`scene::mesh::trim`; only with `SceneOptions::culling`).
     pub fn cut_casters(&self) -> usize {
         self.core
             .gpu

@@ -10,9 +10,9 @@
 //! from the loaded [`Scene`] (decoded image sizes, repaired geometry). The shadow plan is added by
 //! the render layer (`render::frame::plan_report`).
 
-use super::compressed::accessor_type;
-use super::gltf_input::json_part;
-use super::load_error::LoadError;
+use super::gltf::compressed::accessor_type;
+use super::gltf::error::LoadError;
+use super::gltf::input::json_part;
 use super::warning::severity_of;
 use super::{blinn_phong_params, Scene};
 use crate::math::precision::{relative_gap, DepthMapping};
@@ -25,7 +25,7 @@ pub const SCHEMA: &str = "umbra-inspect/1";
 /// Extensions umbra reads (others are ignored; required ones it does not read refuse the file).
 /// Those whose decoder is a cargo feature are listed only when this build has it.
 pub fn supported_extensions() -> Vec<&'static str> {
-    super::compressed::supported_extensions()
+    super::gltf::compressed::supported_extensions()
 }
 
 fn finding(code: &str, pointer: String, message: String) -> Value {
@@ -75,7 +75,7 @@ pub fn document_report(path: &Path, scene: &Scene) -> Result<Value, LoadError> {
     };
     let bytes = std::fs::read(path).map_err(io)?;
     let doc: Value = serde_json::from_slice(json_part(path, &bytes)?)
-        .map_err(|e| super::load_error::invalid(path, e))?;
+        .map_err(|e| super::gltf::error::invalid(path, e))?;
     let mut findings: Vec<Value> = Vec::new();
     for w in &scene.warnings {
         findings.push(finding(w.code, w.pointer.clone(), w.message.clone()));

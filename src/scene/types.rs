@@ -472,7 +472,7 @@ pub struct Scene {
     /// ([`super::anim`]); the scene as loaded holds its rest pose.
     pub rig: Option<std::sync::Arc<super::anim::Rig>>,
     /// For a loaded glTF: what was decoded from compressed or quantized data (empty if none).
-    pub compression: super::compressed::CompressionReport,
+    pub compression: super::gltf::compressed::CompressionReport,
 }
 
 impl Scene {

@@ -10,7 +10,7 @@ use super::gltf_builder::{png, Builder, Container, U16, U32, U8};
 use glam::{Quat, Vec3};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use umbra::scene::shapes::{cuboid, quad, uv_sphere};
+use umbra::scene::built::shapes::{cuboid, quad, uv_sphere};
 use umbra::scene::Primitive;
 
 /// Writes every generated model into `dir` and returns their main files, sorted.

@@ -160,7 +160,7 @@ pub fn ground_point(
 
 /// A scene named `name` holding a grey ground plane `size` across at y = 0, and nothing else.
 pub fn ground_scene(size: f32, name: &str) -> umbra::scene::Scene {
-    use umbra::scene::shapes::{add_object, colored, plane};
+    use umbra::scene::built::shapes::{add_object, colored, plane};
     let mut s = umbra::scene::Scene {
         name: name.into(),
         ..Default::default()

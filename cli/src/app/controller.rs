@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 use umbra::math::Aabb;
-use umbra::scene::framing::{fit_box, FILL, FOV_Y_DEG};
+use umbra::scene::mesh::framing::{fit_box, FILL, FOV_Y_DEG};
 use umbra::scene::{Camera, Projection};
 
 /// Mouse buttons the controllers use.

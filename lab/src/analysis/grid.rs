@@ -259,7 +259,7 @@ pub fn sweep_views(scene: &Scene, aspect: f32) -> Vec<(String, Camera)> {
     let framed = scene.framing.unwrap_or(b);
     let (c, r) = framed.bounding_sphere();
     let dist = (default.position() - c).length();
-    let fov = umbra::scene::framing::FOV_Y_DEG.to_radians();
+    let fov = umbra::scene::mesh::framing::FOV_Y_DEG.to_radians();
     let high = Camera::look_at(
         c + Vec3::new(-0.45, 1.3, -0.6).normalize() * dist,
         c,
@@ -348,7 +348,7 @@ mod tests {
 
     #[test]
     fn views_of_a_scene_without_cameras_include_one_near_the_ground() {
-        let mut s = umbra::scene::demo::demo_scene();
+        let mut s = umbra::scene::built::demo::demo_scene();
         s.cameras.clear();
         let v = sweep_views(&s, 16.0 / 9.0);
         assert_eq!(v.len(), 3);
@@ -356,7 +356,7 @@ mod tests {
         let eye = v[2].1.position();
         assert!(eye.y - b.min.y < 0.1 * b.extent().y, "{eye} in {b:?}");
         assert_eq!(
-            sweep_views(&umbra::scene::synthetic::town_scene(), 1.0).len(),
+            sweep_views(&umbra::scene::built::synthetic::town_scene(), 1.0).len(),
             2
         );
     }

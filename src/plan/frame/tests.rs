@@ -89,7 +89,7 @@ fn the_hemisphere_mixes_ground_to_sky_by_the_up_component() {
     let tilted = Vec3::new(0.0, 0.5, 0.75f32.sqrt());
     assert!((a.at(tilted) - (a.ground * 0.25 + a.sky * 0.75)).length() < 1e-6);
 }
-use crate::scene::demo::demo_scene;
+use crate::scene::built::demo::demo_scene;
 
 #[test]
 fn default_sun_and_override() {

@@ -62,7 +62,7 @@ pub struct Draw {
     pub immediates: SceneImmediates,
     /// World-space bounds (for culling).
     pub world_bounds: Aabb,
-    /// World-space plane `(n, w)` of a flat primitive (`scene::topology::plane_of`), unit `n`.
+    /// World-space plane `(n, w)` of a flat primitive (`scene::mesh::topology::plane_of`), unit `n`.
     pub world_plane: Option<Vec4>,
     /// Draw both faces.
     pub double_sided: bool,
@@ -73,7 +73,7 @@ pub struct Draw {
     pub alpha: AlphaDraw,
     /// The material's shader variant bits (`material_variant_bits`).
     pub material_bits: VariantKey,
-    /// The primitive is closed and consistently wound (`scene::topology::is_closed`): seen from
+    /// The primitive is closed and consistently wound (`scene::mesh::topology::is_closed`): seen from
     /// outside its bounds, culling back faces changes no pixel even if it is double-sided.
     pub closed: bool,
     /// The camera pass may shade it deferred (`CameraPass`): opaque, no vertex colour other than
@@ -86,7 +86,7 @@ pub struct Draw {
     /// The shadow cache draws such casters every frame.
     pub moving: bool,
     /// What the shadow pass draws instead for an alpha-tested caster whose lone cards were cut
-    /// to where their alpha can pass (`scene::trim`; the same shadow map, fewer fragments).
+    /// to where their alpha can pass (`scene::mesh::trim`; the same shadow map, fewer fragments).
     pub shadow_range: Option<IndexRange>,
 }
 

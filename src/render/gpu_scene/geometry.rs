@@ -4,8 +4,8 @@
 use super::*;
 use crate::math::Aabb;
 use crate::plan::settings::SceneOptions;
-use crate::scene::clusters::{self, Cluster};
-use crate::scene::topology::{is_closed, plane_of};
+use crate::scene::mesh::clusters::{self, Cluster};
+use crate::scene::mesh::topology::{is_closed, plane_of};
 use crate::scene::Scene;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -70,7 +70,7 @@ pub(super) struct PrimitiveShape {
     pub(super) closed: bool,
     pub(super) plane: Option<Vec4>,
     pub(super) clusters: Option<(Vec<u32>, Vec<Cluster>)>,
-    /// Its lone cutout cards cut to their alpha for the shadow pass (`scene::trim`).
+    /// Its lone cutout cards cut to their alpha for the shadow pass (`scene::mesh::trim`).
     pub(super) trimmed: Option<crate::scene::Primitive>,
 }
 
@@ -83,7 +83,7 @@ pub(super) struct PrimitiveRange {
     pub(super) bounds: Aabb,
     /// See `Draw::closed`.
     pub(super) closed: bool,
-    /// Model-space plane of a flat primitive (`scene::topology::plane_of`).
+    /// Model-space plane of a flat primitive (`scene::mesh::topology::plane_of`).
     pub(super) plane: Option<Vec4>,
     /// (first, count) in `GpuScene::clusters` (count 0: one draw).
     pub(super) clusters: (u32, u32),
@@ -171,8 +171,8 @@ pub(super) fn pack_geometry(scene: &Scene, options: &SceneOptions) -> Geometry {
                 .culling
                 .then(|| {
                     let m = scene.materials.get(p.material)?;
-                    let cut = crate::scene::trim::AlphaCut::new(m, p, &scene.textures)?;
-                    crate::scene::trim::trim(p, &cut)
+                    let cut = crate::scene::mesh::trim::AlphaCut::new(m, p, &scene.textures)?;
+                    crate::scene::mesh::trim::trim(p, &cut)
                 })
                 .flatten()
                 .map(|t| t.primitive),

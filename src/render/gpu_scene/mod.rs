@@ -28,7 +28,7 @@ use crate::plan::settings::SceneOptions;
 use crate::plan::uniforms::MaterialUniform;
 use crate::plan::Viewpoint;
 use crate::render::samplers::SamplerCache;
-use crate::scene::clusters::{self, Cluster};
+use crate::scene::mesh::clusters::{self, Cluster};
 use crate::scene::Scene;
 use ash::vk;
 use glam::Vec3;
@@ -52,7 +52,7 @@ pub struct GpuScene {
     pub material_sets: Vec<vk::DescriptorSet>,
     /// World bounds.
     pub bounds: Aabb,
-    /// Clusters of the large primitives (`scene::clusters`), indexed by `Draw::clusters`.
+    /// Clusters of the large primitives (`scene::mesh::clusters`), indexed by `Draw::clusters`.
     pub clusters: Vec<Cluster>,
     /// Triangles drawn per frame.
     pub triangles: usize,

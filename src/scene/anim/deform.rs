@@ -109,7 +109,7 @@ pub fn deform(d: &Deform, weights: &[f32], joints: Option<&[Mat4]>, indices: &[u
         }
     }
     if morphed && d.normals_computed {
-        normals = super::super::tangents::compute_smooth_normals(&positions, indices);
+        normals = super::super::mesh::tangents::compute_smooth_normals(&positions, indices);
     }
     if let Some(joints) = joints.filter(|_| d.skinned()) {
         skin(d, joints, &mut positions, &mut normals, &mut tangents);

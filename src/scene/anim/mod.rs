@@ -190,7 +190,7 @@ pub fn add_mover(
     });
     scene.node_names.resize(node, String::new());
     scene.node_names.push(name.into());
-    super::shapes::add_object(
+    super::built::shapes::add_object(
         scene,
         name,
         primitive,

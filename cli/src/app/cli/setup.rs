@@ -6,11 +6,11 @@ use anyhow::{anyhow, bail};
 use std::path::PathBuf;
 use umbra::plan::{ShadowFit, ShadowFormat, ShadowSettings, View};
 use umbra::scene::anim::Playing;
-use umbra::scene::{demo::demo_scene, load_gltf, Camera, Scene};
+use umbra::scene::{built::demo::demo_scene, gltf::load_gltf, Camera, Scene};
 
 #[cfg(feature = "sweep")]
 /// Loads a scene named on the command line: an existing file, `demo`, or a generated scene's
-/// name (`scene::synthetic::by_name`). Prints its warnings; adds a ground plane to files when
+/// name (`scene::built::synthetic::by_name`). Prints its warnings; adds a ground plane to files when
 /// `ground`.
 pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
     let path = std::path::Path::new(spec);
@@ -18,7 +18,7 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
         load_gltf(path)?
     } else if spec == "demo" {
         demo_scene()
-    } else if let Some(s) = umbra::scene::synthetic::by_name(spec) {
+    } else if let Some(s) = umbra::scene::built::synthetic::by_name(spec) {
         s
     } else {
         bail!("{spec}: no such file, and not demo, town, town-mover, grazing, stability, double-sided, room, sun-and-spot, two-suns, lux-yard or spheres:N");
@@ -27,7 +27,7 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
         print_warning(&s.name, w);
     }
     if ground && path.exists() {
-        umbra::scene::shapes::add_ground(&mut s);
+        umbra::scene::built::shapes::add_ground(&mut s);
     }
     Ok(s)
 }
@@ -159,10 +159,10 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
         (Some(_), Some(_)) => bail!("give either SCENE or --synthetic, not both"),
         (Some(p), None) => load_gltf(p)?,
         (None, None) => demo_scene(),
-        (None, Some(name)) => umbra::scene::synthetic::by_name(name).ok_or_else(|| {
+        (None, Some(name)) => umbra::scene::built::synthetic::by_name(name).ok_or_else(|| {
             anyhow!(
                 "--synthetic {name}: expected {} or spheres:N with N in 1..=256",
-                umbra::scene::synthetic::NAMES.join(", ")
+                umbra::scene::built::synthetic::NAMES.join(", ")
             )
         })?,
     };
@@ -181,7 +181,7 @@ pub fn load_scene(path: Option<&PathBuf>, a: &ViewArgs) -> anyhow::Result<Scene>
         None => {}
     }
     if ground {
-        umbra::scene::shapes::add_ground(&mut s);
+        umbra::scene::built::shapes::add_ground(&mut s);
     }
     Ok(s)
 }

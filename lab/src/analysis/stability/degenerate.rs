@@ -11,7 +11,7 @@ use serde::Serialize;
 use std::sync::Arc;
 use umbra::gpu::{Context, GpuError};
 use umbra::plan::{SceneOptions, View, ViewMode};
-use umbra::scene::shapes::{add_object, colored};
+use umbra::scene::built::shapes::{add_object, colored};
 use umbra::scene::{Camera, Light, Primitive, Scene};
 
 /// Largest misclassified fraction of judged pixels away from exact edges for a case to pass.
@@ -102,7 +102,7 @@ fn cases(scene: &Scene, view: &View, quick: bool) -> Vec<Case> {
         v.camera = Camera::look_at(
             eye,
             target,
-            fov.unwrap_or(umbra::scene::framing::FOV_Y_DEG.to_radians()),
+            fov.unwrap_or(umbra::scene::mesh::framing::FOV_Y_DEG.to_radians()),
             near,
         );
         v
@@ -188,7 +188,7 @@ fn cases(scene: &Scene, view: &View, quick: bool) -> Vec<Case> {
         },
     ];
     if !quick {
-        let big = umbra::scene::synthetic::sphere_grid(28);
+        let big = umbra::scene::built::synthetic::sphere_grid(28);
         let (bb, cc) = (big.bounds(), big.bounds().center());
         out.push(Case {
             judged: true,

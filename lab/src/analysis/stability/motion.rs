@@ -19,7 +19,7 @@ use umbra::math::Aabb;
 use umbra::plan::{SceneOptions, ShadowHold, View};
 use umbra::render::Renderer;
 use umbra::scene::anim::{add_mover, Playing};
-use umbra::scene::shapes::{colored, cuboid};
+use umbra::scene::built::shapes::{colored, cuboid};
 use umbra::scene::{Light, Scene};
 
 /// One probe flown with one method.

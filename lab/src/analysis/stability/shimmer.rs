@@ -140,7 +140,7 @@ pub fn camera_path(start: &Camera, bounds: &Aabb, frames: usize) -> Vec<Camera> 
             let t = i as f32 / (frames.max(2) - 1) as f32;
             let fov = start
                 .fov_y()
-                .unwrap_or(umbra::scene::framing::FOV_Y_DEG.to_radians())
+                .unwrap_or(umbra::scene::mesh::framing::FOV_Y_DEG.to_radians())
                 * (1.0 - 0.4 * (std::f32::consts::PI * t).sin());
             let mut cam = Camera::look_at(path.eval(t), target.eval(t), fov, start.near);
             cam.far = start.far;

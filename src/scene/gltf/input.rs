@@ -3,13 +3,13 @@
 //! model's folder) and image decoding limits. Several of these guard panics in gltf 1.4.1 that
 //! mutation fuzzing found (see `tests/loader_fuzz.rs`).
 
-use super::load_error::{corrupt, invalid, LoadError, MAX_TEXTURE_SIDE};
+use super::error::{corrupt, invalid, LoadError, MAX_TEXTURE_SIDE};
 use base64::Engine as _;
 use std::path::{Component, Path};
 
 /// The JSON of a `.glb` (after checking its container: magic, version 2, declared length and
 /// chunk lengths within the file), or the whole input for `.gltf`.
-pub(super) fn json_part<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a [u8], LoadError> {
+pub(in crate::scene) fn json_part<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a [u8], LoadError> {
     if !bytes.starts_with(b"glTF") {
         return Ok(bytes);
     }

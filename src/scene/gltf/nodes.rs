@@ -1,8 +1,8 @@
 //! The glTF node hierarchy walked into instances, cameras and lights, with what animation needs
 //! from it (each node's parent, the nodes lights and cameras hang on).
 
-use super::load_error::{corrupt, LoadError};
-use super::{Camera, Instance, Light, LightKind, Projection, Scene};
+use super::error::{corrupt, LoadError};
+use crate::scene::{Camera, Instance, Light, LightKind, Projection, Scene};
 use glam::{Mat4, Vec3};
 use std::path::Path;
 

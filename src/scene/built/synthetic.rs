@@ -3,12 +3,12 @@
 //! frame time against triangle count, a town for shadows at every distance, and scenes where
 //! several lights cast (a point light in a room, a sun with a spot lamp, two suns).
 
-use super::shapes::{add_object, colored, cuboid, plane, torus, uv_sphere};
-use super::{Camera, Light, LightKind, Scene};
+use crate::scene::built::shapes::{add_object, colored, cuboid, plane, torus, uv_sphere};
+use crate::scene::{Camera, Light, LightKind, Scene};
 use glam::{Mat4, Vec3};
 
 /// A colour material of `roughness` marked double-sided.
-fn two_sided(rgb: Vec3, roughness: f32) -> super::Material {
+fn two_sided(rgb: Vec3, roughness: f32) -> crate::scene::Material {
     let mut m = colored(rgb, roughness);
     m.double_sided = true;
     m
@@ -68,7 +68,7 @@ pub fn double_sided_scene() -> Scene {
 /// triangles, 12 primitives) seen from close by with a 60° lens, so that the models cover about
 /// a third of the frame and both faces of most of them are drawn. One sun about 40° high.
 pub fn close_up_scene() -> Scene {
-    use super::open_shapes::{leaf, ribbon, shell, vase};
+    use crate::scene::built::open_shapes::{leaf, ribbon, shell, vase};
     let mut s = on_double_sided_ground("close-up", 0.45);
     let two = |rgb: Vec3| two_sided(rgb, 0.45);
     let models = [
@@ -578,8 +578,12 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "lux-yard" => Some(lux_yard_scene()),
         "double-sided" => Some(double_sided_scene()),
         "close-up" => Some(close_up_scene()),
-        "foliage" => Some(super::foliage::foliage_scene(super::AlphaMode::Blend)),
-        "foliage-masked" => Some(super::foliage::foliage_scene(super::AlphaMode::Mask(0.5))),
+        "foliage" => Some(crate::scene::built::foliage::foliage_scene(
+            crate::scene::AlphaMode::Blend,
+        )),
+        "foliage-masked" => Some(crate::scene::built::foliage::foliage_scene(
+            crate::scene::AlphaMode::Mask(0.5),
+        )),
         "town" => Some(town_scene()),
         "town-mover" => Some(town_mover_scene()),
         "grazing" => Some(grazing_scene()),
@@ -594,7 +598,7 @@ pub fn by_name(name: &str) -> Option<Scene> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::topology::is_closed;
+    use crate::scene::mesh::topology::is_closed;
 
     #[test]
     fn every_listed_name_builds_a_scene() {

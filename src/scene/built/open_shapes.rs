@@ -3,8 +3,8 @@
 //! a vase of revolution without caps, a bent and twisted leaf, a rippled shell, a ribbon (an open
 //! section of a torus). Each is a grid of `u × v` quads.
 
-use super::shapes::{primitive_from_arrays, MeshArrays};
-use super::Primitive;
+use crate::scene::built::shapes::{primitive_from_arrays, MeshArrays};
+use crate::scene::Primitive;
 use glam::Vec3;
 use std::f32::consts::{PI, TAU};
 
@@ -100,7 +100,7 @@ pub fn ribbon(major: f32, minor: f32, sweep: f32, tube: f32, u: u32, v: u32) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::topology::is_closed;
+    use crate::scene::mesh::topology::is_closed;
 
     #[test]
     fn the_shapes_are_open_grids_of_the_asked_size() {

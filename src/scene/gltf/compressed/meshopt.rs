@@ -5,7 +5,7 @@
 //! decoded on all cores.
 
 use super::{Rewrite, MAX_DECODED_BYTES};
-use crate::scene::load_error::{corrupt, LoadError};
+use crate::scene::gltf::error::{corrupt, LoadError};
 use serde_json::Value;
 use std::path::Path;
 use std::time::Instant;

@@ -1,5 +1,5 @@
 //! Repairs: normals computed when missing, tangents from a normal alone (MikkTSpace tangents
-//! for a whole primitive are `scene::mikk`'s).
+//! for a whole primitive are `scene::mesh::mikk`'s).
 
 use glam::{Vec3, Vec4};
 

@@ -4,11 +4,11 @@
 //! is read, indices are checked against the vertex count, external files must resolve inside the
 //! model's folder, and any remaining panic inside the parser is turned into an error.
 
-use super::anim::load::{check_joint_ranges, read_rig};
-use super::gltf_input::{check_accessor, check_references, decode_image, json_part, read_uri};
-use super::load_error::{corrupt, invalid, MAX_FILE_BYTES};
-pub use super::load_error::{LoadError, MAX_TEXTURE_SIDE};
-use super::{Material, Mesh, Scene, Texture};
+use super::error::LoadError;
+use super::error::{corrupt, invalid, MAX_FILE_BYTES};
+use super::input::{check_accessor, check_references, decode_image, json_part, read_uri};
+use crate::scene::anim::load::{check_joint_ranges, read_rig};
+use crate::scene::{Material, Mesh, Scene, Texture};
 use std::path::{Path, PathBuf};
 
 /// Loads a `.gltf` or `.glb` file into a scene.
@@ -77,7 +77,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
     };
 
     let image_slots = read_images(path, &gltf, &buffers, &base, &mut scene)?;
-    super::gltf_material::read_materials(&gltf, &image_slots, &mut scene);
+    super::material::read_materials(&gltf, &image_slots, &mut scene);
     let default_material = scene.materials.len();
     scene.materials.push(Material::default());
 
@@ -88,7 +88,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
             primitives: Vec::new(),
         };
         for prim in mesh.primitives() {
-            if let Some(p) = super::gltf_primitive::read_primitive(
+            if let Some(p) = super::primitive::read_primitive(
                 path,
                 &mut scene,
                 &buffers,
@@ -102,7 +102,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, LoadError> {
         scene.meshes.push(out);
     }
 
-    let walk = super::gltf_nodes::walk_nodes(path, &gltf, &mut scene)?;
+    let walk = super::nodes::walk_nodes(path, &gltf, &mut scene)?;
     let rig = read_rig(
         &mut scene,
         &gltf,
@@ -256,7 +256,7 @@ fn decode_all(sources: &[ImageSource]) -> Vec<(Decoded, f64)> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::gltf_nodes::light_size_extra;
+    use super::super::nodes::light_size_extra;
 
     #[test]
     fn light_size_comes_from_the_lights_extras() {

@@ -58,7 +58,7 @@ pub enum LoadError {
     },
 }
 
-pub(super) fn invalid(path: &Path, e: impl std::fmt::Display) -> LoadError {
+pub(in crate::scene) fn invalid(path: &Path, e: impl std::fmt::Display) -> LoadError {
     LoadError::Invalid {
         path: path.into(),
         message: e.to_string().replace('\n', " "),

@@ -4,8 +4,8 @@
 //! texels are coarser than the shadows they must draw. Two variants: leaves alpha-blended (as
 //! such files often mark them) and alpha-masked at 0.5.
 
-use super::shapes::{add_object, add_texture, colored, cuboid, plane};
-use super::{AlphaMode, Camera, Light, Material, Primitive, Scene, Texture, TextureRef};
+use crate::scene::built::shapes::{add_object, add_texture, colored, cuboid, plane};
+use crate::scene::{AlphaMode, Camera, Light, Material, Primitive, Scene, Texture, TextureRef};
 use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 
 /// Side of the leaf texture in texels.
@@ -88,7 +88,7 @@ impl Lcg {
 /// `cards` square cards `size` wide, scattered through an ellipsoid crown of radii `radii`
 /// around the origin, each turned at random, merged into one primitive.
 fn crown(rng: &mut Lcg, cards: u32, size: f32, radii: Vec3) -> Primitive {
-    let card = super::shapes::quad(size, size);
+    let card = crate::scene::built::shapes::quad(size, size);
     let mut out = Primitive {
         has_uvs: true,
         ..Default::default()

@@ -2,11 +2,11 @@
 //! normals, texture coordinates, colours, tangents and morph/skin data, each checked, with a
 //! finding for each repair.
 
-use super::gltf_input::check_attribute_types;
-use super::load_error::{corrupt, LoadError};
-use super::mikk::generate_mikktspace;
-use super::tangents::{compute_smooth_normals, count_degenerate, fallback_tangent};
-use super::{Primitive, Scene};
+use super::error::{corrupt, LoadError};
+use super::input::check_attribute_types;
+use crate::scene::mesh::mikk::generate_mikktspace;
+use crate::scene::mesh::tangents::{compute_smooth_normals, count_degenerate, fallback_tangent};
+use crate::scene::{Primitive, Scene};
 use glam::{Vec2, Vec3, Vec4};
 use std::path::Path;
 
@@ -113,7 +113,7 @@ pub(super) fn read_primitive(
     let (uvs, has_uvs) = read_uvs0(&reader, n);
     let uvs1 = read_uvs1(scene, &reader, &site);
     let colors = read_colors(scene, &reader, &site);
-    let deform = super::anim::load::read_deform(scene, &reader, n, &at, &label);
+    let deform = crate::scene::anim::load::read_deform(scene, &reader, n, &at, &label);
     let material = prim.material().index().unwrap_or(default_material);
     let mut p = Primitive {
         positions,

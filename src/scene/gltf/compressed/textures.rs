@@ -58,7 +58,7 @@ fn check_ktx2_layout(data: &[u8]) -> Result<(), String> {
         }
     };
     let (w, h) = (rd32(20).ok_or_else(short)?, rd32(24).ok_or_else(short)?);
-    let max = crate::scene::load_error::MAX_TEXTURE_SIDE as u64;
+    let max = crate::scene::gltf::MAX_TEXTURE_SIDE as u64;
     let depth = rd32(28).ok_or_else(short)?;
     let (layers, faces) = (rd32(32).ok_or_else(short)?, rd32(36).ok_or_else(short)?);
     // KHR_texture_basisu: a 2D image (no depth, no array layers, one face).
@@ -117,7 +117,7 @@ fn transcode(data: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
     use basisu::{DecodeFlags, TargetFormat, Transcoder};
     let t = Transcoder::new(data).map_err(|e| format!("KTX2: {e:?}"))?;
     let info = t.image_level_info(0).map_err(|e| format!("KTX2: {e:?}"))?;
-    let max = crate::scene::load_error::MAX_TEXTURE_SIDE;
+    let max = crate::scene::gltf::MAX_TEXTURE_SIDE;
     if info.width == 0 || info.height == 0 || info.width > max || info.height > max {
         return Err(format!(
             "KTX2: size {}x{} outside 1..={max}",

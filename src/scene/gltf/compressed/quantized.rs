@@ -5,7 +5,7 @@
 
 use super::accessor::{read_f32, Sources};
 use super::Rewrite;
-use crate::scene::load_error::{corrupt, LoadError};
+use crate::scene::gltf::error::{corrupt, LoadError};
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 

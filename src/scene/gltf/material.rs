@@ -1,7 +1,7 @@
 //! glTF materials into the scene's: factors, textures with their KHR_texture_transform and
 //! texture-coordinate set, alpha modes, and the findings a material can raise.
 
-use super::{AlphaMode, Material, Sampler, Scene, TextureRef, UvTransform};
+use crate::scene::{AlphaMode, Material, Sampler, Scene, TextureRef, UvTransform};
 use glam::{Vec2, Vec3, Vec4};
 
 const EXT_TRANSFORM: &str = "KHR_texture_transform";

@@ -33,8 +33,8 @@ pub use report::{CompressionReport, ExtensionUse};
 pub(super) use sniff::is_ktx2;
 pub(super) use textures::decode_ktx2;
 
-use super::gltf_input::read_uri;
-use super::load_error::{corrupt, invalid, LoadError};
+use super::error::{corrupt, invalid, LoadError};
+use super::input::read_uri;
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -154,7 +154,7 @@ impl Appended {
 
 /// Splits `bytes` into the JSON document and the GLB binary chunk (if any).
 fn split(path: &Path, bytes: &[u8]) -> Result<(Value, Option<Vec<u8>>), LoadError> {
-    let json_bytes = super::gltf_input::json_part(path, bytes)?;
+    let json_bytes = super::input::json_part(path, bytes)?;
     let text = String::from_utf8_lossy(json_bytes);
     let json: Value = serde_json::from_str(&text).map_err(|e| invalid(path, e))?;
     let blob = if bytes.starts_with(b"glTF") {

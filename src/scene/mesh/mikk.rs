@@ -1,7 +1,7 @@
 //! MikkTSpace tangents for a primitive whose normal map needs them and whose file has none.
 
-use super::tangents::fallback_tangent;
-use super::Primitive;
+use crate::scene::mesh::tangents::fallback_tangent;
+use crate::scene::Primitive;
 use glam::{Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 

@@ -6,7 +6,7 @@
 //! dequantized, as the extension says).
 
 use super::{Appended, Rewrite, MAX_DECODED_BYTES};
-use crate::scene::load_error::{corrupt, LoadError};
+use crate::scene::gltf::error::{corrupt, LoadError};
 use draco_oxide_core::attribute::{Attribute, ComponentDataType as C};
 use serde_json::{json, Value};
 use std::path::Path;

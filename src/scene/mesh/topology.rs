@@ -81,7 +81,7 @@ pub fn plane_of(positions: &[Vec3], indices: &[u32]) -> Option<Vec4> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::shapes::{cuboid, plane, quad, uv_sphere};
+    use crate::scene::built::shapes::{cuboid, plane, quad, uv_sphere};
 
     #[test]
     fn closed_shapes_and_open_ones() {

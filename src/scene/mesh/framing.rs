@@ -1,8 +1,8 @@
 //! Framing a model: the view a model without a camera is seen from, and the distance at which
 //! its bounds fill a given share of the image.
 
-use super::Camera;
 use crate::math::Aabb;
+use crate::scene::Camera;
 use glam::Vec3;
 
 /// How far above the horizontal the default view looks down (degrees): slightly above, so a
@@ -132,7 +132,7 @@ pub fn framed_camera(bounds: &Aabb, towards_eye: Vec3, aspect: f32) -> Camera {
     Camera::look_at(f.eye, f.target, fov_y, f.nearest * 0.5)
 }
 
-impl super::Scene {
+impl crate::scene::Scene {
     /// The camera a model without one is seen through: from the front (+Z, looking towards
     /// −Z) [`DEFAULT_ELEVATION_DEG`] above the horizontal, at the centre of
     /// its bounds (`framing`, else `bounds()`), at the distance where the bounds' corners fill

@@ -19,8 +19,8 @@
 //! is kept as it is. The camera pass keeps the whole cards: it samples coarser mips, whose
 //! alpha reaches further.
 
-use super::{Material, Primitive, Sampler, Texture, UvTransform, BLEND_SHADOW_CUTOFF};
 use crate::scene::AlphaMode;
+use crate::scene::{Material, Primitive, Sampler, Texture, UvTransform, BLEND_SHADOW_CUTOFF};
 use glam::{Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 
@@ -504,8 +504,8 @@ fn push_vertex(dst: &mut Primitive, src: &Primitive, t: &[u32; 3], w: Vec3) -> u
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::foliage::{leaf_texture, LEAF_TEXTURE_SIZE};
-    use crate::scene::shapes::{plane, quad};
+    use crate::scene::built::foliage::{leaf_texture, LEAF_TEXTURE_SIZE};
+    use crate::scene::built::shapes::{plane, quad};
     use crate::scene::{TextureRef, Wrap};
 
     fn leaf_material(mode: AlphaMode) -> Material {

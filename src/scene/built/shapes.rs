@@ -1,6 +1,6 @@
 //! Procedural meshes for the demo scene and tests, with normals, UVs and tangents.
 
-use super::{Instance, Material, Mesh, Primitive, Scene, Texture};
+use crate::scene::{Instance, Material, Mesh, Primitive, Scene, Texture};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 fn prim(
@@ -259,7 +259,7 @@ pub fn primitive_from_arrays(a: &MeshArrays) -> Result<Primitive, String> {
             .map(|&p| Vec3::from_array(p).try_normalize().unwrap_or(Vec3::Y))
             .collect(),
         Some(_) => return Err("normals hold a NaN or an infinity".into()),
-        None => super::tangents::compute_smooth_normals(&positions, &indices),
+        None => crate::scene::mesh::tangents::compute_smooth_normals(&positions, &indices),
     };
     let uvs: Vec<Vec2> = a
         .uvs
@@ -267,7 +267,7 @@ pub fn primitive_from_arrays(a: &MeshArrays) -> Result<Primitive, String> {
         .unwrap_or_else(|| vec![Vec2::ZERO; n]);
     let tangents = normals
         .iter()
-        .map(|&m| super::tangents::fallback_tangent(m))
+        .map(|&m| crate::scene::mesh::tangents::fallback_tangent(m))
         .collect();
     let mut p = prim(positions, normals, uvs, tangents, indices);
     p.has_uvs = a.uvs.is_some();

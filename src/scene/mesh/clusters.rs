@@ -91,7 +91,7 @@ pub fn visible_runs(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::shapes::uv_sphere;
+    use crate::scene::built::shapes::uv_sphere;
 
     /// A triangle faces `eye` when the eye is on the side its counter-clockwise winding faces.
     fn faces(p: &[Vec3], t: &[u32], eye: Vec3) -> bool {
