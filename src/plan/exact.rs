@@ -2,7 +2,9 @@
 //! shown light's visibility per pixel with shadow rays (exact shadows) or marches short rays
 //! beside the maps (contact shadows), and what the exact pass needs to do it.
 
-use super::settings::{ShadowMethod, View};
+use super::settings::ShadowMethod;
+
+use super::view::View;
 use glam::{Mat4, Vec3};
 
 /// How far a contact shadow ray marches, in texels of the shown light's finest shadow view, and

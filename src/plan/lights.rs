@@ -1,8 +1,8 @@
 //! The lights a frame is shaded with, what auto exposure meters from them, and their uniforms.
 
 use super::input::PlanScene;
-use super::settings::{Ambient, Exposure, View, UNIT_AMBIENT};
 use super::uniforms::{LightUniform, MAX_LIGHTS};
+use super::view::{Ambient, Exposure, View, UNIT_AMBIENT};
 use super::views::{soft_size, ShadowView};
 use crate::math::Aabb;
 use crate::scene::{Light, LightKind};

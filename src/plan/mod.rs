@@ -18,6 +18,7 @@ pub mod report;
 pub(crate) mod settings;
 pub(crate) mod sight;
 pub(crate) mod uniforms;
+pub(crate) mod view;
 pub(crate) mod views;
 
 pub use camera::{camera_projection, fitting_frustum};
@@ -28,10 +29,13 @@ pub use input::{PlanScene, PlanTarget};
 pub use lights::{effective_lights, exposure_scale, metered_illuminance};
 pub use reach::ShadowReach;
 pub use settings::{
-    Ambient, Background, DeviceFacts, Exposure, HeldLight, Pcf, PostAa, SceneOptions, ShadowFit,
-    ShadowFormat, ShadowHold, ShadowMethod, ShadowSettings, Tonemap, View, ViewMode, AUTO_GROUND,
-    AUTO_SKY, GROUND_TINT, MAX_CASCADES, SKY_TINT, SUPERSAMPLE_FACTORS, UNIT_AMBIENT,
+    DeviceFacts, Pcf, PostAa, SceneOptions, ShadowFit, ShadowFormat, ShadowMethod, ShadowSettings,
+    Tonemap, ViewMode, MAX_CASCADES,
 };
 pub use sight::Sight;
 pub use uniforms::{MAX_LIGHTS, MAX_SHADOW_VIEWS};
+pub use view::{
+    Ambient, Background, Exposure, HeldLight, ShadowHold, View, AUTO_GROUND, AUTO_SKY, GROUND_TINT,
+    SKY_TINT, SUPERSAMPLE_FACTORS, UNIT_AMBIENT,
+};
 pub use views::{lookup_reach, soft_size, ShadowView};

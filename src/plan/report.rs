@@ -3,7 +3,8 @@
 //! many draws fall inside it, and the memory the maps take.
 
 use crate::math::Aabb;
-use crate::plan::settings::{ShadowFormat, View};
+use crate::plan::settings::ShadowFormat;
+use crate::plan::view::View;
 use crate::scene::{LightKind, Scene};
 use glam::Mat4;
 use serde_json::{json, Value};
@@ -31,9 +32,9 @@ pub fn exposure_report(scene: &Scene, view: &View, w: u32, h: u32) -> Value {
     let planner = crate::plan::ScenePlanner::new(scene);
     let plan = planner.plan(view, w, h);
     let mode = match view.exposure {
-        crate::plan::settings::Exposure::Auto => "auto".to_string(),
-        crate::plan::settings::Exposure::Ev100(ev) => format!("EV100 {ev}"),
-        crate::plan::settings::Exposure::Scale(k) => format!("scale {k}"),
+        crate::plan::view::Exposure::Auto => "auto".to_string(),
+        crate::plan::view::Exposure::Ev100(ev) => format!("EV100 {ev}"),
+        crate::plan::view::Exposure::Scale(k) => format!("scale {k}"),
     };
     json!({
         "mode": mode,

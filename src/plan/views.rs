@@ -4,8 +4,9 @@
 use super::camera::fitting_frustum;
 use super::casters::CasterPlan;
 use super::input::{PlanScene, PlanTarget};
-use super::settings::{HeldLight, Pcf, ShadowFit, ShadowSettings, View, MAX_CASCADES};
+use super::settings::{Pcf, ShadowFit, ShadowSettings, MAX_CASCADES};
 use super::uniforms::{ShadowViewUniform, MAX_SHADOW_VIEWS};
+use super::view::{HeldLight, View};
 use crate::math::shadow_fit::{
     cascade_splits, fit_directional, fit_point_faces, fit_spot, frustum_box_intersection, widened,
     CameraFrustum, DirectionalFit, DirectionalFitInput,

@@ -7,9 +7,8 @@ use super::gpu_scene::GpuScene;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::math::shadow_fit::spot_near;
-use crate::plan::settings::{
-    Background, PostAa, SceneOptions, ShadowFormat, ShadowSettings, View, ViewMode,
-};
+use crate::plan::settings::{PostAa, SceneOptions, ShadowFormat, ShadowSettings, ViewMode};
+use crate::plan::view::{Background, View};
 use crate::plan::ExactPlan;
 use crate::plan::CLEAR_COLOR;
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};

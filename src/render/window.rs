@@ -9,7 +9,8 @@ use super::renderer::{
 use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
-use crate::plan::settings::{SceneOptions, ShadowHold, View};
+use crate::plan::settings::SceneOptions;
+use crate::plan::view::{ShadowHold, View};
 use crate::render::targets::swapchain::Swapchain;
 use crate::render::targets::{Attachment, MsaaTargets};
 use crate::scene::Scene;

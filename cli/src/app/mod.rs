@@ -3,12 +3,15 @@
 
 #[cfg(feature = "viewer")]
 pub mod actions;
+pub mod bench;
 #[cfg(all(feature = "viewer", feature = "sweep"))]
 pub mod budget_worker;
 pub mod cli;
 #[cfg(feature = "viewer")]
 pub mod controller;
 pub mod inspect_view;
+#[cfg(feature = "reference")]
+pub mod lab_commands;
 #[cfg(feature = "viewer")]
 pub mod overlay;
 #[cfg(feature = "viewer")]

@@ -7,8 +7,9 @@ use crate::plan::casters::Viewpoint;
 use crate::plan::exact::{exact_asked, ExactMode, ExactPlan, CONTACT_TEXELS, CONTACT_THICKNESS};
 use crate::plan::input::PlanScene;
 use crate::plan::reach::ShadowReach;
-use crate::plan::settings::{View, ViewMode};
+use crate::plan::settings::ViewMode;
 use crate::plan::sight::Sight;
+use crate::plan::view::View;
 use crate::scene::LightKind;
 use crate::shader_consts::VariantKey;
 

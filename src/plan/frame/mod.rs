@@ -6,12 +6,10 @@ use super::casters::{plan_casters, Viewpoint};
 use super::exact::{exact_asked, ExactMode, ExactPlan};
 use super::input::{PlanScene, PlanTarget};
 use super::lights::{effective_lights, light_uniforms, metering};
-use super::settings::{
-    Ambient, Background, Exposure, HeldLight, Pcf, ShadowFormat, ShadowHold, ShadowSettings,
-    Tonemap, View, ViewMode,
-};
+use super::settings::{Pcf, ShadowFormat, ShadowSettings, Tonemap, ViewMode};
 use super::sight::Sight;
 use super::uniforms::{FrameUniform, MAX_LIGHTS};
+use super::view::{Ambient, Background, Exposure, HeldLight, ShadowHold, View};
 use super::views::lookup_reach;
 use super::views::{far_view_depth, shadow_views, view_uniforms, ShadowView};
 use crate::math::Aabb;

@@ -26,7 +26,7 @@ fn plan_at(
     plan_frame(&scene, view, &target)
 }
 use crate::plan::lights::*;
-use crate::plan::settings::{AUTO_GROUND, AUTO_SKY, GROUND_TINT, SKY_TINT};
+use crate::plan::view::{AUTO_GROUND, AUTO_SKY, GROUND_TINT, SKY_TINT};
 use crate::scene::Camera;
 
 #[test]

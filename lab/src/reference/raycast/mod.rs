@@ -1,17 +1,18 @@
 //! Exact shadow visibility and a Blinn-Phong reference image by ray casting, for the same view
 //! (same pixel centres, lights and material constants) as a GPU frame.
 
-use super::bvh::{Bvh, Hit};
-use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+mod rays;
+mod surface;
+
+use crate::reference::bvh::{Bvh, Hit};
+use glam::{Mat3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
+use rays::{face_viewer, light_at, primary_ray};
+use surface::{srgb_encode, surface_inputs};
 use umbra::math::interp::perturb_normal;
-use umbra::math::projection::pixel_to_ndc;
 use umbra::math::ray::Ray;
 use umbra::plan::{Ambient, FramePlan};
-use umbra::scene::{
-    blinn_phong_params, shade_blinn_phong, AlphaMode, Filter, LightKind, Sampler, Scene, Texture,
-    TextureRef, BLEND_SHADOW_CUTOFF,
-};
+use umbra::scene::{blinn_phong_params, shade_blinn_phong, Scene};
 
 /// Where a world triangle came from.
 #[derive(Clone, Copy, Debug)]
@@ -111,49 +112,6 @@ pub struct Probe {
     pub visible: bool,
 }
 
-/// Sample `k` of `n` on the unit disk: an area-uniform golden-angle spiral.
-fn spiral(k: usize, n: usize) -> Vec2 {
-    let r = ((k as f32 + 0.5) / n as f32).sqrt();
-    let a = k as f32 * 2.399_963_2;
-    Vec2::new(r * a.cos(), r * a.sin())
-}
-
-/// Light `l` seen from point `p`: unit direction towards it, distance (∞ for a directional
-/// light) and radiance arriving (inverse square and the spot cone applied).
-fn light_at(l: &umbra::scene::Light, p: Vec3) -> (Vec3, f32, Vec3) {
-    match l.kind {
-        LightKind::Directional => (
-            -l.direction.normalize_or(Vec3::NEG_Y),
-            f32::INFINITY,
-            l.color * l.intensity,
-        ),
-        _ => {
-            let d = l.position - p;
-            let r2 = d.length_squared().max(1e-8);
-            let dir = d / r2.sqrt();
-            let mut rad = l.color * l.intensity / r2 * l.range_window(r2.sqrt());
-            let cd = (-dir).dot(l.direction.normalize_or(Vec3::NEG_Y));
-            rad *= l.cone_attenuation(cd);
-            (dir, r2.sqrt(), rad)
-        }
-    }
-}
-
-/// The interpolated TEXCOORD_0, TEXCOORD_1 and COLOR_0 at hit `h` on the triangle whose first
-/// index is `first` (zeros without texture coordinates, white without colours).
-fn surface_inputs(prim: &umbra::scene::Primitive, first: usize, h: &Hit) -> ([Vec2; 2], Vec4) {
-    let i = [0, 1, 2].map(|k| prim.indices[first + k] as usize);
-    let w = [1.0 - h.u - h.v, h.u, h.v];
-    let uv0 = |v: usize| prim.uvs.get(v).copied().unwrap_or_default();
-    let (mut uvs, mut color) = ([Vec2::ZERO; 2], Vec4::ZERO);
-    for (v, w) in i.into_iter().zip(w) {
-        uvs[0] += uv0(v) * w;
-        uvs[1] += prim.uv1(v) * w;
-        color += prim.color(v) * w;
-    }
-    (uvs, color)
-}
-
 /// What a click on the image hits (`ReferenceScene::pick`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pick {
@@ -175,38 +133,6 @@ pub struct Pick {
     pub distance: f32,
     /// Per light of the plan: exactly lit there (facing it and unoccluded).
     pub lights_visible: Vec<bool>,
-}
-
-/// The primary ray through image position (x, y) of `plan`'s camera (clip → world `inv`): from
-/// the eye through the pixel for a perspective camera, from the pixel on the near plane along the
-/// view for an orthographic one (parallel rays).
-fn primary_ray(plan: &FramePlan, inv: &glam::Mat4, x: f32, y: f32, w: u32, h: u32) -> Ray {
-    let n = pixel_to_ndc(x, y, w, h);
-    let at = |depth: f32| {
-        let p = *inv * Vec4::new(n.x, n.y, depth, 1.0);
-        p.truncate() / p.w
-    };
-    if plan.orthographic {
-        let near = at(1.0);
-        return Ray::new(near, (at(0.5) - near).normalize_or(Vec3::NEG_Z));
-    }
-    let eye = plan.camera_position;
-    Ray::new(eye, (at(1e-3) - eye).normalize_or(Vec3::NEG_Z))
-}
-
-/// Turns a hit's geometric normal towards the viewer along `dir`, as the shader does; the
-/// returned flag says whether the shading normals flip too (a back face whose interpolated normal
-/// also faces away).
-fn face_viewer(ng: Vec3, n_geo: Vec3, dir: Vec3) -> (Vec3, bool) {
-    if ng.dot(dir) > 0.0 {
-        (-ng, n_geo.dot(dir) > 0.0)
-    } else {
-        (ng, false)
-    }
-}
-
-fn srgb_encode(c: f32) -> u8 {
-    (umbra::math::tonemap::linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0).round() as u8
 }
 
 impl<'a> ReferenceScene<'a> {
@@ -268,271 +194,6 @@ impl<'a> ReferenceScene<'a> {
         }
     }
 
-    fn texel(&self, t: &Texture, s: &Sampler, x: i64, y: i64, srgb: bool) -> Vec4 {
-        let (w, h) = (t.width as i64, t.height as i64);
-        let (x, y) = (s.wrap_u.texel(x, w), s.wrap_v.texel(y, h));
-        let i = ((y * w + x) * 4) as usize;
-        let px = &t.rgba[i..i + 4];
-        if srgb {
-            Vec4::new(
-                self.srgb_lut[px[0] as usize],
-                self.srgb_lut[px[1] as usize],
-                self.srgb_lut[px[2] as usize],
-                px[3] as f32 / 255.0,
-            )
-        } else {
-            Vec4::new(px[0] as f32, px[1] as f32, px[2] as f32, px[3] as f32) / 255.0
-        }
-    }
-
-    /// Sample of mip 0 at `uv` after the slot's texture transform, with the texture's sampler: its magnification filter (nearest or
-    /// bilinear) and wrap modes (decoded from sRGB when `srgb`). Mip 0 only: the reference has
-    /// no pixel footprint, so minification filters and mipmaps are not modelled.
-    /// `uvs` are the hit's TEXCOORD_0 and TEXCOORD_1; the slot reads its own set.
-    fn sample(&self, tex: Option<TextureRef>, uvs: [Vec2; 2], srgb: bool, default: Vec4) -> Vec4 {
-        let Some((t, s, uv)) = tex.and_then(|r| {
-            Some((
-                self.scene.textures.get(r.texture)?,
-                r.sampler,
-                r.transform.apply(uvs[(r.tex_coord as usize).min(1)]),
-            ))
-        }) else {
-            return default;
-        };
-        let x = uv.x * t.width as f32;
-        let y = uv.y * t.height as f32;
-        if s.mag == Filter::Nearest {
-            return self.texel(t, &s, x.floor() as i64, y.floor() as i64, srgb);
-        }
-        let (x, y) = (x - 0.5, y - 0.5);
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let a = self
-            .texel(t, &s, x0, y0, srgb)
-            .lerp(self.texel(t, &s, x0 + 1, y0, srgb), fx);
-        let b = self
-            .texel(t, &s, x0, y0 + 1, srgb)
-            .lerp(self.texel(t, &s, x0 + 1, y0 + 1, srgb), fx);
-        a.lerp(b, fy)
-    }
-
-    /// Exact visibility of world point `p` (geometric normal `ng`, facing normal `n`) from light
-    /// `i`: whether its centre is visible, the fraction of its emitter that is (the same for a
-    /// punctual light), the direction towards it and the radiance arriving.
-    fn visible(
-        &self,
-        plan: &FramePlan,
-        i: usize,
-        p: Vec3,
-        ng: Vec3,
-        n_facing: Vec3,
-    ) -> (bool, f32, Vec3, Vec3) {
-        let l = &plan.lights[i];
-        let (dir, dist, radiance) = light_at(l, p);
-        let facing = n_facing.dot(dir) > 0.0;
-        if !facing {
-            return (false, 0.0, dir, radiance);
-        }
-        if !plan.is_shadowed(i) {
-            return (true, 1.0, dir, radiance);
-        }
-        let centre = !self.occluded(p, ng, dir, dist);
-        let size = umbra::plan::soft_size(l);
-        if size <= 0.0 {
-            return (centre, if centre { 1.0 } else { 0.0 }, dir, radiance);
-        }
-        // The emitter's disk across the direction to it: the sun's directions within its
-        // angular radius (tan = size), a sphere light's disk of radius `size`.
-        let (e1, e2) = dir.any_orthonormal_pair();
-        let open = (0..AREA_SAMPLES)
-            .filter(|&k| {
-                let u = spiral(k, AREA_SAMPLES);
-                let (d, t) = match l.kind {
-                    LightKind::Directional => (
-                        (dir + (e1 * u.x + e2 * u.y) * size).normalize(),
-                        f32::INFINITY,
-                    ),
-                    _ => {
-                        let to = l.position + (e1 * u.x + e2 * u.y) * size - p;
-                        let t = to.length();
-                        (to / t.max(1e-20), t)
-                    }
-                };
-                !self.occluded(p, ng, d, t)
-            })
-            .count();
-        (centre, open as f32 / AREA_SAMPLES as f32, dir, radiance)
-    }
-
-    /// Whether anything lies between surface point `p` (geometric normal `ng`) and a light
-    /// `dist` away along `dir`.
-    fn occluded(&self, p: Vec3, ng: Vec3, dir: Vec3, dist: f32) -> bool {
-        // Start the shadow ray off the surface, on the light's side of the true face.
-        let side = if ng.dot(dir) >= 0.0 { ng } else { -ng };
-        let origin = p + side * self.eps;
-        self.bvh.occluded_where(
-            &Ray::new(origin, dir),
-            self.eps,
-            dist - self.eps,
-            &|h: &Hit| self.stops(h, true),
-        )
-    }
-
-    /// Whether a caster of light `i` lies within `radius` of surface point `p` (geometric normal
-    /// `ng`) across the light's direction: shadow rays start from 32 points of a disk of that
-    /// radius around `p` (across the direction to the light, moved along it onto `p`'s tangent
-    /// plane). A shadow map resolves
-    /// casters to its lookup's reach, so a false shadow with such a caster nearby is a shadow
-    /// drawn too wide, not the receiver shadowing itself.
-    pub fn caster_within(
-        &self,
-        plan: &FramePlan,
-        i: usize,
-        p: Vec3,
-        ng: Vec3,
-        radius: f32,
-    ) -> bool {
-        let Some(l) = plan.lights.get(i) else {
-            return false;
-        };
-        let (dir, _, _) = light_at(l, p);
-        let cos = ng.dot(dir);
-        if cos.abs() < 1e-3 {
-            return false;
-        }
-        let side = if cos >= 0.0 { ng } else { -ng };
-        let (e1, e2) = dir.any_orthonormal_pair();
-        (0..32).any(|k| {
-            let u = spiral(k, 32) * radius;
-            let o = e1 * u.x + e2 * u.y;
-            // Onto the tangent plane along the light's direction.
-            let start = p + o - dir * (ng.dot(o) / cos) + side * self.eps;
-            let (d, t) = match l.kind {
-                LightKind::Directional => (dir, f32::INFINITY),
-                _ => {
-                    let to = l.position - start;
-                    let t = to.length();
-                    (to / t.max(1e-20), t)
-                }
-            };
-            self.bvh
-                .occluded_where(&Ray::new(start, d), self.eps, t - self.eps, &|h: &Hit| {
-                    self.stops(h, true)
-                })
-        })
-    }
-
-    /// The nearest surface along a primary ray from `t_min` (alpha-masked texels let it
-    /// through).
-    fn intersect_from(&self, ray: &Ray, t_min: f32) -> Option<Hit> {
-        self.bvh
-            .intersect_where(ray, t_min, f32::INFINITY, &|h: &Hit| self.stops(h, false))
-    }
-
-    /// The receiver seen through `h`, a blended texel below `BLEND_SHADOW_CUTOFF` (which
-    /// neither casts nor receives): the next surface along `ray` that would stop a shadow ray.
-    fn receiver_beyond(&self, ray: &Ray, h: &Hit) -> Option<Hit> {
-        self.bvh.intersect_where(
-            ray,
-            h.t * (1.0 + 1e-5) + self.eps,
-            f32::INFINITY,
-            &|h: &Hit| self.stops(h, true),
-        )
-    }
-
-    /// The nearest surface along a primary ray.
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.intersect_from(ray, 0.0)
-    }
-
-    /// Whether a hit stops a primary ray or (`shadow`) a shadow ray: always, except where the
-    /// base colour's alpha (factor × texture, bilinear on mip 0 as everywhere here) is below the
-    /// cutoff of an alpha-masked material (where the GPU's masked pipelines discard, camera and
-    /// shadow pass alike), and, for shadow rays, below `BLEND_SHADOW_CUTOFF` on a blended one.
-    fn stops(&self, h: &Hit, shadow: bool) -> bool {
-        let cutoff = match self.material_of(h).map(|m| m.alpha_mode) {
-            Some(AlphaMode::Mask(c)) => c,
-            Some(AlphaMode::Blend) if shadow => BLEND_SHADOW_CUTOFF,
-            _ => return true,
-        };
-        self.alpha_at(h) >= cutoff
-    }
-
-    /// The material of the triangle hit (None: the default material).
-    fn material_of(&self, h: &Hit) -> Option<&umbra::scene::Material> {
-        let r = self.refs[h.triangle as usize];
-        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
-        self.scene.materials.get(prim.material)
-    }
-
-    /// Base-colour alpha (factor × texture) at hit `h`.
-    fn alpha_at(&self, h: &Hit) -> f32 {
-        let r = self.refs[h.triangle as usize];
-        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
-        let Some(mat) = self.scene.materials.get(prim.material) else {
-            return 1.0;
-        };
-        let (uvs, color) = surface_inputs(prim, r.first as usize, h);
-        let tex = mat.base_color_texture;
-        color.w * mat.base_color.w * self.sample(tex, uvs, true, Vec4::ONE).w
-    }
-
-    /// The linear colour seen along `ray` beyond `t_min`: the first surface's shading, and where
-    /// it is blended, that over what lies behind it (up to `MAX_BLEND_LAYERS` blended surfaces);
-    /// the background where nothing is hit.
-    fn radiance(
-        &self,
-        plan: &FramePlan,
-        ray: &Ray,
-        t_min: f32,
-        ambient: Ambient,
-        layers: u32,
-    ) -> Vec3 {
-        let Some(h) = self.intersect_from(ray, t_min) else {
-            return plan.background_along(ray.dir);
-        };
-        let (_, _, rgb) = self.shade(plan, ray, &h, ambient);
-        let rgb = plan.display_surface(rgb, self.unlit(&h));
-        self.blend_behind(plan, ray, &h, rgb, ambient, layers)
-    }
-
-    /// Whether the surface hit is unlit (KHR_materials_unlit).
-    fn unlit(&self, h: &Hit) -> bool {
-        self.material_of(h).is_some_and(|m| m.unlit)
-    }
-
-    /// `rgb`, the shading of hit `h`, blended over what lies behind it when its material is
-    /// blended (the GPU's over operator: a·rgb + (1 − a)·behind).
-    fn blend_behind(
-        &self,
-        plan: &FramePlan,
-        ray: &Ray,
-        h: &Hit,
-        rgb: Vec3,
-        ambient: Ambient,
-        layers: u32,
-    ) -> Vec3 {
-        if layers >= MAX_BLEND_LAYERS
-            || self.material_of(h).map(|m| m.alpha_mode) != Some(AlphaMode::Blend)
-        {
-            return rgb;
-        }
-        let a = self.alpha_at(h).clamp(0.0, 1.0);
-        if a >= 1.0 {
-            return rgb;
-        }
-        // Past this surface: a relative step so that the same triangle is not hit again.
-        let behind = self.radiance(
-            plan,
-            ray,
-            h.t * (1.0 + 1e-5) + self.eps,
-            ambient,
-            layers + 1,
-        );
-        rgb * a + behind * (1.0 - a)
-    }
-
     /// What lies under image position (`x`, `y`) (pixel units, centres at +0.5) of `plan`'s
     /// camera: the surface the primary ray hits first, with each of the plan's lights' exact
     /// verdict there (facing it, and unoccluded whether or not the GPU shadows that light).
@@ -571,27 +232,6 @@ impl<'a> ReferenceScene<'a> {
             distance: h.t,
             lights_visible: lights,
         })
-    }
-
-    /// Geometric and interpolated normals (world space, as stored: not yet turned to the viewer)
-    /// at a hit.
-    fn hit_normals(&self, h: &Hit) -> (Vec3, Vec3) {
-        let r = self.refs[h.triangle as usize];
-        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
-        let world_from_model = self.matrices[r.instance as usize];
-        let idx = [0, 1, 2].map(|k| prim.indices[r.first as usize + k] as usize);
-        let pw = idx.map(|i| world_from_model.transform_point3(prim.positions[i]));
-        let ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
-        if prim.normals.len() != prim.positions.len() {
-            return (ng, ng);
-        }
-        let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
-        let n =
-            prim.normals[idx[0]] * w.x + prim.normals[idx[1]] * w.y + prim.normals[idx[2]] * w.z;
-        (
-            ng,
-            (self.normal_mats[r.instance as usize] * n).normalize_or(ng),
-        )
     }
 
     /// Exact visibility at chosen pixel centres of `plan`'s camera (for sparse probes: the error

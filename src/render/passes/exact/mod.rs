@@ -1,0 +1,295 @@
+//! Exact hard shadows by an irregular z-buffer ([`crate::plan::ShadowMethod::Exact`]): the
+//! shadowed light's visibility at each pixel's receiver, decided by intersecting its shadow ray
+//! with the caster triangles themselves, on the device (`shaders/exact.wgsl`); and contact
+//! shadows ([`crate::plan::ShadowSettings::contact`]), which share its first step.
+//!
+//! Three steps after the shadow pass: the camera's receivers (what casts and is judged: the
+//! alpha cutoff of the shadow pass) are drawn into a position and a face-normal image; a compute
+//! pass makes each covered pixel a sample and links it into the list of the light-view grid cell
+//! its shadow ray starts in (a grid per cube face for a point light); every caster triangle is
+//! drawn into that grid grown by half a cell (a sliver as its grown box), so that each cell it
+//! touches runs a fragment, and each fragment tests the cell's samples against the exact
+//! triangle (and its alpha texture), unless the triangle lies wholly farther from a directional
+//! light than every sample of the cell. The camera pass then reads the verdict at its pixel where
+//! its fragment is that receiver, and the shadow map elsewhere (blended layers over the receiver,
+//! MSAA's edge samples). The grid only sorts the work: its size changes the cost, not the answer.
+//! Contact shadows replace the last two steps by a march through the receiver image.
+//!
+//! The images and buffers are made on first use and remade when the image size changes; they are
+//! shared by the frames in flight (each frame's barriers order it after the previous one's use).
+
+mod record;
+mod targets;
+
+use crate::gpu::context::{Context, GpuError};
+use crate::gpu::resources::Buffer;
+use crate::gpu::shaders::{allocate_sets, create_module, exact as sh, set_layout_for};
+use crate::gpu::Image;
+use crate::plan::{ExactMode, ExactPlan};
+use crate::render::gpu_scene::{vertex_layout, GpuScene};
+use crate::render::pipeline::{
+    create_layout, create_pipeline, ColorBlend, Depth, PipelineDesc, Stencil,
+};
+use crate::render::targets::Attachment;
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec4};
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+/// Cells per side of the light-view grid the samples are sorted into.
+/// (At 1280×720 against 1024 cells: 0.76× the pass on the close-up stand-in, 0.69× on
+/// FlightHelmet close by; 32 MiB of heads and depths, cleared every frame.)
+pub const GRID: u32 = 2048;
+
+/// Cells per side of each of a point light's six cube-face grids (six of 2048² would be 192 MiB).
+pub const CUBE_GRID: u32 = 1024;
+
+/// Cells of the largest grid set: one `GRID`² or six `CUBE_GRID`².
+const MAX_CELLS: u64 = {
+    let one = (GRID as u64) * (GRID as u64);
+    let six = 6 * (CUBE_GRID as u64) * (CUBE_GRID as u64);
+    if one > six {
+        one
+    } else {
+        six
+    }
+};
+
+/// Cells per side of the grids of a frame with `views` light views.
+fn grid_side(views: usize) -> u32 {
+    if views > 1 {
+        CUBE_GRID
+    } else {
+        GRID
+    }
+}
+
+const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// `ExactFrame` of `shaders/exact.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ExactFrame {
+    views: [Mat4; 6],
+    light: Vec4,
+    params: Vec4,
+    camera_clip: Mat4,
+    eye: Vec4,
+    contact: Vec4,
+    counts: Vec4,
+}
+
+/// `ExactImmediates` of `shaders/exact.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ExactImmediates {
+    world_from_model: Mat4,
+    extra: Mat4,
+}
+
+/// The images and buffers of one image size.
+struct Targets {
+    extent: vk::Extent2D,
+    _position: Image,
+    _normal: Image,
+    _depth: Image,
+    position: Attachment,
+    normal: Attachment,
+    depth: Attachment,
+    heads: Buffer,
+    next: Buffer,
+    samples: Buffer,
+    rays: Buffer,
+}
+
+/// The exact shadow pass.
+pub struct ExactPass {
+    ctx: Arc<Context>,
+    set_layout: vk::DescriptorSetLayout,
+    layout: vk::PipelineLayout,
+    module: vk::ShaderModule,
+    receiver: vk::Pipeline,
+    build: vk::Pipeline,
+    contact: vk::Pipeline,
+    caster: vk::Pipeline,
+    pool: vk::DescriptorPool,
+    sets: Vec<vk::DescriptorSet>,
+    uniforms: Vec<Buffer>,
+    targets: Option<Targets>,
+    /// A buffer the camera pass binds when no frame has run the pass (its binding must be
+    /// written); shaped like an empty sample list.
+    empty: Buffer,
+}
+
+impl ExactPass {
+    /// The pass for `scene` (its material set layout at set 1) with `slots` frames in flight.
+    pub fn new(ctx: &Arc<Context>, scene: &GpuScene, slots: usize) -> Result<Self, GpuError> {
+        let stages = vk::ShaderStageFlags::VERTEX
+            | vk::ShaderStageFlags::FRAGMENT
+            | vk::ShaderStageFlags::COMPUTE;
+        let set_layout = set_layout_for(ctx, sh::BINDINGS, 0, stages, "exact set layout")?;
+        let layout = create_layout(
+            ctx,
+            &[set_layout, scene.material_layout],
+            sh::IMMEDIATE_SIZE,
+            "exact layout",
+        )?;
+        let module = create_module(ctx, &sh::spirv()?, "exact.wgsl")?;
+        let (bindings, all) = vertex_layout();
+        let attributes = [all[0], all[2], all[4], all[5]];
+        let receiver = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "exact receivers",
+                layout,
+                vertex: (module, sh::ENTRY_VS_RECEIVER),
+                fragment: Some((module, sh::ENTRY_FS_RECEIVER)),
+                bindings: &bindings,
+                attributes: &attributes,
+                color_formats: &[POSITION_FORMAT, POSITION_FORMAT],
+                masked_targets: 0,
+                depth_format: DEPTH_FORMAT,
+                stencil: Stencil::Off,
+                depth_clamp: false,
+                depth_bias: false,
+                depth: Depth::Test,
+                blend: ColorBlend::Off,
+                samples: 1,
+            },
+        )?;
+        let caster = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "exact casters",
+                layout,
+                vertex: (module, sh::ENTRY_VS_CASTER),
+                fragment: Some((module, sh::ENTRY_FS_CASTER)),
+                bindings: &[],
+                attributes: &[],
+                color_formats: &[],
+                masked_targets: 0,
+                depth_format: vk::Format::UNDEFINED,
+                stencil: Stencil::Off,
+                depth_clamp: false,
+                depth_bias: false,
+                depth: Depth::Off,
+                blend: ColorBlend::Off,
+                samples: 1,
+            },
+        )?;
+        let compute = |entry, name: &str| -> Result<vk::Pipeline, GpuError> {
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(module)
+                .name(entry);
+            let info = vk::ComputePipelineCreateInfo::default()
+                .stage(stage)
+                .layout(layout);
+            let p = unsafe {
+                ctx.device
+                    .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
+            }
+            .map_err(|(_, e)| GpuError::Vk {
+                call: "vkCreateComputePipelines",
+                result: e,
+            })?[0];
+            ctx.set_name(p, name);
+            Ok(p)
+        };
+        let build = compute(sh::ENTRY_CS_BUILD, "exact build")?;
+        let contact = compute(sh::ENTRY_CS_CONTACT, "contact shadows")?;
+        let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, set_layout, slots)?;
+        let uniforms = (0..slots)
+            .map(|i| {
+                Buffer::new(
+                    ctx,
+                    &format!("exact frame {i}"),
+                    std::mem::size_of::<ExactFrame>() as u64,
+                    vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    MemoryLocation::CpuToGpu,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut empty = Buffer::new(
+            ctx,
+            "exact samples (none)",
+            16,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        empty.write(0, bytemuck::cast_slice(&[0f32; 4]))?;
+        Ok(Self {
+            ctx: ctx.clone(),
+            set_layout,
+            layout,
+            module,
+            receiver,
+            build,
+            contact,
+            caster,
+            pool,
+            sets,
+            uniforms,
+            targets: None,
+            empty,
+        })
+    }
+
+    /// The sample buffer the camera pass reads (the empty one before the first exact frame).
+    pub fn samples(&self) -> vk::Buffer {
+        self.targets
+            .as_ref()
+            .map_or(self.empty.raw, |t| t.samples.raw)
+    }
+
+    /// Writes slot `slot`'s frame uniform (its previous frame must have completed).
+    pub fn write_frame(&mut self, slot: usize, f: &ExactPlan) -> Result<(), GpuError> {
+        let extent = self
+            .targets
+            .as_ref()
+            .map_or(vk::Extent2D::default(), |t| t.extent);
+        let (length, thickness) = match f.mode {
+            ExactMode::Exact => (0.0, 0.0),
+            ExactMode::Contact { length, thickness } => (length, thickness),
+        };
+        let u = ExactFrame {
+            camera_clip: f.clip_from_world,
+            eye: f.eye.0.extend(1.0),
+            contact: Vec4::new(length, 0.0, thickness, 0.0),
+            views: std::array::from_fn(|i| f.views.get(i).copied().unwrap_or(Mat4::ZERO)),
+            counts: Vec4::new(f.views.len() as f32, 0.0, 0.0, 0.0),
+            light: f.light.extend(if f.positional {
+                crate::gpu::shaders::scene::LIGHT_SPOT
+            } else {
+                crate::gpu::shaders::scene::LIGHT_DIRECTIONAL
+            }),
+            params: Vec4::new(
+                f.eps,
+                grid_side(f.views.len()) as f32,
+                extent.width as f32,
+                extent.height as f32,
+            ),
+        };
+        self.uniforms[slot].write(0, bytemuck::bytes_of(&u))
+    }
+}
+
+impl Drop for ExactPass {
+    fn drop(&mut self) {
+        unsafe {
+            let d = &self.ctx.device;
+            let _ = d.device_wait_idle();
+            self.targets = None;
+            d.destroy_pipeline(self.receiver, None);
+            d.destroy_pipeline(self.build, None);
+            d.destroy_pipeline(self.contact, None);
+            d.destroy_pipeline(self.caster, None);
+            d.destroy_shader_module(self.module, None);
+            d.destroy_pipeline_layout(self.layout, None);
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}

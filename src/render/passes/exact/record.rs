@@ -1,0 +1,254 @@
+//! Recording the exact pass: the receivers' positions and normals, each pixel's ray binned into
+//! the grid of light views, the casters drawn into the grid.
+
+use super::*;
+use crate::gpu::barrier::{memory_barrier, Access};
+use crate::plan::Viewpoint;
+use crate::plan::{ExactMode, ExactPlan};
+use crate::render::gpu_scene::GpuScene;
+use crate::render::pipeline::{depth_clear_attachment, set_viewport};
+use ash::vk;
+use glam::{Mat4, Vec4};
+
+impl ExactPass {
+    /// Records the three steps for slot `slot` (after [`ExactPass::ensure`] and
+    /// [`ExactPass::write_frame`]); the samples are then ready for the camera pass's fragment
+    /// shaders.
+    pub fn record(&mut self, cmd: vk::CommandBuffer, slot: usize, scene: &GpuScene, f: &ExactPlan) {
+        let ctx = self.ctx.clone();
+        let d = &ctx.device;
+        let set = self.sets[slot];
+        let mut t = self.targets.take().expect("exact targets made by ensure");
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        // The previous frame's reads and writes of the lists and samples come first.
+        memory_barrier(
+            d,
+            cmd,
+            (
+                S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ),
+            (
+                S::ALL_TRANSFER | S::COMPUTE_SHADER,
+                A::TRANSFER_WRITE | A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ),
+        );
+        unsafe { d.cmd_fill_buffer(cmd, t.heads.raw, 0, vk::WHOLE_SIZE, 0) };
+        self.record_receivers(cmd, set, scene, f, &mut t);
+        let groups = (t.extent.width.div_ceil(8), t.extent.height.div_ceil(8));
+        if let ExactMode::Contact { .. } = f.mode {
+            bind(
+                d,
+                self.layout,
+                cmd,
+                (vk::PipelineBindPoint::COMPUTE, self.contact),
+                set,
+            );
+            unsafe { d.cmd_dispatch(cmd, groups.0, groups.1, 1) };
+            memory_barrier(
+                d,
+                cmd,
+                (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+                (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
+            );
+            self.targets = Some(t);
+            return;
+        }
+        self.record_binning(cmd, set, groups);
+        self.record_casters(cmd, set, scene, f);
+        self.targets = Some(t);
+    }
+
+    /// Step 1: the receivers' world positions and normals, depth-tested, into `t`.
+    fn record_receivers(
+        &self,
+        cmd: vk::CommandBuffer,
+        set: vk::DescriptorSet,
+        scene: &GpuScene,
+        f: &ExactPlan,
+        t: &mut Targets,
+    ) {
+        let ctx = &self.ctx;
+        let d = &ctx.device;
+        t.position.transition(d, cmd, Access::ColorAttachment);
+        t.normal.transition(d, cmd, Access::ColorAttachment);
+        t.depth.transition(d, cmd, Access::DepthAttachment);
+        let clear = |view| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: [0.0; 4] },
+                })
+        };
+        let colors = [clear(t.position.view), clear(t.normal.view)];
+        let depth = depth_clear_attachment(t.depth.view, false);
+        let area = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: t.extent,
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&colors)
+            .depth_attachment(&depth);
+        unsafe { d.cmd_begin_rendering(cmd, &info) };
+        bind(
+            d,
+            self.layout,
+            cmd,
+            (vk::PipelineBindPoint::GRAPHICS, self.receiver),
+            set,
+        );
+        set_viewport(ctx, cmd, t.extent);
+        scene.bind_geometry(d, cmd);
+        for &i in &f.receivers {
+            let dr = &scene.draws[i];
+            scene.bind_material(d, cmd, self.layout, 1, dr.material);
+            let pc = ExactImmediates {
+                world_from_model: dr.world_from_model,
+                extra: f.clip_from_world,
+            };
+            scene.record_draw(
+                cmd,
+                self.layout,
+                dr,
+                Some(f.eye),
+                Viewpoint::Eye(f.eye.0),
+                bytemuck::bytes_of(&pc),
+            );
+        }
+        unsafe { d.cmd_end_rendering(cmd) };
+        t.position.transition(d, cmd, Access::ComputeSampled);
+        t.normal.transition(d, cmd, Access::ComputeSampled);
+    }
+
+    /// Step 2: each pixel's shadow ray binned into the grid of light views (`groups` of 8×8).
+    fn record_binning(&self, cmd: vk::CommandBuffer, set: vk::DescriptorSet, groups: (u32, u32)) {
+        let d = &self.ctx.device;
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        memory_barrier(
+            d,
+            cmd,
+            (S::ALL_TRANSFER, A::TRANSFER_WRITE),
+            (
+                S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ),
+        );
+        bind(
+            d,
+            self.layout,
+            cmd,
+            (vk::PipelineBindPoint::COMPUTE, self.build),
+            set,
+        );
+        unsafe { d.cmd_dispatch(cmd, groups.0, groups.1, 1) };
+        memory_barrier(
+            d,
+            cmd,
+            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+            (
+                S::VERTEX_SHADER | S::FRAGMENT_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ),
+        );
+    }
+
+    /// Step 3: the casters drawn into the grid (no attachments: the fragments only test and mark
+    /// the rays they hit), then made visible to the camera pass's fragments.
+    fn record_casters(
+        &self,
+        cmd: vk::CommandBuffer,
+        set: vk::DescriptorSet,
+        scene: &GpuScene,
+        f: &ExactPlan,
+    ) {
+        let ctx = &self.ctx;
+        let d = &ctx.device;
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        let side = grid_side(f.views.len());
+        let grid = vk::Extent2D {
+            width: side,
+            height: side,
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: grid,
+            })
+            .layer_count(1);
+        unsafe { d.cmd_begin_rendering(cmd, &info) };
+        bind(
+            d,
+            self.layout,
+            cmd,
+            (vk::PipelineBindPoint::GRAPHICS, self.caster),
+            set,
+        );
+        set_viewport(ctx, cmd, grid);
+        unsafe {
+            d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
+            d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
+        }
+        for &i in &f.casters {
+            let dr = &scene.draws[i].shadow_caster();
+            scene.bind_material(d, cmd, self.layout, 1, dr.material);
+            for view in 0..f.views.len() {
+                let mut extra = Mat4::ZERO;
+                extra.x_axis = Vec4::new(
+                    f32::from_bits(dr.first_index),
+                    f32::from_bits(dr.vertex_offset as u32),
+                    if dr.alpha.tests_alpha_in_shadow() {
+                        1.0
+                    } else {
+                        0.0
+                    },
+                    view as f32,
+                );
+                let pc = ExactImmediates {
+                    world_from_model: dr.world_from_model,
+                    extra,
+                };
+                unsafe {
+                    d.cmd_push_constants(
+                        cmd,
+                        self.layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&pc),
+                    );
+                    // Six vertices a triangle: the triangle grown (or its box's two halves).
+                    d.cmd_draw(cmd, 2 * dr.index_count, 1, 0, 0);
+                }
+            }
+        }
+        unsafe { d.cmd_end_rendering(cmd) };
+        // The verdicts, for the camera pass's fragments.
+        memory_barrier(
+            d,
+            cmd,
+            (S::FRAGMENT_SHADER, A::SHADER_STORAGE_WRITE),
+            (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
+        );
+    }
+}
+
+/// Binds `pipeline` at `point` with the frame's set `set` (set 0 of `layout`).
+pub(super) fn bind(
+    d: &ash::Device,
+    layout: vk::PipelineLayout,
+    cmd: vk::CommandBuffer,
+    (point, pipeline): (vk::PipelineBindPoint, vk::Pipeline),
+    set: vk::DescriptorSet,
+) {
+    unsafe {
+        d.cmd_bind_pipeline(cmd, point, pipeline);
+        d.cmd_bind_descriptor_sets(cmd, point, layout, 0, &[set], &[]);
+    }
+}

@@ -1,0 +1,108 @@
+//! The exact pass's images and buffers at one image size (re-made when it changes).
+
+use super::*;
+use crate::gpu::context::{GpuError, VkCheck};
+use crate::gpu::resources::Buffer;
+use crate::gpu::shaders::exact as sh;
+use crate::gpu::Image;
+use crate::render::gpu_scene::GpuScene;
+use crate::render::targets::Attachment;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+impl ExactPass {
+    /// Makes the images and buffers for `extent` (and writes every slot's set), if not made yet.
+    pub fn ensure(&mut self, scene: &GpuScene, extent: vk::Extent2D) -> Result<(), GpuError> {
+        if self.targets.as_ref().is_some_and(|t| t.extent == extent) {
+            return Ok(());
+        }
+        if let Some(old) = self.targets.take() {
+            // A new image size: the frames in flight may still read the old targets and sets.
+            unsafe { self.ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
+            drop(old);
+        }
+        let ctx = &self.ctx;
+        let image = |name: &str, format, usage| Image::new(ctx, name, format, extent, 1, usage);
+        let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let position = image("exact receiver positions", POSITION_FORMAT, color)?;
+        let normal = image("exact receiver normals", POSITION_FORMAT, color)?;
+        let depth = image(
+            "exact receiver depth",
+            DEPTH_FORMAT,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        )?;
+        let pixels = (extent.width * extent.height) as u64;
+        let storage = |name: &str, size: u64| {
+            Buffer::new(
+                ctx,
+                name,
+                size,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )
+        };
+        let t = Targets {
+            extent,
+            position: Attachment::of(&position),
+            normal: Attachment::of(&normal),
+            depth: Attachment::of(&depth),
+            _position: position,
+            _normal: normal,
+            _depth: depth,
+            heads: storage("exact grid heads", 2 * MAX_CELLS * 4)?,
+            next: storage("exact sample links", pixels * 4)?,
+            samples: storage("exact samples", (pixels + 1) * 16)?,
+            rays: storage("exact shadow rays", pixels * 16)?,
+        };
+        for (slot, &set) in self.sets.iter().enumerate() {
+            let buffer = |b: &Buffer| {
+                [vk::DescriptorBufferInfo {
+                    buffer: b.raw,
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                }]
+            };
+            let image = |view| {
+                [vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }]
+            };
+            let buffers = [
+                (sh::XF, buffer(&self.uniforms[slot])),
+                (sh::HEADS, buffer(&t.heads)),
+                (sh::NEXT, buffer(&t.next)),
+                (sh::SAMPLES, buffer(&t.samples)),
+                (sh::RAYS, buffer(&t.rays)),
+                (sh::POSITIONS, buffer(&scene.positions)),
+                (sh::INDICES, buffer(&scene.indices)),
+                (sh::ATTRIBUTES, buffer(&scene.attributes)),
+            ];
+            let images = [
+                (sh::RECEIVER_POSITION, image(t.position.view)),
+                (sh::RECEIVER_NORMAL, image(t.normal.view)),
+            ];
+            let mut writes: Vec<vk::WriteDescriptorSet> = buffers
+                .iter()
+                .map(|(b, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(b.binding)
+                        .descriptor_type(b.descriptor_type())
+                        .buffer_info(info)
+                })
+                .collect();
+            writes.extend(images.iter().map(|(b, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(b.binding)
+                    .descriptor_type(b.descriptor_type())
+                    .image_info(info)
+            }));
+            unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        }
+        self.targets = Some(t);
+        Ok(())
+    }
+}
