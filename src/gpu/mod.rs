@@ -6,8 +6,10 @@ pub(crate) mod barrier;
 pub(crate) mod context;
 mod heap;
 pub mod pipeline_cache;
+pub(crate) mod recorder;
 pub(crate) mod resources;
 pub(crate) mod shaders;
 
 pub use context::{Context, ContextDesc, GpuError, RawVulkan, Validation, ValidationLog};
+pub(crate) use recorder::Recorder;
 pub(crate) use resources::{Buffer, Image};

@@ -6,6 +6,7 @@ use super::device::device_facts;
 use super::gpu_scene::GpuScene;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::Recorder;
 use crate::math::shadow_fit::spot_near;
 use crate::plan::settings::{PostAa, SceneOptions, ShadowFormat, ShadowSettings, ViewMode};
 use crate::plan::view::{Background, View};
@@ -252,16 +253,13 @@ impl FrameCore {
         let d = &ctx.device;
         let q = 3 * slot as u32;
         let timestamps = ctx.timestamp_valid_bits > 0;
-        unsafe {
-            if timestamps {
-                d.cmd_reset_query_pool(cmd, self.query_pool, q, 3);
-                d.cmd_write_timestamp2(
-                    cmd,
-                    vk::PipelineStageFlags2::TOP_OF_PIPE,
-                    self.query_pool,
-                    q,
-                );
-            }
+        if timestamps {
+            Recorder::new(d, cmd).reset_query_pool(self.query_pool, q, 3);
+            Recorder::new(d, cmd).write_timestamp2(
+                vk::PipelineStageFlags2::TOP_OF_PIPE,
+                self.query_pool,
+                q,
+            );
         }
         let views: Vec<_> = plan
             .shadow_views
@@ -277,15 +275,12 @@ impl FrameCore {
         if let (Some(inputs), Some(pass)) = (&plan.exact, self.exact.as_mut()) {
             pass.record(cmd, slot, &self.gpu, inputs);
         }
-        unsafe {
-            if timestamps {
-                d.cmd_write_timestamp2(
-                    cmd,
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    self.query_pool,
-                    q + 1,
-                );
-            }
+        if timestamps {
+            Recorder::new(d, cmd).write_timestamp2(
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.query_pool,
+                q + 1,
+            );
         }
         // With post-process AA the camera pass draws into the pass's source image.
         let color_target: &mut Attachment = if frame.post_aa {
@@ -327,15 +322,12 @@ impl FrameCore {
         if frame.post_aa {
             self.post.record(cmd, color);
         }
-        unsafe {
-            if timestamps {
-                d.cmd_write_timestamp2(
-                    cmd,
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    self.query_pool,
-                    q + 2,
-                );
-            }
+        if timestamps {
+            Recorder::new(d, cmd).write_timestamp2(
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.query_pool,
+                q + 2,
+            );
         }
         self.timestamps_written[slot] = timestamps;
         PassCounts {

@@ -2,6 +2,7 @@
 
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::resources::has_stencil;
+use crate::gpu::Recorder;
 use ash::vk;
 use std::ffi::CStr;
 
@@ -261,10 +262,8 @@ pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D)
         offset: vk::Offset2D::default(),
         extent,
     }];
-    unsafe {
-        ctx.device.cmd_set_viewport(cmd, 0, &vp);
-        ctx.device.cmd_set_scissor(cmd, 0, &sc);
-    }
+    Recorder::new(&ctx.device, cmd).set_viewport(0, &vp);
+    Recorder::new(&ctx.device, cmd).set_scissor(0, &sc);
 }
 
 /// A depth attachment cleared to 0 (reversed-z: 0 is the far plane) and stored (with a stencil

@@ -4,6 +4,7 @@ use super::core::{FrameCore, Targets};
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::resources::blit_linear;
+use crate::gpu::Recorder;
 use crate::gpu::{Buffer, Image};
 use crate::plan::settings::SceneOptions;
 use crate::plan::view::{View, SUPERSAMPLE_FACTORS};
@@ -124,15 +125,12 @@ pub fn copy_to_buffer(
             height: extent.height,
             depth: 1,
         })];
-    unsafe {
-        d.cmd_copy_image_to_buffer(
-            cmd,
-            image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            buffer,
-            &region,
-        )
-    };
+    Recorder::new(d, cmd).copy_image_to_buffer(
+        image,
+        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        buffer,
+        &region,
+    )
 }
 
 /// Makes transfer writes visible to the host.
@@ -142,7 +140,7 @@ pub fn transfer_to_host_barrier(d: &ash::Device, cmd: vk::CommandBuffer) {
         .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
         .dst_stage_mask(vk::PipelineStageFlags2::HOST)
         .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-    unsafe { d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&mb)) };
+    Recorder::new(d, cmd).pipeline_barrier2(&vk::DependencyInfo::default().memory_barriers(&mb));
 }
 
 /// Tightly packed RGBA8 rows (row pitch = width · 4) from a mapped readback; `bgra` swaps R and B.

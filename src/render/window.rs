@@ -8,6 +8,7 @@ use super::renderer::{
 };
 use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::Recorder;
 use crate::gpu::{Buffer, Image};
 use crate::plan::settings::SceneOptions;
 use crate::plan::view::{ShadowHold, View};
@@ -565,9 +566,9 @@ fn record_overlay(
         })
         .layer_count(1)
         .color_attachments(&attachments);
-    unsafe { d.cmd_begin_rendering(cmd, &rendering) };
+    Recorder::new(d, cmd).begin_rendering(&rendering);
     overlay.record(cmd, extent);
-    unsafe { d.cmd_end_rendering(cmd) };
+    Recorder::new(d, cmd).end_rendering();
 }
 
 impl Drop for WindowRenderer {

@@ -12,6 +12,7 @@ pub use draws::{AlphaDraw, Draw, IndexRange};
 pub use geometry::{vertex_layout, VertexAttributes};
 pub use materials::material_variant_bits;
 
+use crate::gpu::Recorder;
 use crate::shader_consts::VariantKey;
 use draws::build_draws;
 use geometry::{pack_geometry, vertex_attributes, Geometry, PrimitiveRange};
@@ -79,10 +80,12 @@ impl GpuScene {
     /// Binds the scene's vertex streams (positions, attributes) and index buffer: what the camera,
     /// AOV and exact passes draw from.
     pub fn bind_geometry(&self, d: &ash::Device, cmd: vk::CommandBuffer) {
-        unsafe {
-            d.cmd_bind_vertex_buffers(cmd, 0, &[self.positions.raw, self.attributes.raw], &[0, 0]);
-            d.cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
-        }
+        Recorder::new(d, cmd).bind_vertex_buffers(
+            0,
+            &[self.positions.raw, self.attributes.raw],
+            &[0, 0],
+        );
+        Recorder::new(d, cmd).bind_index_buffer(self.indices.raw, 0, vk::IndexType::UINT32);
     }
 
     /// Binds `material`'s descriptor set as set `set` of `layout`.
@@ -94,16 +97,13 @@ impl GpuScene {
         set: u32,
         material: usize,
     ) {
-        unsafe {
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                layout,
-                set,
-                &[self.material_sets[material]],
-                &[],
-            )
-        };
+        Recorder::new(d, cmd).bind_descriptor_sets(
+            vk::PipelineBindPoint::GRAPHICS,
+            layout,
+            set,
+            &[self.material_sets[material]],
+            &[],
+        )
     }
 
     /// Records draw `dr` of a pass seen from `eye` (`Draw::cull_mode`): its cull mode and front
@@ -119,17 +119,14 @@ impl GpuScene {
     ) {
         let cull = dr.cull_mode(eye);
         let device = &self.ctx.device;
-        unsafe {
-            device.cmd_set_cull_mode(cmd, cull);
-            device.cmd_set_front_face(cmd, dr.front_face());
-            device.cmd_push_constants(
-                cmd,
-                layout,
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                immediates,
-            );
-        }
+        Recorder::new(device, cmd).set_cull_mode(cull);
+        Recorder::new(device, cmd).set_front_face(dr.front_face());
+        Recorder::new(device, cmd).push_constants(
+            layout,
+            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            0,
+            immediates,
+        );
         self.draw_indexed(device, cmd, dr, cull, from);
     }
 
@@ -145,8 +142,14 @@ impl GpuScene {
         from: Viewpoint,
     ) {
         let (start, count) = dr.clusters;
-        let draw = |first: u32, n: u32| unsafe {
-            device.cmd_draw_indexed(cmd, n, 1, dr.first_index + first, dr.vertex_offset, 0)
+        let draw = |first: u32, n: u32| {
+            Recorder::new(device, cmd).draw_indexed(
+                n,
+                1,
+                dr.first_index + first,
+                dr.vertex_offset,
+                0,
+            )
         };
         if count == 0 || cull != vk::CullModeFlags::BACK {
             return draw(0, dr.index_count);

@@ -11,6 +11,7 @@ use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, create_module, post as sh, set_layout};
 use crate::gpu::Image;
+use crate::gpu::Recorder;
 use crate::render::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
     PipelineDesc, Stencil,
@@ -214,30 +215,26 @@ impl PostAaPass {
                 .layer_count(1)
                 .color_attachments(&color)
                 .depth_attachment(&depth);
-            unsafe {
-                d.cmd_begin_rendering(cmd, &rendering);
-                set_viewport(&ctx, cmd, extent);
-                d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
-                d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.layout,
-                    0,
-                    &[scratch.set],
-                    &[],
-                );
-                d.cmd_push_constants(
-                    cmd,
-                    self.layout,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    0,
-                    bytes,
-                );
-                d.cmd_draw(cmd, 3, 1, 0, 0);
-                d.cmd_end_rendering(cmd);
-            }
+            Recorder::new(d, cmd).begin_rendering(&rendering);
+            set_viewport(&ctx, cmd, extent);
+            Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
+            Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
+            Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
+            Recorder::new(d, cmd).bind_descriptor_sets(
+                vk::PipelineBindPoint::GRAPHICS,
+                self.layout,
+                0,
+                &[scratch.set],
+                &[],
+            );
+            Recorder::new(d, cmd).push_constants(
+                self.layout,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                0,
+                bytes,
+            );
+            Recorder::new(d, cmd).draw(3, 1, 0, 0);
+            Recorder::new(d, cmd).end_rendering();
         }
         ctx.end_label(cmd);
     }

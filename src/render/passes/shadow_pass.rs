@@ -5,6 +5,7 @@ use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{create_module, shadow as sh};
 use crate::gpu::Image;
+use crate::gpu::Recorder;
 use crate::plan::settings::{ShadowFormat, ShadowSettings};
 use crate::plan::uniforms::ShadowImmediates;
 use crate::plan::{CasterPlan, Viewpoint};
@@ -415,16 +416,13 @@ impl ShadowPass {
                 depth: 1,
             },
         }];
-        unsafe {
-            d.cmd_copy_image(
-                cmd,
-                src,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                dst,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &region,
-            )
-        };
+        Recorder::new(d, cmd).copy_image(
+            src,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            dst,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &region,
+        );
         map_at.transition(d, cmd, Access::DepthAttachment);
     }
 
@@ -461,58 +459,57 @@ impl ShadowPass {
             .layer_count(1)
             .depth_attachment(&depth_attachment);
         let mut drawn = 0;
-        unsafe {
-            d.cmd_begin_rendering(cmd, &rendering);
-            if !draws.is_empty() {
-                let side = casters.size.min(map.extent.width);
-                set_viewport(
-                    &self.ctx,
-                    cmd,
-                    vk::Extent2D {
-                        width: side,
-                        height: side,
-                    },
-                );
-                d.cmd_set_scissor(cmd, 0, &[area]);
-                d.cmd_bind_index_buffer(cmd, scene.indices.raw, 0, vk::IndexType::UINT32);
-                for masked in [false, true] {
-                    let (pipeline, layout) = match (&self.masked, masked) {
-                        (_, false) => (self.pipeline, self.layout),
-                        (Some(m), true) => (m.pipeline, m.layout),
-                        // No masked pipeline: no masked draws (`ensure_masked`).
-                        (None, true) => break,
-                    };
-                    let mut bound = false;
-                    for dr in draws.iter().map(|&i| scene.draws[i].shadow_caster()) {
-                        if dr.alpha.tests_alpha_in_shadow() != masked {
-                            continue;
-                        }
-                        if !bound {
-                            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                            // Reversed-z: "away from the light" is towards smaller depth, so
-                            // the factor is negated. The constant bias is applied on the
-                            // receiver side, in texels.
-                            d.cmd_set_depth_bias(cmd, 0.0, 0.0, -s.slope_bias);
-                            let buffers = [scene.positions.raw, scene.attributes.raw];
-                            let n = if masked { 2 } else { 1 };
-                            d.cmd_bind_vertex_buffers(cmd, 0, &buffers[..n], &[0, 0][..n]);
-                            bound = true;
-                        }
-                        if masked {
-                            scene.bind_material(d, cmd, layout, 0, dr.material);
-                        }
-                        let pc = ShadowImmediates {
-                            light_clip_from_world: *t.light_clip_from_world,
-                            world_from_model: dr.world_from_model,
-                        };
-                        let pc = bytemuck::bytes_of(&pc);
-                        scene.record_draw(cmd, layout, &dr, eye, from, pc);
-                        drawn += 1;
+        Recorder::new(d, cmd).begin_rendering(&rendering);
+        if !draws.is_empty() {
+            let side = casters.size.min(map.extent.width);
+            set_viewport(
+                &self.ctx,
+                cmd,
+                vk::Extent2D {
+                    width: side,
+                    height: side,
+                },
+            );
+            Recorder::new(d, cmd).set_scissor(0, &[area]);
+            Recorder::new(d, cmd).bind_index_buffer(scene.indices.raw, 0, vk::IndexType::UINT32);
+            for masked in [false, true] {
+                let (pipeline, layout) = match (&self.masked, masked) {
+                    (_, false) => (self.pipeline, self.layout),
+                    (Some(m), true) => (m.pipeline, m.layout),
+                    // No masked pipeline: no masked draws (`ensure_masked`).
+                    (None, true) => break,
+                };
+                let mut bound = false;
+                for dr in draws.iter().map(|&i| scene.draws[i].shadow_caster()) {
+                    if dr.alpha.tests_alpha_in_shadow() != masked {
+                        continue;
                     }
+                    if !bound {
+                        Recorder::new(d, cmd)
+                            .bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
+                        // Reversed-z: "away from the light" is towards smaller depth, so
+                        // the factor is negated. The constant bias is applied on the
+                        // receiver side, in texels.
+                        Recorder::new(d, cmd).set_depth_bias(0.0, 0.0, -s.slope_bias);
+                        let buffers = [scene.positions.raw, scene.attributes.raw];
+                        let n = if masked { 2 } else { 1 };
+                        Recorder::new(d, cmd).bind_vertex_buffers(0, &buffers[..n], &[0, 0][..n]);
+                        bound = true;
+                    }
+                    if masked {
+                        scene.bind_material(d, cmd, layout, 0, dr.material);
+                    }
+                    let pc = ShadowImmediates {
+                        light_clip_from_world: *t.light_clip_from_world,
+                        world_from_model: dr.world_from_model,
+                    };
+                    let pc = bytemuck::bytes_of(&pc);
+                    scene.record_draw(cmd, layout, &dr, eye, from, pc);
+                    drawn += 1;
                 }
             }
-            d.cmd_end_rendering(cmd);
         }
+        Recorder::new(d, cmd).end_rendering();
         drawn
     }
 }

@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::gpu::resources::has_stencil;
+use crate::gpu::Recorder;
 use crate::render::gpu_scene::{AlphaDraw, GpuScene};
 use crate::render::passes::cull::Entry;
 use crate::render::pipeline::depth_clear_attachment;
@@ -80,15 +81,13 @@ impl CameraPass {
         let (mut bound_material, mut drawn) = (usize::MAX, 0);
         for i in aov_draws(scene, frame) {
             let dr = &scene.draws[i];
-            unsafe {
-                if dr.material != bound_material {
-                    scene.bind_material(d, cmd, self.layout, 1, dr.material);
-                    bound_material = dr.material;
-                }
-                // Made by `ensure_aov_pipelines`.
-                let pipeline = self.pipelines[&(dr.material_bits, Entry::Aov)];
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+            if dr.material != bound_material {
+                scene.bind_material(d, cmd, self.layout, 1, dr.material);
+                bound_material = dr.material;
             }
+            // Made by `ensure_aov_pipelines`.
+            let pipeline = self.pipelines[&(dr.material_bits, Entry::Aov)];
+            Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
             let mut imm = dr.immediates;
             imm.normal_z.w = (dr.source.0 + 1) as f32;
             scene.record_draw(
@@ -101,7 +100,7 @@ impl CameraPass {
             );
             drawn += 1;
         }
-        unsafe { d.cmd_end_rendering(cmd) };
+        Recorder::new(d, cmd).end_rendering();
         self.ctx.end_label(cmd);
         drawn
     }

@@ -4,6 +4,7 @@
 use super::*;
 use crate::gpu::barrier::Access;
 use crate::gpu::resources::has_stencil;
+use crate::gpu::Recorder;
 use crate::render::gpu_scene::GpuScene;
 use crate::render::passes::cull::{CameraCull, Entry};
 use crate::render::passes::deferred::{self, DeferPlan};
@@ -85,23 +86,21 @@ impl CameraPass {
             rendering = rendering.stencil_attachment(&depth_att);
         }
         self.begin_rendering(cmd, &rendering, extent, frame_set);
-        unsafe {
-            if shadow_map_view {
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.map_pipeline);
-                d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
-                d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
-                d.cmd_draw(cmd, 3, 1, 0, 0);
-            }
-            if deferring {
-                self.record_resolve(cmd, scene, plan, cull.frame_bits, extent);
-            }
-            if !plan.forward.is_empty() || frame.sky {
-                let (n, u) = self.record_forward(cmd, scene, frame, extent);
-                drawn += n;
-                unshadowed += u;
-            }
-            d.cmd_end_rendering(cmd);
+        if shadow_map_view {
+            Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, self.map_pipeline);
+            Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
+            Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
+            Recorder::new(d, cmd).draw(3, 1, 0, 0);
         }
+        if deferring {
+            self.record_resolve(cmd, scene, plan, cull.frame_bits, extent);
+        }
+        if !plan.forward.is_empty() || frame.sky {
+            let (n, u) = self.record_forward(cmd, scene, frame, extent);
+            drawn += n;
+            unshadowed += u;
+        }
+        Recorder::new(d, cmd).end_rendering();
         ctx.end_label(cmd);
         CameraCounts {
             drawn: drawn + deferred_draws,
@@ -125,58 +124,56 @@ impl CameraPass {
         let cull = &frame.cull;
         let d = &self.ctx.device;
         let (mut drawn, mut unshadowed) = (0, 0);
-        unsafe {
-            scene.bind_geometry(d, cmd);
-            let mut bound_material = usize::MAX;
-            let mut bound_pipeline = vk::Pipeline::null();
-            let mut sky = frame.sky;
-            let forward = frame.defer.forward.iter().zip(&frame.splits);
-            for ((&i, split), &flat) in forward.zip(&frame.flat) {
-                let dr = &scene.draws[i];
-                let entry = frame.entry(dr.alpha, flat);
-                if sky && entry == Entry::Blended {
-                    self.record_sky(cmd);
-                    bound_pipeline = self.sky_pipeline;
-                    sky = false;
-                }
-                let bits = dr.material_bits | cull.frame_bits;
-                unshadowed += usize::from(*split != Split::Shadowed);
-                let pieces = pieces(bits, split.clone());
-                drawn += 1;
-                if dr.material != bound_material {
-                    scene.bind_material(d, cmd, self.layout, 1, dr.material);
-                    bound_material = dr.material;
-                }
-                let mut imm = dr.immediates;
-                if cull.highlight == Some(dr.source) {
-                    imm.normal_y.w = 1.0;
-                }
-                for &(variant, scissor) in &pieces {
-                    // Created by `ensure_pipelines` for this frame's bits.
-                    let pipeline = self.pipelines[&(variant, entry)];
-                    if pipeline != bound_pipeline {
-                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                        bound_pipeline = pipeline;
-                    }
-                    if let Some(s) = scissor {
-                        d.cmd_set_scissor(cmd, 0, &[s]);
-                    }
-                    scene.record_draw(
-                        cmd,
-                        self.layout,
-                        dr,
-                        Some(cull.eye),
-                        cull.viewpoint,
-                        bytemuck::bytes_of(&imm),
-                    );
-                }
-                if pieces.iter().any(|p| p.1.is_some()) {
-                    d.cmd_set_scissor(cmd, 0, &[full_rect(extent)]);
-                }
-            }
-            if sky {
+        scene.bind_geometry(d, cmd);
+        let mut bound_material = usize::MAX;
+        let mut bound_pipeline = vk::Pipeline::null();
+        let mut sky = frame.sky;
+        let forward = frame.defer.forward.iter().zip(&frame.splits);
+        for ((&i, split), &flat) in forward.zip(&frame.flat) {
+            let dr = &scene.draws[i];
+            let entry = frame.entry(dr.alpha, flat);
+            if sky && entry == Entry::Blended {
                 self.record_sky(cmd);
+                bound_pipeline = self.sky_pipeline;
+                sky = false;
             }
+            let bits = dr.material_bits | cull.frame_bits;
+            unshadowed += usize::from(*split != Split::Shadowed);
+            let pieces = pieces(bits, split.clone());
+            drawn += 1;
+            if dr.material != bound_material {
+                scene.bind_material(d, cmd, self.layout, 1, dr.material);
+                bound_material = dr.material;
+            }
+            let mut imm = dr.immediates;
+            if cull.highlight == Some(dr.source) {
+                imm.normal_y.w = 1.0;
+            }
+            for &(variant, scissor) in &pieces {
+                // Created by `ensure_pipelines` for this frame's bits.
+                let pipeline = self.pipelines[&(variant, entry)];
+                if pipeline != bound_pipeline {
+                    Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
+                    bound_pipeline = pipeline;
+                }
+                if let Some(s) = scissor {
+                    Recorder::new(d, cmd).set_scissor(0, &[s]);
+                }
+                scene.record_draw(
+                    cmd,
+                    self.layout,
+                    dr,
+                    Some(cull.eye),
+                    cull.viewpoint,
+                    bytemuck::bytes_of(&imm),
+                );
+            }
+            if pieces.iter().any(|p| p.1.is_some()) {
+                Recorder::new(d, cmd).set_scissor(0, &[full_rect(extent)]);
+            }
+        }
+        if sky {
+            self.record_sky(cmd);
         }
         (drawn, unshadowed)
     }
@@ -185,12 +182,10 @@ impl CameraPass {
     /// drawn (inside a rendering whose set 0 is bound).
     fn record_sky(&self, cmd: vk::CommandBuffer) {
         let d = &self.ctx.device;
-        unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.sky_pipeline);
-            d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
-            d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
-            d.cmd_draw(cmd, 3, 1, 0, 0);
-        }
+        Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, self.sky_pipeline);
+        Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
+        Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
+        Recorder::new(d, cmd).draw(3, 1, 0, 0);
     }
 
     /// Records the G-buffer pass of `plan`'s deferred draws (clearing depth and stencil, each
@@ -241,10 +236,10 @@ impl CameraPass {
             if bound != Some(variant) {
                 // Made by `ensure_pipelines` for this frame.
                 let pipeline = self.pipelines[&(variant, Entry::GBuffer)];
-                unsafe { d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline) };
+                Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
                 bound = Some(variant);
             }
-            unsafe { d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, mark) };
+            Recorder::new(d, cmd).set_stencil_reference(vk::StencilFaceFlags::FRONT_AND_BACK, mark);
             scene.record_draw(
                 cmd,
                 self.layout,
@@ -254,7 +249,7 @@ impl CameraPass {
                 bytemuck::bytes_of(&dr.immediates),
             );
         }
-        unsafe { d.cmd_end_rendering(cmd) };
+        Recorder::new(d, cmd).end_rendering();
         if let Some(g) = self.gbuffer.as_mut() {
             g.transition(cmd, Access::FragmentSampled);
         }
@@ -270,9 +265,8 @@ impl CameraPass {
                 vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
                     | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
             )];
-        unsafe {
-            d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&mb))
-        };
+        Recorder::new(d, cmd)
+            .pipeline_barrier2(&vk::DependencyInfo::default().memory_barriers(&mb));
         ctx.end_label(cmd);
         plan.deferred.len()
     }
@@ -287,18 +281,15 @@ impl CameraPass {
         frame_set: vk::DescriptorSet,
     ) {
         let d = &self.ctx.device;
-        unsafe {
-            d.cmd_begin_rendering(cmd, rendering);
-            set_viewport(&self.ctx, cmd, extent);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout,
-                0,
-                &[frame_set],
-                &[],
-            );
-        }
+        Recorder::new(d, cmd).begin_rendering(rendering);
+        set_viewport(&self.ctx, cmd, extent);
+        Recorder::new(d, cmd).bind_descriptor_sets(
+            vk::PipelineBindPoint::GRAPHICS,
+            self.layout,
+            0,
+            &[frame_set],
+            &[],
+        );
     }
 
     /// Records one full-screen triangle per resolved material of `plan`, limited to its draws'
@@ -316,27 +307,25 @@ impl CameraPass {
             return;
         };
         let d = &self.ctx.device;
-        unsafe {
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout,
-                2,
-                &[gbuffer.set],
-                &[],
-            );
-            d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
-            d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
-            for r in &plan.resolved {
-                let pipeline = self.pipelines[&(r.material_bits | frame_bits, Entry::Resolve)];
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                scene.bind_material(d, cmd, self.layout, 1, r.material);
-                d.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, r.mark);
-                d.cmd_set_scissor(cmd, 0, &[r.rect.scissor()]);
-                d.cmd_draw(cmd, 3, 1, 0, 0);
-            }
-            d.cmd_set_scissor(cmd, 0, &[full_rect(extent)]);
+        Recorder::new(d, cmd).bind_descriptor_sets(
+            vk::PipelineBindPoint::GRAPHICS,
+            self.layout,
+            2,
+            &[gbuffer.set],
+            &[],
+        );
+        Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
+        Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
+        for r in &plan.resolved {
+            let pipeline = self.pipelines[&(r.material_bits | frame_bits, Entry::Resolve)];
+            Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
+            scene.bind_material(d, cmd, self.layout, 1, r.material);
+            Recorder::new(d, cmd)
+                .set_stencil_reference(vk::StencilFaceFlags::FRONT_AND_BACK, r.mark);
+            Recorder::new(d, cmd).set_scissor(0, &[r.rect.scissor()]);
+            Recorder::new(d, cmd).draw(3, 1, 0, 0);
         }
+        Recorder::new(d, cmd).set_scissor(0, &[full_rect(extent)]);
     }
 }
 

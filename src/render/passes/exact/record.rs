@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::gpu::barrier::{memory_barrier, Access};
+use crate::gpu::Recorder;
 use crate::plan::Viewpoint;
 use crate::plan::{ExactMode, ExactPlan};
 use crate::render::gpu_scene::GpuScene;
@@ -34,7 +35,7 @@ impl ExactPass {
                 A::TRANSFER_WRITE | A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
             ),
         );
-        unsafe { d.cmd_fill_buffer(cmd, t.heads.raw, 0, vk::WHOLE_SIZE, 0) };
+        Recorder::new(d, cmd).fill_buffer(t.heads.raw, 0, vk::WHOLE_SIZE, 0);
         self.record_receivers(cmd, set, scene, f, &mut t);
         let groups = (t.extent.width.div_ceil(8), t.extent.height.div_ceil(8));
         if let ExactMode::Contact { .. } = f.mode {
@@ -45,7 +46,7 @@ impl ExactPass {
                 (vk::PipelineBindPoint::COMPUTE, self.contact),
                 set,
             );
-            unsafe { d.cmd_dispatch(cmd, groups.0, groups.1, 1) };
+            Recorder::new(d, cmd).dispatch(groups.0, groups.1, 1);
             memory_barrier(
                 d,
                 cmd,
@@ -95,7 +96,7 @@ impl ExactPass {
             .layer_count(1)
             .color_attachments(&colors)
             .depth_attachment(&depth);
-        unsafe { d.cmd_begin_rendering(cmd, &info) };
+        Recorder::new(d, cmd).begin_rendering(&info);
         bind(
             d,
             self.layout,
@@ -121,7 +122,7 @@ impl ExactPass {
                 bytemuck::bytes_of(&pc),
             );
         }
-        unsafe { d.cmd_end_rendering(cmd) };
+        Recorder::new(d, cmd).end_rendering();
         t.position.transition(d, cmd, Access::ComputeSampled);
         t.normal.transition(d, cmd, Access::ComputeSampled);
     }
@@ -147,7 +148,7 @@ impl ExactPass {
             (vk::PipelineBindPoint::COMPUTE, self.build),
             set,
         );
-        unsafe { d.cmd_dispatch(cmd, groups.0, groups.1, 1) };
+        Recorder::new(d, cmd).dispatch(groups.0, groups.1, 1);
         memory_barrier(
             d,
             cmd,
@@ -183,7 +184,7 @@ impl ExactPass {
                 extent: grid,
             })
             .layer_count(1);
-        unsafe { d.cmd_begin_rendering(cmd, &info) };
+        Recorder::new(d, cmd).begin_rendering(&info);
         bind(
             d,
             self.layout,
@@ -192,10 +193,8 @@ impl ExactPass {
             set,
         );
         set_viewport(ctx, cmd, grid);
-        unsafe {
-            d.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
-            d.cmd_set_front_face(cmd, vk::FrontFace::COUNTER_CLOCKWISE);
-        }
+        Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
+        Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
         for &i in &f.casters {
             let dr = &scene.draws[i].shadow_caster();
             scene.bind_material(d, cmd, self.layout, 1, dr.material);
@@ -215,20 +214,17 @@ impl ExactPass {
                     world_from_model: dr.world_from_model,
                     extra,
                 };
-                unsafe {
-                    d.cmd_push_constants(
-                        cmd,
-                        self.layout,
-                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                        0,
-                        bytemuck::bytes_of(&pc),
-                    );
-                    // Six vertices a triangle: the triangle grown (or its box's two halves).
-                    d.cmd_draw(cmd, 2 * dr.index_count, 1, 0, 0);
-                }
+                Recorder::new(d, cmd).push_constants(
+                    self.layout,
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    0,
+                    bytemuck::bytes_of(&pc),
+                );
+                // Six vertices a triangle: the triangle grown (or its box's two halves).
+                Recorder::new(d, cmd).draw(2 * dr.index_count, 1, 0, 0);
             }
         }
-        unsafe { d.cmd_end_rendering(cmd) };
+        Recorder::new(d, cmd).end_rendering();
         // The verdicts, for the camera pass's fragments.
         memory_barrier(
             d,
@@ -247,8 +243,6 @@ pub(super) fn bind(
     (point, pipeline): (vk::PipelineBindPoint, vk::Pipeline),
     set: vk::DescriptorSet,
 ) {
-    unsafe {
-        d.cmd_bind_pipeline(cmd, point, pipeline);
-        d.cmd_bind_descriptor_sets(cmd, point, layout, 0, &[set], &[]);
-    }
+    Recorder::new(d, cmd).bind_pipeline(point, pipeline);
+    Recorder::new(d, cmd).bind_descriptor_sets(point, layout, 0, &[set], &[]);
 }
