@@ -349,39 +349,8 @@ pub(super) fn directional_views(
     let fit = |camera| fit_held(camera, None);
     match view.shadow.fit {
         ShadowFit::Camera | ShadowFit::Sphere => {
-            let mut frustum = fitting_frustum(fit_cam, aspect, bounds);
-            // Sample-distribution fitting: the frustum ends where the depths seen end.
-            if let Some((lo, hi)) = view
-                .visible_depths
-                .filter(|_| view.shadow.depth_fit && view.shadow_fit_camera.is_none())
-                .filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && *hi >= *lo && *lo > 0.0)
-            {
-                let near = (lo / DEPTH_FIT_MARGIN).max(frustum.near);
-                let far = (hi * DEPTH_FIT_MARGIN).min(frustum.far);
-                if far > near {
-                    (frustum.near, frustum.far) = (near, far);
-                }
-            }
-            // Split the depths where the view meets the scene, not the whole frustum: a camera
-            // high above a compact scene sees nothing near. (Per frame, so only when the count
-            // is not fixed at one map.)
-            let (near, far) = match view.shadow.cascades {
-                1 => (frustum.near, frustum.far),
-                _ if view.shadow.snap => {
-                    let (n, f) = receiver_depths(&frustum, bounds, receivers);
-                    match held_range {
-                        // In motion the range, and so the splits, hold still until the
-                        // receivers leave it, then widen by doublings; they narrow again when
-                        // the camera stops (a step changes every cascade at once).
-                        Some((hn, hf)) => {
-                            let near = (1.0 / widened(1.0 / hn, 1.0 / n)).max(frustum.near);
-                            (near, widened(hf, f).max(near))
-                        }
-                        None => quantise_depth_range(n, f, (frustum.near, frustum.far)),
-                    }
-                }
-                _ => receiver_depths(&frustum, bounds, receivers),
-            };
+            let frustum = depth_fitted_frustum(view, fit_cam, aspect, bounds);
+            let (near, far) = split_range(view, &frustum, (bounds, receivers), held_range);
             // The automatic count fits one map first; when it stays at one, that is the map.
             let mut single = None;
             let n = match view.shadow.cascades {
@@ -452,5 +421,60 @@ pub fn soft_size(l: &Light) -> f32 {
     match l.kind {
         LightKind::Directional => (0.5 * s.min(3.0)).tan(),
         _ => s,
+    }
+}
+
+/// The fitting camera's frustum clipped to the scene, and with sample-distribution fitting
+/// (`depth_fit`) ended where the depths the view saw end.
+fn depth_fitted_frustum(
+    view: &View,
+    fit_cam: &Camera,
+    aspect: f32,
+    bounds: &Aabb,
+) -> CameraFrustum {
+    let mut frustum = fitting_frustum(fit_cam, aspect, bounds);
+    // Sample-distribution fitting: the frustum ends where the depths seen end.
+    if let Some((lo, hi)) = view
+        .visible_depths
+        .filter(|_| view.shadow.depth_fit && view.shadow_fit_camera.is_none())
+        .filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && *hi >= *lo && *lo > 0.0)
+    {
+        let near = (lo / DEPTH_FIT_MARGIN).max(frustum.near);
+        let far = (hi * DEPTH_FIT_MARGIN).min(frustum.far);
+        if far > near {
+            (frustum.near, frustum.far) = (near, far);
+        }
+    }
+    frustum
+}
+
+/// The view depths the cascades split: where the view meets the scene's receivers (held still
+/// in motion while they stay inside `held_range`, quantised otherwise), or the whole frustum for
+/// one map.
+fn split_range(
+    view: &View,
+    frustum: &CameraFrustum,
+    (bounds, receivers): (&Aabb, &[Aabb]),
+    held_range: Option<(f32, f32)>,
+) -> (f32, f32) {
+    // Split the depths where the view meets the scene, not the whole frustum: a camera
+    // high above a compact scene sees nothing near. (Per frame, so only when the count
+    // is not fixed at one map.)
+    match view.shadow.cascades {
+        1 => (frustum.near, frustum.far),
+        _ if view.shadow.snap => {
+            let (n, f) = receiver_depths(frustum, bounds, receivers);
+            match held_range {
+                // In motion the range, and so the splits, hold still until the
+                // receivers leave it, then widen by doublings; they narrow again when
+                // the camera stops (a step changes every cascade at once).
+                Some((hn, hf)) => {
+                    let near = (1.0 / widened(1.0 / hn, 1.0 / n)).max(frustum.near);
+                    (near, widened(hf, f).max(near))
+                }
+                None => quantise_depth_range(n, f, (frustum.near, frustum.far)),
+            }
+        }
+        _ => receiver_depths(frustum, bounds, receivers),
     }
 }

@@ -288,36 +288,19 @@ impl FrameCore {
         } else {
             &mut *color
         };
-        color_target.transition(d, cmd, Access::ColorAttachment);
-        let (draw_color, draw_depth, resolve) = match msaa {
-            Some(m) => {
-                m.color.transition(d, cmd, Access::ColorAttachment);
-                m.depth.transition(d, cmd, Access::DepthAttachment);
-                if resolve_depth {
-                    depth.transition(d, cmd, Access::DepthResolve);
-                }
-                let resolve = Resolve {
-                    color: Some(color_target.view),
-                    depth: resolve_depth.then_some(depth.view),
-                };
-                (m.color.view, m.depth.view, resolve)
-            }
-            None => {
-                depth.transition(d, cmd, Access::DepthAttachment);
-                (color_target.view, depth.view, Resolve::default())
-            }
+        let clear = match (frame.mode, plan.background) {
+            (ViewMode::Overdraw, _) => [0.0, 0.0, 0.0, 1.0],
+            (ViewMode::Lit, Background::Color(c)) => c.extend(1.0).to_array(),
+            _ => CLEAR_COLOR,
         };
-        let targets = CameraTargets {
-            color: draw_color,
-            depth: draw_depth,
-            resolve,
+        let targets = camera_targets(
+            d,
+            cmd,
+            (color_target, depth, msaa),
+            resolve_depth,
             extent,
-            clear: match (frame.mode, plan.background) {
-                (ViewMode::Overdraw, _) => [0.0, 0.0, 0.0, 1.0],
-                (ViewMode::Lit, Background::Color(c)) => c.extend(1.0).to_array(),
-                _ => CLEAR_COLOR,
-            },
-        };
+            clear,
+        );
         let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
         if frame.post_aa {
             self.post.record(cmd, color);
@@ -387,6 +370,45 @@ impl FrameCore {
             t[1].wrapping_sub(t[0]) as f64 * period,
             t[2].wrapping_sub(t[1]) as f64 * period,
         ))
+    }
+}
+
+/// Moves the camera pass's attachments into their attachment layouts and names them: the colour
+/// target (or with MSAA the multisampled colour and depth, resolving into the colour target and,
+/// with `resolve_depth`, into `depth`) and the depth.
+fn camera_targets(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    (color_target, depth, msaa): (&mut Attachment, &mut Attachment, Option<&mut MsaaTargets>),
+    resolve_depth: bool,
+    extent: vk::Extent2D,
+    clear: [f32; 4],
+) -> CameraTargets {
+    color_target.transition(d, cmd, Access::ColorAttachment);
+    let (draw_color, draw_depth, resolve) = match msaa {
+        Some(m) => {
+            m.color.transition(d, cmd, Access::ColorAttachment);
+            m.depth.transition(d, cmd, Access::DepthAttachment);
+            if resolve_depth {
+                depth.transition(d, cmd, Access::DepthResolve);
+            }
+            let resolve = Resolve {
+                color: Some(color_target.view),
+                depth: resolve_depth.then_some(depth.view),
+            };
+            (m.color.view, m.depth.view, resolve)
+        }
+        None => {
+            depth.transition(d, cmd, Access::DepthAttachment);
+            (color_target.view, depth.view, Resolve::default())
+        }
+    };
+    CameraTargets {
+        color: draw_color,
+        depth: draw_depth,
+        resolve,
+        extent,
+        clear,
     }
 }
 

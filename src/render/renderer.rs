@@ -391,38 +391,7 @@ impl Renderer {
             },
         );
         let plan = prepared.plan;
-        t.color_at.transition(d, cmd, Access::TransferSrc);
-        let shown = match t.filtered.as_mut() {
-            Some((image, at)) => {
-                at.transition(d, cmd, Access::TransferDst);
-                // 2:1: each pixel the mean of its 2×2 samples, in linear light.
-                let (dw, dh, w, h) = (dw as i32, dh as i32, width as i32, height as i32);
-                blit_linear(d, cmd, (t.color.raw, 0, dw, dh), (image.raw, 0, w, h));
-                at.transition(d, cmd, Access::TransferSrc);
-                image.raw
-            }
-            None => t.color.raw,
-        };
-        copy_to_buffer(
-            d,
-            cmd,
-            shown,
-            vk::ImageAspectFlags::COLOR,
-            extent,
-            t.readback.raw,
-        );
-        if self.read_depth {
-            t.depth_at.transition(d, cmd, Access::TransferSrc);
-            copy_to_buffer(
-                d,
-                cmd,
-                t.depth.raw,
-                vk::ImageAspectFlags::DEPTH,
-                drawn,
-                t.depth_readback.raw,
-            );
-        }
-        transfer_to_host_barrier(d, cmd);
+        record_readback(d, cmd, t, (extent, drawn), self.read_depth);
         unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
         ctx.submit_and_wait_with(cmd, self.fence)?;
         let times = self.core.gpu_times(0);
@@ -440,22 +409,7 @@ impl Renderer {
             hardware_compare: self.core.shadow.hardware_filtering(plan.shadow_format),
         };
         let t = self.target.as_mut().expect("target");
-        let bytes = t
-            .readback
-            .mapped()
-            .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
-        let image = rgba_from_readback(bytes, width, height, false);
-        let depth = if self.read_depth {
-            let bytes = t
-                .depth_readback
-                .mapped()
-                .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
-            Some(bytemuck::pod_collect_to_vec(
-                &bytes[..(dw * dh * 4) as usize],
-            ))
-        } else {
-            None
-        };
+        let (image, depth) = read_back(t, (width, height), drawn, self.read_depth)?;
         let mut stats = stats;
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(RenderedFrame {
@@ -540,6 +494,79 @@ impl Drop for Renderer {
         self.core.ctx.free_command_buffer(self.cmd);
         unsafe { self.core.ctx.device.destroy_fence(self.fence, None) };
     }
+}
+
+/// Records the copies a frame is read back from: the colour (through the 2:1 filter when
+/// supersampled) at `extent`, and with `read_depth` the depth at the `drawn` size, then makes
+/// them visible to the host.
+fn record_readback(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    t: &mut Target,
+    (extent, drawn): (vk::Extent2D, vk::Extent2D),
+    read_depth: bool,
+) {
+    let (dw, dh, width, height) = (drawn.width, drawn.height, extent.width, extent.height);
+    t.color_at.transition(d, cmd, Access::TransferSrc);
+    let shown = match t.filtered.as_mut() {
+        Some((image, at)) => {
+            at.transition(d, cmd, Access::TransferDst);
+            // 2:1: each pixel the mean of its 2×2 samples, in linear light.
+            let (dw, dh, w, h) = (dw as i32, dh as i32, width as i32, height as i32);
+            blit_linear(d, cmd, (t.color.raw, 0, dw, dh), (image.raw, 0, w, h));
+            at.transition(d, cmd, Access::TransferSrc);
+            image.raw
+        }
+        None => t.color.raw,
+    };
+    copy_to_buffer(
+        d,
+        cmd,
+        shown,
+        vk::ImageAspectFlags::COLOR,
+        extent,
+        t.readback.raw,
+    );
+    if read_depth {
+        t.depth_at.transition(d, cmd, Access::TransferSrc);
+        copy_to_buffer(
+            d,
+            cmd,
+            t.depth.raw,
+            vk::ImageAspectFlags::DEPTH,
+            drawn,
+            t.depth_readback.raw,
+        );
+    }
+    transfer_to_host_barrier(d, cmd);
+}
+
+/// The image (`width`×`height`) and, with `read_depth`, the depth (`drawn` size) a frame's
+/// readback buffers hold.
+fn read_back(
+    t: &mut Target,
+    (width, height): (u32, u32),
+    drawn: vk::Extent2D,
+    read_depth: bool,
+) -> Result<(image::RgbaImage, Option<Vec<f32>>), GpuError> {
+    let (dw, dh) = (drawn.width, drawn.height);
+    let bytes = t
+        .readback
+        .mapped()
+        .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
+    let image = rgba_from_readback(bytes, width, height, false);
+    let depth = if read_depth {
+        let bytes = t
+            .depth_readback
+            .mapped()
+            .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
+        Some(bytemuck::pod_collect_to_vec(
+            &bytes[..(dw * dh * 4) as usize],
+        ))
+    } else {
+        None
+    };
+    Ok((image, depth))
 }
 
 #[cfg(test)]

@@ -131,6 +131,45 @@ pub(super) struct Geometry {
     pub(super) clusters: Vec<Cluster>,
 }
 
+/// What the load-time analysis finds about primitive `p` of `scene`: its area, and with culling
+/// on whether it is closed, its plane, its clusters and its cutout cards cut to their alpha.
+fn analyse(scene: &Scene, options: &SceneOptions, p: &crate::scene::Primitive) -> PrimitiveShape {
+    let double_sided = scene
+        .materials
+        .get(p.material)
+        .is_some_and(|m| m.double_sided);
+    PrimitiveShape {
+        area: p
+            .indices
+            .chunks_exact(3)
+            .map(|t| {
+                let v = |k: usize| p.positions.get(t[k] as usize).copied().unwrap_or_default();
+                0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length()
+            })
+            .sum(),
+        // Only double-sided materials can use it; skip the check for the others.
+        closed: options.culling && double_sided && is_closed(&p.positions, &p.indices),
+        plane: options
+            .culling
+            .then(|| plane_of(&p.positions, &p.indices))
+            .flatten(),
+        clusters: options
+            .culling
+            .then(|| clusters::build(&p.positions, &p.indices))
+            .flatten(),
+        // Work that cannot change the image, as culling is.
+        trimmed: options
+            .culling
+            .then(|| {
+                let m = scene.materials.get(p.material)?;
+                let cut = crate::scene::mesh::trim::AlphaCut::new(m, p, &scene.textures)?;
+                crate::scene::mesh::trim::trim(p, &cut)
+            })
+            .flatten()
+            .map(|t| t.primitive),
+    }
+}
+
 /// Packs every mesh primitive once (instances share it), analysing each (closed? flat?
 /// clusters) on all cores.
 pub(super) fn pack_geometry(scene: &Scene, options: &SceneOptions) -> Geometry {
@@ -142,43 +181,7 @@ pub(super) fn pack_geometry(scene: &Scene, options: &SceneOptions) -> Geometry {
     // Shape analysis per primitive (closed? flat? clusters), on all cores.
     let prims: Vec<&crate::scene::Primitive> =
         scene.meshes.iter().flat_map(|m| &m.primitives).collect();
-    let mut analyses = crate::parallel::map(&prims, |p| {
-        let double_sided = scene
-            .materials
-            .get(p.material)
-            .is_some_and(|m| m.double_sided);
-        PrimitiveShape {
-            area: p
-                .indices
-                .chunks_exact(3)
-                .map(|t| {
-                    let v = |k: usize| p.positions.get(t[k] as usize).copied().unwrap_or_default();
-                    0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length()
-                })
-                .sum(),
-            // Only double-sided materials can use it; skip the check for the others.
-            closed: options.culling && double_sided && is_closed(&p.positions, &p.indices),
-            plane: options
-                .culling
-                .then(|| plane_of(&p.positions, &p.indices))
-                .flatten(),
-            clusters: options
-                .culling
-                .then(|| clusters::build(&p.positions, &p.indices))
-                .flatten(),
-            // Work that cannot change the image, as culling is.
-            trimmed: options
-                .culling
-                .then(|| {
-                    let m = scene.materials.get(p.material)?;
-                    let cut = crate::scene::mesh::trim::AlphaCut::new(m, p, &scene.textures)?;
-                    crate::scene::mesh::trim::trim(p, &cut)
-                })
-                .flatten()
-                .map(|t| t.primitive),
-        }
-    })
-    .into_iter();
+    let mut analyses = crate::parallel::map(&prims, |p| analyse(scene, options, p)).into_iter();
     for mesh in &scene.meshes {
         let mut r = Vec::new();
         for p in &mesh.primitives {

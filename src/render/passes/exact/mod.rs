@@ -137,69 +137,10 @@ impl ExactPass {
             "exact layout",
         )?;
         let module = create_module(ctx, &sh::spirv()?, "exact.wgsl")?;
-        let (bindings, all) = vertex_layout();
-        let attributes = [all[0], all[2], all[4], all[5]];
-        let receiver = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "exact receivers",
-                layout,
-                vertex: (module, sh::ENTRY_VS_RECEIVER),
-                fragment: Some((module, sh::ENTRY_FS_RECEIVER)),
-                bindings: &bindings,
-                attributes: &attributes,
-                color_formats: &[POSITION_FORMAT, POSITION_FORMAT],
-                masked_targets: 0,
-                depth_format: DEPTH_FORMAT,
-                stencil: Stencil::Off,
-                depth_clamp: false,
-                depth_bias: false,
-                depth: Depth::Test,
-                blend: ColorBlend::Off,
-                samples: 1,
-            },
-        )?;
-        let caster = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "exact casters",
-                layout,
-                vertex: (module, sh::ENTRY_VS_CASTER),
-                fragment: Some((module, sh::ENTRY_FS_CASTER)),
-                bindings: &[],
-                attributes: &[],
-                color_formats: &[],
-                masked_targets: 0,
-                depth_format: vk::Format::UNDEFINED,
-                stencil: Stencil::Off,
-                depth_clamp: false,
-                depth_bias: false,
-                depth: Depth::Off,
-                blend: ColorBlend::Off,
-                samples: 1,
-            },
-        )?;
-        let compute = |entry, name: &str| -> Result<vk::Pipeline, GpuError> {
-            let stage = vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::COMPUTE)
-                .module(module)
-                .name(entry);
-            let info = vk::ComputePipelineCreateInfo::default()
-                .stage(stage)
-                .layout(layout);
-            let p = unsafe {
-                ctx.device
-                    .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
-            }
-            .map_err(|(_, e)| GpuError::Vk {
-                call: "vkCreateComputePipelines",
-                result: e,
-            })?[0];
-            ctx.set_name(p, name);
-            Ok(p)
-        };
-        let build = compute(sh::ENTRY_CS_BUILD, "exact build")?;
-        let contact = compute(sh::ENTRY_CS_CONTACT, "contact shadows")?;
+        let (receiver, caster) = graphics_pipelines(ctx, layout, module)?;
+        let build = compute_pipeline(ctx, layout, module, sh::ENTRY_CS_BUILD, "exact build")?;
+        let contact =
+            compute_pipeline(ctx, layout, module, sh::ENTRY_CS_CONTACT, "contact shadows")?;
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, set_layout, slots)?;
         let uniforms = (0..slots)
             .map(|i| {
@@ -274,6 +215,85 @@ impl ExactPass {
         };
         self.uniforms[slot].write(0, bytemuck::bytes_of(&u))
     }
+}
+
+/// The receivers' pipeline (world positions and normals into two targets, depth-tested) and the
+/// casters' (no attachments: their fragments test and mark the grid).
+fn graphics_pipelines(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    module: vk::ShaderModule,
+) -> Result<(vk::Pipeline, vk::Pipeline), GpuError> {
+    let (bindings, all) = vertex_layout();
+    let attributes = [all[0], all[2], all[4], all[5]];
+    let receiver = create_pipeline(
+        ctx,
+        &PipelineDesc {
+            name: "exact receivers",
+            layout,
+            vertex: (module, sh::ENTRY_VS_RECEIVER),
+            fragment: Some((module, sh::ENTRY_FS_RECEIVER)),
+            bindings: &bindings,
+            attributes: &attributes,
+            color_formats: &[POSITION_FORMAT, POSITION_FORMAT],
+            masked_targets: 0,
+            depth_format: DEPTH_FORMAT,
+            stencil: Stencil::Off,
+            depth_clamp: false,
+            depth_bias: false,
+            depth: Depth::Test,
+            blend: ColorBlend::Off,
+            samples: 1,
+        },
+    )?;
+    let caster = create_pipeline(
+        ctx,
+        &PipelineDesc {
+            name: "exact casters",
+            layout,
+            vertex: (module, sh::ENTRY_VS_CASTER),
+            fragment: Some((module, sh::ENTRY_FS_CASTER)),
+            bindings: &[],
+            attributes: &[],
+            color_formats: &[],
+            masked_targets: 0,
+            depth_format: vk::Format::UNDEFINED,
+            stencil: Stencil::Off,
+            depth_clamp: false,
+            depth_bias: false,
+            depth: Depth::Off,
+            blend: ColorBlend::Off,
+            samples: 1,
+        },
+    )?;
+    Ok((receiver, caster))
+}
+
+/// A compute pipeline of `module`'s entry point `entry`, named `name`.
+fn compute_pipeline(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    module: vk::ShaderModule,
+    entry: &std::ffi::CStr,
+    name: &str,
+) -> Result<vk::Pipeline, GpuError> {
+    let stage = vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::COMPUTE)
+        .module(module)
+        .name(entry);
+    let info = vk::ComputePipelineCreateInfo::default()
+        .stage(stage)
+        .layout(layout);
+    let p = unsafe {
+        ctx.device
+            .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
+    }
+    .map_err(|(_, e)| GpuError::Vk {
+        call: "vkCreateComputePipelines",
+        result: e,
+    })?[0];
+    ctx.set_name(p, name);
+    Ok(p)
 }
 
 impl Drop for ExactPass {
