@@ -185,8 +185,17 @@ def main():
         for s, t in code_edges
         if rank(s) is not None and rank(t) is not None and rank(t) > rank(s)
     ]
+    # The plan needs no device: it does not import the GPU layer at all.
+    bad += [(s, t) for s, t in code_edges if s[:2] == ("umbra", "plan") and t[:2] == ("umbra", "gpu")]
     for s, t in sorted(bad):
         print(f"layering broken: {name(s)} -> {name(t)}")
+    # Nor Vulkan's types (a device fact enters the plan as a plain value).
+    for mod, f in sorted(mods.items()):
+        if mod[:2] == ("umbra", "plan"):
+            text = strip_comments(open(f, encoding="utf-8").read())
+            if re.search(r"\b(ash|vk)::", text):
+                bad.append((mod, ("ash",)))
+                print(f"layering broken: {name(mod)} uses ash")
     return 1 if comps or bad else 0
 
 
