@@ -66,12 +66,13 @@ fn ten_thousand_offscreen_frames_do_not_grow_memory() {
         halves.0 as f64 / 1e6,
         halves.1 as f64 / 1e6
     );
-    // A leak grows both halves alike; where the allocator's fragments land moves RSS once, by up
-    // to ~2 MB (measured 0, 1.17 and 2.11 MB in three runs of the whole), in one half. Either
-    // half under 1 MB catches any leak of 210 bytes a frame or more, as the 2 MB bound on the
-    // whole did (a deliberate 256-byte leak a frame: 1.54 + 1.67 MB, it fails).
+    // A leak grows both halves alike; where the allocator's fragments land moves RSS in steps of
+    // about 1.05 MB, in one half (measured 0, 1.05, 1.05, 1.17, 2.11, 2.11 and, in one CI run,
+    // 4.21 + 0.00 MB). Either half under 1 MB catches any leak of 210 bytes a frame or more (a
+    // deliberate 256-byte leak a frame: 3.67 + 1.60 MB, it fails); the whole is bounded at
+    // 8 MB, twice the largest step measured.
     assert!(
-        halves.0.min(halves.1) < 1_000_000 && growth < 4_000_000,
+        halves.0.min(halves.1) < 1_000_000 && growth < 8_000_000,
         "resident memory grew by {:.2} + {:.2} MB over {} frames",
         halves.0 as f64 / 1e6,
         halves.1 as f64 / 1e6,
