@@ -68,8 +68,7 @@ impl FrameCore {
     ) -> Result<Self, GpuError> {
         let origin = scene.render_origin();
         let gpu = GpuScene::new(ctx, scene, options, origin)?;
-        let receiver_bounds = gpu.draws.iter().map(|d| d.world_bounds).collect();
-        let receiver_planes = gpu.draws.iter().map(|d| d.world_plane).collect();
+        let (receiver_bounds, receiver_planes) = gpu.plan_inputs();
         let mut shadow = ShadowPass::new(ctx)?;
         shadow.set_caching(options.shadow_cache);
         let device = device_facts(ctx);
@@ -116,8 +115,7 @@ impl FrameCore {
     /// draws, bounds and the lights, which may hang on animated nodes.
     pub fn set_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
         self.gpu.update_pose(scene)?;
-        self.receiver_bounds = self.gpu.draws.iter().map(|d| d.world_bounds).collect();
-        self.receiver_planes = self.gpu.draws.iter().map(|d| d.world_plane).collect();
+        (self.receiver_bounds, self.receiver_planes) = self.gpu.plan_inputs();
         self.lights = scene
             .lights
             .iter()

@@ -77,6 +77,14 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
+    /// What the plan reads of the draws (`plan::PlanScene`): each one's world box and, where it
+    /// is flat, its world plane, index-aligned with `draws`.
+    pub fn plan_inputs(&self) -> (Vec<crate::math::Aabb>, Vec<Option<glam::Vec4>>) {
+        let bounds = self.draws.iter().map(|d| d.world_bounds).collect();
+        let planes = self.draws.iter().map(|d| d.world_plane).collect();
+        (bounds, planes)
+    }
+
     /// Binds the scene's vertex streams (positions, attributes) and index buffer: what the camera,
     /// AOV and exact passes draw from.
     pub fn bind_geometry(&self, d: &ash::Device, cmd: vk::CommandBuffer) {
