@@ -4,8 +4,9 @@
 // 1. vs_receiver / fs_receiver: the camera's receivers (what casts and is judged: the shadow
 //    pass's alpha cutoff) into two images, world position and face normal, one texel per pixel.
 // 2. cs_build: each covered pixel is one sample: its shadow ray's origin (off the surface on the
-//    light's side by `eps`, as the CPU reference starts its rays) is projected into the light's
-//    view and pushed onto that grid cell's list (a head per cell, a next per sample).
+//    light's side by its ray offset, as the CPU reference starts its rays) is projected
+//    into the light's view and pushed onto that grid cell's list (a head per cell, a next per
+//    sample).
 // 3. vs_caster / fs_caster: every caster triangle, pulled from the scene's buffers, is drawn into
 //    the grid as its light-view box grown by half a cell (so every cell it touches runs a
 //    fragment; a dilated triangle's corners run away for slivers); each fragment walks its cell's
@@ -24,7 +25,8 @@ struct ExactFrame {
     // xyz: the direction a directional light's rays travel, or a spot light's position;
     // w: LIGHT_DIRECTIONAL or LIGHT_SPOT.
     light: vec4<f32>,
-    // x: ray offset eps (world units), y: grid side in cells, z: image width, w: image height.
+    // x: contact shadows' margin (world units: rays start that far off their surface, and a step
+    // counts that far behind one), y: grid side in cells, z: image width, w: image height.
     params: vec4<f32>,
     // The camera's clip from world, and its position (contact shadows).
     camera_clip: mat4x4<f32>,
@@ -66,12 +68,13 @@ const OCCLUDED: f32 = 0.0;
 @group(1) @binding(1) var base_color_tex: texture_2d<f32>;
 @group(1) @binding(5) var base_color_sampler: sampler;
 
-// 128 bytes: the receiver pass's camera and model transforms; the caster pass reads the first
-// matrix as its model transform and the rest as `CasterImmediates`.
+// 128 bytes: the model transform, and what the pass needs of its draw.
 struct ExactImmediates {
     world_from_model: mat4x4<f32>,
-    // Receiver pass: the camera's clip_from_world. Caster pass: x = first index, y = vertex
-    // offset (bit-cast i32), z = 1 when the caster's alpha is tested, w = the view (cube face).
+    // Receiver pass: x = the ray offset's factors (`math::ray::ray_offset`): xyz the draw's
+    // coordinate magnitudes times the relative offset, w the relative offset. Caster
+    // pass: x = first index, y = vertex offset (bit-cast i32), z = 1 when the caster's alpha is
+    // tested, w = the view (cube face).
     extra: mat4x4<f32>,
 }
 
@@ -99,7 +102,7 @@ fn vs_receiver(v: ReceiverIn) -> ReceiverOut {
     var out: ReceiverOut;
     let world = pc.world_from_model * vec4<f32>(v.position, 1.0);
     out.world_position = world.xyz;
-    out.clip = pc.extra * world;
+    out.clip = xf.camera_clip * world;
     out.uv = vec4<f32>(v.uv, v.uv1);
     out.alpha = v.color.a;
     return out;
@@ -121,7 +124,10 @@ fn fs_receiver(in: ReceiverOut) -> ReceiverTargets {
     }
     var out: ReceiverTargets;
     out.position = vec4<f32>(in.world_position, 1.0);
-    out.normal = vec4<f32>(ng, 0.0);
+    // w: how far this surface's shadow rays start off it (`math::ray::ray_offset`).
+    let p = abs(in.world_position);
+    let offset = dot(abs(ng), pc.extra[0].xyz) + max(p.x, max(p.y, p.z)) * pc.extra[0].w;
+    out.normal = vec4<f32>(ng, offset);
     return out;
 }
 
@@ -211,10 +217,10 @@ fn towards_light(p: vec3<f32>) -> vec4<f32> {
 }
 
 // Where the shadow ray of the receiver at invocation `id`, point `p`, towards `dir` starts: off
-// the surface by the reference's offset, on the light's side of the face.
-fn ray_origin(id: vec3<u32>, p: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+// the surface by `offset`, on the light's side of the face.
+fn ray_origin(id: vec3<u32>, p: vec3<f32>, dir: vec3<f32>, offset: f32) -> vec3<f32> {
     let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
-    return p + select(-ng, ng, dot(ng, dir) >= 0.0) * xf.params.x;
+    return p + select(-ng, ng, dot(ng, dir) >= 0.0) * offset;
 }
 
 @compute @workgroup_size(8, 8)
@@ -228,9 +234,11 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
     let to_light = towards_light(p);
     let dir = to_light.xyz;
     let reach = to_light.w;
-    let origin = ray_origin(id, p, dir);
+    // Off the surface by its ray offset (the receiver pass's normal.w), as the reference's.
+    let offset = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).w;
+    let origin = ray_origin(id, p, dir, offset);
     samples[i + 1u] = vec4<f32>(p, 1.0);
-    rays[i] = vec4<f32>(origin, reach - xf.params.x);
+    rays[i] = vec4<f32>(origin, reach - offset);
     let cell = cell_of(origin);
     let n = cell_count();
     if cell < n {
@@ -266,7 +274,7 @@ fn cs_contact(@builtin(global_invocation_id) id: vec3<u32>) {
         // A spot or point light: the length is per unit of distance, as its texels are.
         length = min(length * to_light.w, 0.5 * to_light.w);
     }
-    let origin = ray_origin(id, p, dir);
+    let origin = ray_origin(id, p, dir, xf.params.x);
     let size = xf.params.zw;
     var verdict = -1.0;
     for (var k = 1u; k <= CONTACT_STEPS; k++) {
@@ -512,7 +520,8 @@ fn fs_caster(in: CasterOut) {
             continue;
         }
         let t = dot(e2, qv) * inv;
-        if t <= xf.params.x || t >= ray.w {
+        // The origin is off the surface: its own triangle lies behind it (t < 0).
+        if t <= 0.0 || t >= ray.w {
             continue;
         }
         if tested {

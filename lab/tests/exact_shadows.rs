@@ -141,7 +141,7 @@ fn contact_shadows_darken_creases_the_maps_leave_lit() {
     // pole), which they cannot see behind.
     let mut lines = Vec::new();
     for (scene, bound) in [
-        (synthetic::close_up_scene(), 0.0031),
+        (synthetic::close_up_scene(), 0.0034),
         (demo_scene(), 0.0010),
     ] {
         let (map, _) = measure(&scene, ShadowMethod::Map);
@@ -160,11 +160,13 @@ fn contact_shadows_darken_creases_the_maps_leave_lit() {
         );
         lines.push((map, contact, bound));
     }
-    // Close-up (measured): 0.496 % → 0.284 %, false light 0.394 % → 0.123 %.
+    // Close-up (measured): 0.533 % → 0.320 %, false light 0.421 % → 0.150 % (against the
+    // reference whose rays start 2⁻¹⁶ of the surface's coordinates off it, which finds more of
+    // the folds' own shadow than one 2·10⁻⁵ of the scene's diagonal off did: 0.496 % → 0.284 %).
     let (map, contact, bound) = &lines[0];
     assert!(contact.misclassified <= *bound, "{}", contact.misclassified);
     assert!(contact.false_light < 0.4 * map.false_light);
-    // Demo (measured): 0.051 % → 0.085 %, false shadow 0.018 % → 0.060 % on convex edges.
+    // Demo (measured): 0.054 % → 0.088 %, false shadow 0.019 % → 0.061 % on convex edges.
     let (_, contact, bound) = &lines[1];
     assert!(contact.misclassified <= *bound, "{}", contact.misclassified);
 }

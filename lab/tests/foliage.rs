@@ -88,9 +88,11 @@ fn blended_and_masked_foliage_follow_one_rule_on_the_gpu_and_in_the_reference() 
         );
         // Most of the frame is judged (measured: 134,154 of 230,400).
         assert!(j.judged > 120_000, "{}", j.judged);
-        // Away from edges as on solid scenes (the first look's bound, 10⁻⁴): measured 0.0031 %
-        // (4 pixels) for both.
-        assert!(interior < 1e-4, "interior {:.4} %", interior * 100.0);
+        // Away from edges: measured 0.0154 % (15 pixels) for both. 9 of them were there when
+        // the reference's rays started 2·10⁻⁵ of the scene's diagonal (1.7 mm) off their
+        // surface; the 6 more, since they start 2⁻¹⁶ of the surface's coordinates (about 0.2 mm) off
+        // it, are on leaves within a millimetre of another leaf, where that choice decides.
+        assert!(interior < 2e-4, "interior {:.4} %", interior * 100.0);
         // Leaf shadows finer than the map's texels: measured 3.31 % of edge pixels wrong.
         assert!(edge < 0.04, "edge {:.2} %", edge * 100.0);
         // Mipmapped alpha in the camera pass against mip 0 in the reference at distant leaves:

@@ -16,6 +16,7 @@ mod masked_shadows;
 mod material_inputs;
 mod multi_light_shadows;
 mod reference;
+mod scale;
 mod soft_shadows;
 #[cfg(feature = "sweep")]
 mod stability;

@@ -28,6 +28,10 @@ pub enum ExactMode {
         length: f32,
         /// Thickness of what the depth image shows.
         thickness: f32,
+        /// How far a ray starts off its surface, and how far behind a surface of the depth
+        /// image a step must lie to count (world units): 2·10⁻⁵ of the scene's diagonal, what
+        /// the depth image's planes are trusted to.
+        margin: f32,
     },
 }
 
@@ -43,8 +47,6 @@ pub struct ExactPlan {
     pub light: Vec3,
     /// A light with a position (spot, or point for contact shadows), else directional.
     pub positional: bool,
-    /// Shadow rays start this far off the surface and ignore hits nearer (world units).
-    pub eps: f32,
     /// The camera's clip from world.
     pub clip_from_world: Mat4,
     /// The camera's position and near-plane reach (back-face culling, as the camera pass).

@@ -51,6 +51,7 @@ pub(super) fn choose_exact(
             ExactMode::Contact {
                 length,
                 thickness: CONTACT_THICKNESS * length,
+                margin: (scene.bounds.diagonal() * 2e-5).max(1e-6),
             }
         }
         _ => return None,
@@ -70,8 +71,6 @@ pub(super) fn choose_exact(
             .collect(),
         light,
         positional,
-        // The CPU reference's ray offset: 2·10⁻⁵ of the scene's diagonal.
-        eps: (scene.bounds.diagonal() * 2e-5).max(1e-6),
         clip_from_world: plan.clip_from_world,
         eye: (
             plan.camera_position,

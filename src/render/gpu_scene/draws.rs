@@ -2,6 +2,7 @@
 //! alpha treatment and shadow-pass range.
 
 use super::*;
+use crate::math::ray::coordinate_magnitudes;
 use crate::math::Aabb;
 use crate::plan::uniforms::SceneImmediates;
 use crate::scene::{AlphaMode, Scene};
@@ -62,6 +63,9 @@ pub struct Draw {
     pub immediates: SceneImmediates,
     /// World-space bounds (for culling).
     pub world_bounds: Aabb,
+    /// Its coordinates' size per axis (`math::ray::coordinate_magnitudes`): how far its
+    /// surfaces' shadow rays start off them (`math::ray::ray_offset`).
+    pub magnitudes: Vec3,
     /// World-space plane `(n, w)` of a flat primitive (`scene::mesh::topology::plane_of`), unit `n`.
     pub world_plane: Option<Vec4>,
     /// Draw both faces.
@@ -172,6 +176,7 @@ pub(super) fn build_draws(
                 model_from_world: world_from_model.inverse(),
                 clusters: r.clusters,
                 immediates: SceneImmediates::new(world_from_model),
+                magnitudes: coordinate_magnitudes(&world_bounds, &world_from_model),
                 world_bounds,
                 world_plane: r.plane.and_then(|pl| world_plane(pl, &world_from_model)),
                 double_sided: mat.is_some_and(|m| m.double_sided),

@@ -332,6 +332,7 @@ mod tests {
             clusters: (0, 0),
             immediates: SceneImmediates::new(m),
             world_bounds: Aabb::new(center - Vec3::splat(0.5), center + Vec3::splat(0.5)),
+            magnitudes: Vec3::ZERO,
             world_plane: None,
             double_sided: false,
             mirrored: false,

@@ -294,7 +294,13 @@ pub fn near_casters(
             Some(at) => v.texel_world * at.distance(p.position),
             None => v.texel_world,
         };
-        near[i] = reference.caster_within(&f.plan, light, p.position, p.normal, reach * texel);
+        near[i] = reference.caster_within(
+            &f.plan,
+            light,
+            (p.position, p.offset),
+            p.normal,
+            reach * texel,
+        );
     }
     near
 }

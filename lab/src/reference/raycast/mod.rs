@@ -10,7 +10,8 @@ use rayon::prelude::*;
 use rays::{face_viewer, light_at, primary_ray};
 use surface::{srgb_encode, surface_inputs};
 use umbra::math::interp::perturb_normal;
-use umbra::math::ray::Ray;
+use umbra::math::ray::{coordinate_magnitudes, Ray};
+use umbra::math::Aabb;
 use umbra::plan::{Ambient, FramePlan};
 use umbra::scene::{blinn_phong_params, shade_blinn_phong, Scene};
 
@@ -22,6 +23,9 @@ struct TriRef {
     primitive: u32,
     /// Index of the triangle's first index in the primitive.
     first: u32,
+    /// Its draw's coordinate magnitudes (`umbra::math::ray::coordinate_magnitudes`): how far
+    /// shadow rays leaving it start off it, as on the GPU.
+    magnitudes: Vec3,
 }
 
 /// A scene prepared for ray casting: world-space triangles in a BVH, plus what shading needs.
@@ -38,7 +42,6 @@ pub struct ReferenceScene<'a> {
     refs: Vec<TriRef>,
     normal_mats: Vec<Mat3>,
     srgb_lut: [f32; 256],
-    eps: f32,
 }
 
 /// The reference result for one view.
@@ -106,6 +109,8 @@ pub struct Probe {
     pub position: Vec3,
     /// Geometric normal, facing the camera.
     pub normal: Vec3,
+    /// How far its shadow rays start off it (`umbra::math::ray::ray_offset`).
+    pub offset: f32,
     /// Distance along the ray.
     pub distance: f32,
     /// Exact visibility of the shadowed light (facing it and unoccluded).
@@ -161,6 +166,8 @@ impl<'a> ReferenceScene<'a> {
                     .iter()
                     .map(|v| world_from_model.transform_point3(*v))
                     .collect();
+                let bounds = Aabb::from_points(world.iter().copied());
+                let magnitudes = coordinate_magnitudes(&bounds, &world_from_model);
                 for (k, t) in p.indices.chunks_exact(3).enumerate() {
                     tris.push([
                         world[t[0] as usize],
@@ -172,6 +179,7 @@ impl<'a> ReferenceScene<'a> {
                         mesh: inst.mesh as u32,
                         primitive: pi as u32,
                         first: (k * 3) as u32,
+                        magnitudes,
                     });
                 }
             }
@@ -181,7 +189,6 @@ impl<'a> ReferenceScene<'a> {
         for (i, v) in srgb_lut.iter_mut().enumerate() {
             *v = umbra::math::tonemap::srgb_to_linear(i as f32 / 255.0);
         }
-        let eps = (scene.bounds().diagonal() * 2e-5).max(1e-6);
         Self {
             scene,
             matrices,
@@ -190,7 +197,6 @@ impl<'a> ReferenceScene<'a> {
             refs,
             normal_mats,
             srgb_lut,
-            eps,
         }
     }
 
@@ -212,13 +218,13 @@ impl<'a> ReferenceScene<'a> {
         if flip {
             n_geo = -n_geo;
         }
-        let p = ray.at(h.t);
+        let (p, offset) = self.surface_point(&h);
         let lights = plan
             .lights
             .iter()
             .map(|l| {
                 let (dir, dist, _) = light_at(l, p);
-                n_geo.dot(dir) > 0.0 && !self.occluded(p, ng, dir, dist)
+                n_geo.dot(dir) > 0.0 && !self.occluded((p, offset), ng, dir, dist)
             })
             .collect();
         Some(Pick {
@@ -263,14 +269,15 @@ impl<'a> ReferenceScene<'a> {
                 if flip {
                     n_geo = -n_geo;
                 }
-                let p = ray.at(h.t);
+                let (p, offset) = self.surface_point(&h);
                 let visible = match plan.shadow_light {
-                    Some(i) => self.visible(plan, i, p, ng, n_geo).0,
+                    Some(i) => self.visible(plan, i, (p, offset), ng, n_geo).0,
                     None => true,
                 };
                 Some(Probe {
                     position: p,
                     normal: ng,
+                    offset,
                     distance: h.t,
                     visible,
                 })
@@ -369,7 +376,7 @@ impl<'a> ReferenceScene<'a> {
             prim.indices[r.first as usize + 2] as usize,
         ];
         let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
-        let p = ray.at(h.t);
+        let (p, offset) = self.surface_point(h);
         let m3 = Mat3::from_mat4(self.matrices[r.instance as usize]);
         let (ng, mut n_geo) = self.hit_normals(h);
         let (uv, vertex_color) = surface_inputs(prim, r.first as usize, h);
@@ -416,7 +423,7 @@ impl<'a> ReferenceScene<'a> {
         let mut color = bp.ka * ambient.at(n) * occlusion + emissive;
         let (mut shadow_vis, mut shadow_cover) = (true, 1.0);
         for i in 0..plan.lights.len() {
-            let (vis, cover, l, radiance) = self.visible(plan, i, p, ng, n_geo);
+            let (vis, cover, l, radiance) = self.visible(plan, i, (p, offset), ng, n_geo);
             if plan.shadow_light == Some(i) {
                 (shadow_vis, shadow_cover) = (vis, cover);
             }

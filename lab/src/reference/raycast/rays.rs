@@ -72,14 +72,15 @@ pub(super) fn spiral(k: usize, n: usize) -> Vec2 {
 }
 
 impl<'a> ReferenceScene<'a> {
-    /// Exact visibility of world point `p` (geometric normal `ng`, facing normal `n`) from light
-    /// `i`: whether its centre is visible, the fraction of its emitter that is (the same for a
-    /// punctual light), the direction towards it and the radiance arriving.
+    /// Exact visibility of world point `p` (its shadow rays' offset `offset`, geometric normal
+    /// `ng`, facing normal `n`) from light `i`: whether its centre is visible, the fraction of its
+    /// emitter that is (the same for a punctual light), the direction towards it and the radiance
+    /// arriving.
     pub(super) fn visible(
         &self,
         plan: &FramePlan,
         i: usize,
-        p: Vec3,
+        (p, offset): (Vec3, f32),
         ng: Vec3,
         n_facing: Vec3,
     ) -> (bool, f32, Vec3, Vec3) {
@@ -92,7 +93,7 @@ impl<'a> ReferenceScene<'a> {
         if !plan.is_shadowed(i) {
             return (true, 1.0, dir, radiance);
         }
-        let centre = !self.occluded(p, ng, dir, dist);
+        let centre = !self.occluded((p, offset), ng, dir, dist);
         let size = umbra::plan::soft_size(l);
         if size <= 0.0 {
             return (centre, if centre { 1.0 } else { 0.0 }, dir, radiance);
@@ -114,7 +115,7 @@ impl<'a> ReferenceScene<'a> {
                         (to / t.max(1e-20), t)
                     }
                 };
-                !self.occluded(p, ng, d, t)
+                !self.occluded((p, offset), ng, d, t)
             })
             .count();
         (centre, open as f32 / AREA_SAMPLES as f32, dir, radiance)
@@ -122,20 +123,25 @@ impl<'a> ReferenceScene<'a> {
 
     /// Whether anything lies between surface point `p` (geometric normal `ng`) and a light
     /// `dist` away along `dir`.
-    pub(super) fn occluded(&self, p: Vec3, ng: Vec3, dir: Vec3, dist: f32) -> bool {
-        // Start the shadow ray off the surface, on the light's side of the true face.
+    pub(super) fn occluded(
+        &self,
+        (p, offset): (Vec3, f32),
+        ng: Vec3,
+        dir: Vec3,
+        dist: f32,
+    ) -> bool {
+        // Start the shadow ray off the surface by its offset, on the light's side of the true
+        // face: its own triangle then lies behind it (t < 0), as on the GPU.
         let side = if ng.dot(dir) >= 0.0 { ng } else { -ng };
-        let origin = p + side * self.eps;
-        self.bvh.occluded_where(
-            &Ray::new(origin, dir),
-            self.eps,
-            dist - self.eps,
-            &|h: &Hit| self.stops(h, true),
-        )
+        let origin = p + side * offset;
+        self.bvh
+            .occluded_where(&Ray::new(origin, dir), 0.0, dist - offset, &|h: &Hit| {
+                self.stops(h, true)
+            })
     }
 
-    /// Whether a caster of light `i` lies within `radius` of surface point `p` (geometric normal
-    /// `ng`) across the light's direction: shadow rays start from 32 points of a disk of that
+    /// Whether a caster of light `i` lies within `radius` of surface point `p` (its shadow rays'
+    /// offset `offset`, geometric normal `ng`) across the light's direction: shadow rays start from 32 points of a disk of that
     /// radius around `p` (across the direction to the light, moved along it onto `p`'s tangent
     /// plane). A shadow map resolves
     /// casters to its lookup's reach, so a false shadow with such a caster nearby is a shadow
@@ -144,7 +150,7 @@ impl<'a> ReferenceScene<'a> {
         &self,
         plan: &FramePlan,
         i: usize,
-        p: Vec3,
+        (p, offset): (Vec3, f32),
         ng: Vec3,
         radius: f32,
     ) -> bool {
@@ -162,7 +168,7 @@ impl<'a> ReferenceScene<'a> {
             let u = spiral(k, 32) * radius;
             let o = e1 * u.x + e2 * u.y;
             // Onto the tangent plane along the light's direction.
-            let start = p + o - dir * (ng.dot(o) / cos) + side * self.eps;
+            let start = p + o - dir * (ng.dot(o) / cos) + side * offset;
             let (d, t) = match l.kind {
                 LightKind::Directional => (dir, f32::INFINITY),
                 _ => {
@@ -172,7 +178,7 @@ impl<'a> ReferenceScene<'a> {
                 }
             };
             self.bvh
-                .occluded_where(&Ray::new(start, d), self.eps, t - self.eps, &|h: &Hit| {
+                .occluded_where(&Ray::new(start, d), 0.0, t - offset, &|h: &Hit| {
                     self.stops(h, true)
                 })
         })
@@ -190,7 +196,7 @@ impl<'a> ReferenceScene<'a> {
     pub(super) fn receiver_beyond(&self, ray: &Ray, h: &Hit) -> Option<Hit> {
         self.bvh.intersect_where(
             ray,
-            h.t * (1.0 + 1e-5) + self.eps,
+            h.t * (1.0 + 1e-5) + self.surface_point(h).1,
             f32::INFINITY,
             &|h: &Hit| self.stops(h, true),
         )

@@ -135,11 +135,34 @@ impl<'a> ReferenceScene<'a> {
         let behind = self.radiance(
             plan,
             ray,
-            h.t * (1.0 + 1e-5) + self.eps,
+            h.t * (1.0 + 1e-5) + self.surface_point(h).1,
             ambient,
             layers + 1,
         );
         rgb * a + behind * (1.0 - a)
+    }
+
+    /// The world vertices of the triangle hit.
+    fn world_vertices(&self, h: &Hit) -> [Vec3; 3] {
+        let r = self.refs[h.triangle as usize];
+        let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
+        let world_from_model = self.matrices[r.instance as usize];
+        [0, 1, 2].map(|k| {
+            world_from_model
+                .transform_point3(prim.positions[prim.indices[r.first as usize + k] as usize])
+        })
+    }
+
+    /// The surface point of a hit and how far its shadow rays start off it. The point is its
+    /// triangle's vertices weighted by the hit's barycentrics, as the GPU interpolates it: off
+    /// the plane by units in the last place of the triangle's coordinates, whatever the ray's
+    /// length (the ray's `at(t)` errs with the distance from the eye).
+    pub(super) fn surface_point(&self, h: &Hit) -> (Vec3, f32) {
+        let pw = self.world_vertices(h);
+        let p = pw[0] * (1.0 - h.u - h.v) + pw[1] * h.u + pw[2] * h.v;
+        let n = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
+        let m = self.refs[h.triangle as usize].magnitudes;
+        (p, umbra::math::ray::ray_offset(m, n, p))
     }
 
     /// Geometric and interpolated normals (world space, as stored: not yet turned to the viewer)
@@ -147,9 +170,8 @@ impl<'a> ReferenceScene<'a> {
     pub(super) fn hit_normals(&self, h: &Hit) -> (Vec3, Vec3) {
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
-        let world_from_model = self.matrices[r.instance as usize];
         let idx = [0, 1, 2].map(|k| prim.indices[r.first as usize + k] as usize);
-        let pw = idx.map(|i| world_from_model.transform_point3(prim.positions[i]));
+        let pw = self.world_vertices(h);
         let ng = (pw[1] - pw[0]).cross(pw[2] - pw[0]).normalize_or(Vec3::Y);
         if prim.normals.len() != prim.positions.len() {
             return (ng, ng);

@@ -191,9 +191,13 @@ impl ExactPass {
             .targets
             .as_ref()
             .map_or(vk::Extent2D::default(), |t| t.extent);
-        let (length, thickness) = match f.mode {
-            ExactMode::Exact => (0.0, 0.0),
-            ExactMode::Contact { length, thickness } => (length, thickness),
+        let (length, thickness, margin) = match f.mode {
+            ExactMode::Exact => (0.0, 0.0, 0.0),
+            ExactMode::Contact {
+                length,
+                thickness,
+                margin,
+            } => (length, thickness, margin),
         };
         let u = ExactFrame {
             camera_clip: f.clip_from_world,
@@ -207,7 +211,7 @@ impl ExactPass {
                 crate::gpu::shaders::scene::LIGHT_DIRECTIONAL
             }),
             params: Vec4::new(
-                f.eps,
+                margin,
                 grid_side(f.views.len()) as f32,
                 extent.width as f32,
                 extent.height as f32,

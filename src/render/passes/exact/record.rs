@@ -4,6 +4,7 @@
 use super::*;
 use crate::gpu::barrier::{memory_barrier, Access};
 use crate::gpu::Recorder;
+use crate::math::ray::RAY_OFFSET_RELATIVE;
 use crate::plan::Viewpoint;
 use crate::plan::{ExactMode, ExactPlan};
 use crate::render::gpu_scene::GpuScene;
@@ -109,9 +110,12 @@ impl ExactPass {
         for &i in &f.receivers {
             let dr = &scene.draws[i];
             scene.bind_material(d, cmd, self.layout, 1, dr.material);
+            // The ray offset's factors (`math::ray::ray_offset`), multiplied out.
+            let mut extra = Mat4::ZERO;
+            extra.x_axis = (dr.magnitudes * RAY_OFFSET_RELATIVE).extend(RAY_OFFSET_RELATIVE);
             let pc = ExactImmediates {
                 world_from_model: dr.world_from_model,
-                extra: f.clip_from_world,
+                extra,
             };
             scene.record_draw(
                 cmd,
