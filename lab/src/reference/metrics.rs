@@ -117,43 +117,21 @@ pub struct Classified {
     pub coverage_mismatch: usize,
 }
 
-/// Classifies every pixel of a GPU shadow-visibility frame (`gpu_shadow`, thresholded at 0.5, and
-/// its depth buffer) against the reference for the same plan.
-pub fn classify(
-    gpu_shadow: &image::RgbaImage,
-    gpu_depth: &[f32],
-    plan: &FramePlan,
-    reference: &ReferenceFrame,
-) -> Classified {
-    let (w, h) = (reference.width, reference.height);
-    let inv = plan.clip_from_world.inverse();
-    let eye = plan.camera_position;
+/// The pixels within [`EDGE_PIXELS`] of an exact shadow boundary (two neighbouring pixels whose
+/// exact visibility differs) of a `w`×`h` visibility image.
+pub fn edge_band(visibility: &[Option<bool>], w: u32, h: u32) -> Vec<bool> {
     let idx = |x: i32, y: i32| (y as u32 * w + x as u32) as usize;
-    // Same surface point: both see something, at distances within 1% (+ a small absolute term).
-    let same = |x: u32, y: u32| -> Option<bool> {
-        let i = (y * w + x) as usize;
-        let vis = reference.visibility[i]?;
-        let d = gpu_depth[i];
-        if d <= 0.0 {
-            return None;
-        }
-        let n = pixel_to_ndc(x as f32 + 0.5, y as f32 + 0.5, w, h);
-        let p = inv * Vec4::new(n.x, n.y, d, 1.0);
-        let dist = (p.truncate() / p.w).distance(eye);
-        let r = reference.distance[i];
-        ((dist - r).abs() <= 0.01 * r + 1e-4).then_some(vis)
-    };
     // Exact boundary pixels, then the band within EDGE_PIXELS of them.
     let mut boundary = vec![false; (w * h) as usize];
     for y in 0..h as i32 {
         for x in 0..w as i32 {
-            let Some(v) = reference.visibility[idx(x, y)] else {
+            let Some(v) = visibility[idx(x, y)] else {
                 continue;
             };
             for (dx, dy) in [(1, 0), (0, 1)] {
                 let (nx, ny) = (x + dx, y + dy);
                 if nx < w as i32 && ny < h as i32 {
-                    if let Some(u) = reference.visibility[idx(nx, ny)] {
+                    if let Some(u) = visibility[idx(nx, ny)] {
                         if u != v {
                             boundary[idx(x, y)] = true;
                             boundary[idx(nx, ny)] = true;
@@ -179,6 +157,35 @@ pub fn classify(
             }
         }
     }
+    edge
+}
+
+/// Classifies every pixel of a GPU shadow-visibility frame (`gpu_shadow`, thresholded at 0.5, and
+/// its depth buffer) against the reference for the same plan.
+pub fn classify(
+    gpu_shadow: &image::RgbaImage,
+    gpu_depth: &[f32],
+    plan: &FramePlan,
+    reference: &ReferenceFrame,
+) -> Classified {
+    let (w, h) = (reference.width, reference.height);
+    let inv = plan.clip_from_world.inverse();
+    let eye = plan.camera_position;
+    // Same surface point: both see something, at distances within 1% (+ a small absolute term).
+    let same = |x: u32, y: u32| -> Option<bool> {
+        let i = (y * w + x) as usize;
+        let vis = reference.visibility[i]?;
+        let d = gpu_depth[i];
+        if d <= 0.0 {
+            return None;
+        }
+        let n = pixel_to_ndc(x as f32 + 0.5, y as f32 + 0.5, w, h);
+        let p = inv * Vec4::new(n.x, n.y, d, 1.0);
+        let dist = (p.truncate() / p.w).distance(eye);
+        let r = reference.distance[i];
+        ((dist - r).abs() <= 0.01 * r + 1e-4).then_some(vis)
+    };
+    let edge = edge_band(&reference.visibility, w, h);
     let mut class = vec![PixelClass::Unjudged; (w * h) as usize];
     let mut coverage_mismatch = 0;
     for y in 0..h {

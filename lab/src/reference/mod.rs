@@ -8,7 +8,7 @@ pub mod raycast;
 
 pub use bvh::{Bvh, Hit};
 pub use metrics::{
-    classify, compare, flip, misclassified_by_depth, psnr, summarise, Classified, DepthBin,
-    Metrics, PixelClass,
+    classify, compare, edge_band, flip, misclassified_by_depth, psnr, summarise, Classified,
+    DepthBin, Metrics, PixelClass,
 };
 pub use raycast::{Pick, Probe, ReferenceFrame, ReferenceScene};

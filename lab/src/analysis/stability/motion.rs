@@ -7,16 +7,18 @@
 //!
 //! Flicker is the fraction of still receiver points (pixels seeing the same surface at the same
 //! depth in two consecutive frames) whose shadow classification flips between the frames while
-//! their exact visibility, ray-cast for each frame, does not. Flown fitted afresh per frame (as
-//! stills) and held (`View::shadow_hold`, as the viewer renders).
+//! their exact visibility, ray-cast for each frame, does not; also counted away from edges (points
+//! beyond `EDGE_PIXELS` of an exact shadow boundary in both frames). Flown with maps fitted
+//! afresh per frame (as stills) and held (`View::shadow_hold`, as the viewer renders), and with
+//! exact shadows.
 
 use super::{fraction, shadow_frame};
-use crate::reference::ReferenceScene;
+use crate::reference::{classify, edge_band, PixelClass, ReferenceScene};
 use glam::Vec3;
 use serde::Serialize;
 use umbra::gpu::GpuError;
 use umbra::math::Aabb;
-use umbra::plan::{SceneOptions, ShadowHold, View};
+use umbra::plan::{SceneOptions, ShadowHold, ShadowMethod, View};
 use umbra::render::Renderer;
 use umbra::scene::anim::{add_mover, Playing};
 use umbra::scene::built::shapes::{colored, cuboid};
@@ -29,7 +31,7 @@ pub struct MotionSeries {
     pub probe: String,
     /// What moves: the animation's name, or "added box".
     pub mover: String,
-    /// "defaults" (fitted afresh per frame) or "defaults, held" (the viewer).
+    /// "defaults" (maps fitted afresh per frame), "defaults, held" (the viewer) or "exact".
     pub method: String,
     /// Per consecutive pair: still points whose exact visibility is the same in both frames.
     pub points: Vec<usize>,
@@ -39,7 +41,19 @@ pub struct MotionSeries {
     pub mean_fraction: f64,
     /// Largest flipped fraction of one pair.
     pub max_fraction: f64,
+    /// Per pair: the still points away from edges (beyond `EDGE_PIXELS` of an exact shadow
+    /// boundary in both frames), and of those, the ones that flipped.
+    pub interior: Vec<(usize, usize)>,
+    /// Mean over pairs of the flipped fraction away from edges.
+    pub mean_interior_fraction: f64,
 }
+
+/// How a probe is flown: maps fitted afresh each frame, maps held across frames, exact shadows.
+const METHODS: [(&str, bool, ShadowMethod); 3] = [
+    ("defaults", false, ShadowMethod::Map),
+    ("defaults, held", true, ShadowMethod::Map),
+    ("exact", false, ShadowMethod::Exact),
+];
 
 /// Frames of each probe: 2 s at 60 frames per second (`quick`: its first half second).
 pub fn frames(quick: bool) -> usize {
@@ -102,16 +116,22 @@ pub fn sun_arc(i: usize, n: usize) -> Vec3 {
     )
 }
 
-/// One frame of a probe: the GPU's shadow view (with depth) and the exact visibility.
+/// One frame of a probe: the GPU's shadow view (with depth), the exact visibility and its edge
+/// band.
 struct Frame {
     lit: Vec<Option<bool>>,
     depth: Vec<f32>,
     exact: Vec<Option<bool>>,
+    edge: Vec<bool>,
 }
 
-/// Flickers between consecutive frames: (points, flipped).
-fn flicker(a: &Frame, b: &Frame) -> (usize, usize) {
+/// Still points and of those the flipped ones.
+type Counts = (usize, usize);
+
+/// Flicker between consecutive frames: (points, flipped), and the same away from edges.
+fn flicker(a: &Frame, b: &Frame) -> (Counts, Counts) {
     let (mut n, mut f) = (0, 0);
+    let (mut ni, mut fi) = (0, 0);
     for i in 0..a.depth.len() {
         let (da, db) = (a.depth[i], b.depth[i]);
         // The same still surface: same depth (to 1e-6 relative) in both frames.
@@ -129,8 +149,12 @@ fn flicker(a: &Frame, b: &Frame) -> (usize, usize) {
         };
         n += 1;
         f += (ga != gb) as usize;
+        if !a.edge[i] && !b.edge[i] {
+            ni += 1;
+            fi += (ga != gb) as usize;
+        }
     }
-    (n, f)
+    ((n, f), (ni, fi))
 }
 
 fn render(
@@ -142,23 +166,27 @@ fn render(
     let f = shadow_frame(renderer, view, size)?;
     let exact = ReferenceScene::new(scene).render(&f.plan, size.0, size.1, f.plan.ambient);
     let depth = f.depth.clone().unwrap_or_default();
+    // Judged where the GPU and the reference see the same surface (`classify`'s rule).
+    let judged = classify(&f.image, &depth, &f.plan, &exact);
     let lit = f
         .image
         .pixels()
-        .zip(&depth)
-        .map(|(p, d)| (*d > 0.0).then_some(p[0] >= 128))
+        .zip(&judged.class)
+        .map(|(p, c)| (*c != PixelClass::Unjudged).then_some(p[0] >= 128))
         .collect();
     Ok((
         Frame {
             lit,
             depth,
+            edge: edge_band(&exact.visibility, size.0, size.1),
             exact: exact.visibility,
         },
         ShadowHold::from_plan(&f.plan),
     ))
 }
 
-/// Both probes, each fitted afresh and held; `progress` is called once per frame rendered.
+/// Both probes, each flown with every one of `METHODS`; `progress` is called once per frame
+/// rendered.
 pub fn motion(
     ctx: &std::sync::Arc<umbra::gpu::Context>,
     scene: &Scene,
@@ -178,7 +206,7 @@ pub fn motion(
     let duration = moving.rig.as_deref().map_or(0.0, |r| r.duration(&playing));
     let mut out = Vec::new();
     let mut renderer = Renderer::with_options(ctx, &moving, options)?;
-    for held in [false, true] {
+    for (name, held, method) in METHODS {
         let mut frames = Vec::new();
         let mut hold = None;
         for i in 0..n {
@@ -188,29 +216,31 @@ pub fn motion(
             moving.pose_at(&playing, t);
             renderer.set_pose(&moving)?;
             let mut v = view.clone();
+            v.shadow.method = method;
             v.shadow_hold = if held { hold.clone() } else { None };
             let (f, h) = render(&mut renderer, &moving, &v, size)?;
             hold = Some(h);
             frames.push(f);
             progress();
         }
-        out.push(series("moving caster", &mover, held, &frames));
+        out.push(series("moving caster", &mover, name, &frames));
     }
     drop(renderer);
     let mut renderer = Renderer::with_options(ctx, scene, options)?;
-    for held in [false, true] {
+    for (name, held, method) in METHODS {
         let mut frames = Vec::new();
         let mut hold = None;
         for i in 0..n {
             let mut v = view.clone();
             v.sun_direction = Some(sun_arc(i, frames_full(quick, n)));
+            v.shadow.method = method;
             v.shadow_hold = if held { hold.clone() } else { None };
             let (f, h) = render(&mut renderer, scene, &v, size)?;
             hold = Some(h);
             frames.push(f);
             progress();
         }
-        out.push(series("sun arc", "sun", held, &frames));
+        out.push(series("sun arc", "sun", name, &frames));
     }
     Ok(out)
 }
@@ -225,22 +255,27 @@ fn frames_full(quick: bool, n: usize) -> usize {
     }
 }
 
-fn series(probe: &str, mover: &str, held: bool, frames: &[Frame]) -> MotionSeries {
-    let (points, flipped): (Vec<usize>, Vec<usize>) =
+fn series(probe: &str, mover: &str, method: &str, frames: &[Frame]) -> MotionSeries {
+    let (all, interior): (Vec<Counts>, Vec<Counts>) =
         frames.windows(2).map(|w| flicker(&w[0], &w[1])).unzip();
+    let (points, flipped): (Vec<usize>, Vec<usize>) = all.into_iter().unzip();
+    let mean = |fr: &[f64]| fr.iter().sum::<f64>() / fr.len().max(1) as f64;
     let fr: Vec<f64> = points
         .iter()
         .zip(&flipped)
         .map(|(&n, &f)| fraction(f, n))
         .collect();
+    let fri: Vec<f64> = interior.iter().map(|&(n, f)| fraction(f, n)).collect();
     MotionSeries {
         probe: probe.into(),
         mover: mover.into(),
-        method: if held { "defaults, held" } else { "defaults" }.into(),
-        mean_fraction: fr.iter().sum::<f64>() / fr.len().max(1) as f64,
+        method: method.into(),
+        mean_fraction: mean(&fr),
         max_fraction: fr.iter().copied().fold(0.0, f64::max),
         points,
         flipped,
+        mean_interior_fraction: mean(&fri),
+        interior,
     }
 }
 
@@ -253,6 +288,7 @@ mod tests {
             lit: lit.to_vec(),
             depth: depth.to_vec(),
             exact: exact.to_vec(),
+            edge: vec![false; lit.len()],
         }
     }
 
@@ -270,7 +306,11 @@ mod tests {
             &[Some(true), Some(true), Some(true), Some(true), None],
             &[0.5, 0.5, 0.5, 0.6, 0.0],
         );
-        assert_eq!(flicker(&a, &b), (2, 1));
+        assert_eq!(flicker(&a, &b), ((2, 1), (2, 1)));
+        // Point 0 within the edge band of one frame: flicker, but not away from edges.
+        let mut b = b;
+        b.edge[0] = true;
+        assert_eq!(flicker(&a, &b), ((2, 1), (1, 0)));
     }
 
     #[test]

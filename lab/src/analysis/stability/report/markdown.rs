@@ -193,10 +193,12 @@ pub(super) fn motion_md(r: &StabilityReport) -> String {
         "mean flipped",
         "worst frame",
         "points per frame",
+        "mean flipped away from edges",
     ]);
     for s in &r.motion {
         let mut row = vec![s.probe.clone(), s.mover.clone(), s.method.clone()];
         row.extend(flip_cells(s.mean_fraction, s.max_fraction, &s.points));
+        row.push(format!("{:.2e}", s.mean_interior_fraction));
         t.row(row);
     }
     m += &t.render(true);

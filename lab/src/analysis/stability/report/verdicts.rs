@@ -109,6 +109,22 @@ pub(super) fn motion_verdicts(r: &StabilityReport, v: &mut Vec<Verdict>) {
             pass: Some(s.mean_fraction <= SHIMMER_BOUND),
         });
     }
+    // Exact shadows have no texels to flicker: away from edges, their still points flip only
+    // where the exact pass and the reference disagree in one frame and not the next (isolated
+    // pixels where the light grazes a surface).
+    for s in r.motion.iter().filter(|s| s.method == "exact") {
+        v.push(Verdict {
+            criterion: format!(
+                "exact shadows: flicker in motion away from edges ≤ {EXACT_MOTION_BOUND:.0e} ({}: {})",
+                s.probe, s.mover
+            ),
+            measured: format!(
+                "mean {:.2e} away from edges, {:.2e} in all",
+                s.mean_interior_fraction, s.mean_fraction
+            ),
+            pass: Some(s.mean_interior_fraction <= EXACT_MOTION_BOUND),
+        });
+    }
     for s in r.motion.iter().filter(|s| s.method.ends_with("held")) {
         let bound = if s.probe == "sun arc" {
             SUN_ARC_BOUND
