@@ -13,10 +13,13 @@
 //    samples and intersects each one's shadow ray with the exact triangle (Moller-Trumbore; the
 //    alpha texture at the hit for masked and blended casters), marking the samples it blocks. No
 //    bias, no texels in the answer: the grid only sorts the work.
+// Hybrid shadows (lib/hybrid.wgsl) keep the map's verdict in step 2 where it is certain, and
+// draw in step 3 only the caster triangles near the samples left.
 // The camera pass reads the result at its pixel where its fragment is the receiver (scene.wgsl).
 // Contact shadows reuse step 1 and replace 2 and 3 by `cs_contact`.
 
 #include "lib/material.wgsl"
+#include "lib/hybrid.wgsl"
 
 struct ExactFrame {
     // The grid: the shadowed light's view (clip space), or a point light's six cube faces, each
@@ -37,6 +40,13 @@ struct ExactFrame {
     contact: vec4<f32>,
     // x: the views (1, or 6 for a point light's cube).
     counts: vec4<f32>,
+    // Hybrid shadows (x = 1; 0 for exact): y = the map's side in texels, z = a texel's world
+    // size (per unit of distance for a spot light).
+    hybrid: vec4<f32>,
+    // The map's casters' lookup rectangle (texels x0, y0, x1, y1): nothing outside it casts.
+    rect: vec4<f32>,
+    // World from the map's clip space.
+    world_from_map: mat4x4<f32>,
 }
 
 const LIGHT_DIRECTIONAL: f32 = 0.0;
@@ -47,6 +57,20 @@ const LIGHT_SPOT: f32 = 2.0;
 const ATTRIBUTE_WORDS: u32 = 13u;
 // A sample whose shadow ray a caster blocks (`samples[i].w`); 1 is lit, -1 no surface.
 const OCCLUDED: f32 = 0.0;
+// Hybrid shadows: a traced sample's verdict, 2 + (1 lit, 0 blocked); 1 and 0 are the map's
+// (the camera pass takes the verdict modulo 2, and its cascade view shows which).
+const TRACED_LIT: f32 = 3.0;
+const TRACED_OCCLUDED: f32 = 2.0;
+// The certainty test's allowance for its own arithmetic, relative to the largest terms (2⁻²⁰:
+// 8 steps of f32's 2⁻²³).
+const ARITHMETIC_ERROR: f32 = 9.5367432e-7;
+// A caster triangle whose smallest height in map texels is below this may fall between the
+// texel centres of a 3×3 footprint: a triangle at least this high holds a disk one texel across
+// (its inradius is at least a third of its smallest height), which holds a texel centre.
+const THIN_TEXELS: f32 = 3.0;
+// Cells per side of a tile of the hybrid method's culling grid (per tile: the farthest along the
+// light of its traced samples' ray origins, `ordered`, 0 for none).
+const TILE_CELLS: u32 = 4u;
 
 @group(0) @binding(0) var<uniform> xf: ExactFrame;
 // Cells 0..n (n = views × g²): each cell's list head (sample + 1, 0 for none); n..2n: the
@@ -63,6 +87,21 @@ const OCCLUDED: f32 = 0.0;
 @group(0) @binding(7) var<storage, read> attributes: array<u32>;
 @group(0) @binding(8) var receiver_position: texture_2d<f32>;
 @group(0) @binding(9) var receiver_normal: texture_2d<f32>;
+// Hybrid shadows: the map (layer 0), and per tile of `TILE_CELLS`² cells the farthest ray origin
+// of its traced samples (written by cs_build, read by cs_cull through `tiles_read`).
+@group(0) @binding(10) var shadow_map: texture_depth_2d_array;
+@group(0) @binding(11) var<storage, read_write> tiles: array<atomic<u32>>;
+@group(0) @binding(12) var<storage, read> tiles_read: array<u32>;
+// Hybrid shadows: the caster triangles cs_cull keeps (each draw's from `pc.extra[1].x`), and each
+// draw's indirect arguments (vertex count, instance count, first vertex, first instance) at
+// `pc.extra[1].y`; vs_caster reads the kept triangles through `kept_read`.
+@group(0) @binding(13) var<storage, read_write> kept: array<u32>;
+@group(0) @binding(14) var<storage, read_write> draw_args: array<atomic<u32>>;
+@group(0) @binding(15) var<storage, read> kept_read: array<u32>;
+// Hybrid shadows: a bit per map texel, set where a caster triangle thinner than `THIN_TEXELS`
+// (or alpha-tested: its holes and edges are the texture's) comes within half a texel (cs_thin):
+// there a texel centre can miss it, and the map proves nothing.
+@group(0) @binding(16) var<storage, read_write> thin: array<atomic<u32>>;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_color_tex: texture_2d<f32>;
@@ -74,7 +113,8 @@ struct ExactImmediates {
     // Receiver pass: x = the ray offset's factors (`math::ray::ray_offset`): xyz the draw's
     // coordinate magnitudes times the relative offset, w the relative offset. Caster
     // pass: x = first index, y = vertex offset (bit-cast i32), z = 1 when the caster's alpha is
-    // tested, w = the view (cube face).
+    // tested, w = the view (cube face); hybrid culling, y (bit-cast u32): x = the draw's first
+    // kept triangle, y = its indirect arguments' index, z = its triangles.
     extra: mat4x4<f32>,
 }
 
@@ -237,7 +277,17 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
     // Off the surface by its ray offset (the receiver pass's normal.w), as the reference's.
     let offset = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).w;
     let origin = ray_origin(id, p, dir, offset);
-    samples[i + 1u] = vec4<f32>(p, 1.0);
+    var unjudged = 1.0;
+    if xf.hybrid.x > 0.5 {
+        let ng = textureLoad(receiver_normal, vec2<i32>(id.xy), 0).xyz;
+        let certain = map_verdict(p, select(-ng, ng, dot(ng, dir) >= 0.0), origin, offset, reach);
+        if certain >= 0.0 {
+            samples[i + 1u] = vec4<f32>(p, certain);
+            return;
+        }
+        unjudged = TRACED_LIT;
+    }
+    samples[i + 1u] = vec4<f32>(p, unjudged);
     rays[i] = vec4<f32>(origin, reach - offset);
     let cell = cell_of(origin);
     let n = cell_count();
@@ -245,6 +295,11 @@ fn cs_build(@builtin(global_invocation_id) id: vec3<u32>) {
         next[i] = atomicExchange(&heads[cell], i + 1u);
         if xf.light.w == LIGHT_DIRECTIONAL {
             atomicMax(&heads[n + cell], ordered(dot(origin, xf.light.xyz)));
+        }
+        if xf.hybrid.x > 0.5 {
+            let g = u32(xf.params.y);
+            let t = vec2<u32>(cell % g, cell / g) / TILE_CELLS;
+            atomicMax(&tiles[t.y * (g / TILE_CELLS) + t.x], ordered(light_depth(origin)));
         }
     }
 }
@@ -374,7 +429,10 @@ fn grown_line(p: array<vec2<f32>, 3>, e: u32, area: f32, half: f32) -> vec3<f32>
 fn vs_caster(@builtin(vertex_index) vi: u32) -> CasterOut {
     var out: CasterOut;
     // Six vertices a triangle: two triangles over the cells its light-view box touches.
-    let tri = vi / 6u;
+    var tri = vi / 6u;
+    if xf.hybrid.x > 0.5 {
+        tri = kept_read[bitcast<u32>(pc.extra[1].x) + tri];
+    }
     let corner = vi % 6u;
     let i0 = vertex_index_of(tri, 0u);
     let i1 = vertex_index_of(tri, 1u);
@@ -459,16 +517,21 @@ fn vs_caster(@builtin(vertex_index) vi: u32) -> CasterOut {
             out.clip = vec4<f32>(grown[0], 0.5, 1.0);
         }
     }
-    // Cells of the box (rows down, as cell_of).
-    out.cells = vec4<f32>(
+    out.cells = box_cells(lo, hi);
+    // The nearest any point of the triangle comes to a directional light.
+    out.depth = min(dot(out.v0, xf.light.xyz), min(dot(out.v1, xf.light.xyz), dot(out.v2, xf.light.xyz)));
+    return out;
+}
+
+// The cells (x0, y0, x1, y1, inclusive; rows down, as cell_of) of the light-view box lo..hi (NDC).
+fn box_cells(lo: vec2<f32>, hi: vec2<f32>) -> vec4<f32> {
+    let g = xf.params.y;
+    return vec4<f32>(
         floor((lo.x * 0.5 + 0.5) * g),
         floor((0.5 - hi.y * 0.5) * g),
         floor((hi.x * 0.5 + 0.5) * g),
         floor((0.5 - lo.y * 0.5) * g),
     );
-    // The nearest any point of the triangle comes to a directional light.
-    out.depth = min(dot(out.v0, xf.light.xyz), min(dot(out.v1, xf.light.xyz), dot(out.v2, xf.light.xyz)));
-    return out;
 }
 
 @fragment
@@ -487,6 +550,7 @@ fn fs_caster(in: CasterOut) {
     let e1 = in.v1 - in.v0;
     let e2 = in.v2 - in.v0;
     let tested = pc.extra[0].z > 0.5;
+    let blocked_verdict = select(OCCLUDED, TRACED_OCCLUDED, xf.hybrid.x > 0.5);
     var s = atomicLoad(&heads[c]);
     loop {
         if s == 0u {
@@ -494,7 +558,7 @@ fn fs_caster(in: CasterOut) {
         }
         let i = s - 1u;
         s = next[i];
-        if samples[i + 1u].w == OCCLUDED {
+        if samples[i + 1u].w == blocked_verdict {
             continue;
         }
         let ray = rays[i];
@@ -533,6 +597,6 @@ fn fs_caster(in: CasterOut) {
                 continue;
             }
         }
-        samples[i + 1u].w = OCCLUDED;
+        samples[i + 1u].w = blocked_verdict;
     }
 }

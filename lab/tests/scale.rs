@@ -209,8 +209,9 @@ fn truth_frame(scale: f64) -> ReferenceFrame {
     }
 }
 
-/// One scale's scores against the truth: the maps, the exact method and the CPU reference.
-fn measure(scale: f32) -> [Score; 3] {
+/// One scale's scores against the truth: the maps, the exact method, the hybrid one and the CPU
+/// reference.
+fn measure(scale: f32) -> [Score; 4] {
     let (scene, camera) = town(scale);
     let truth = truth_frame(scale as f64);
     let ctx = context();
@@ -219,10 +220,11 @@ fn measure(scale: f32) -> [Score; 3] {
     let mut view = View::new(camera);
     view.mode = ViewMode::Shadow;
     let mut gpu = Vec::new();
-    for method in [ShadowMethod::Map, ShadowMethod::Exact] {
+    for method in [ShadowMethod::Map, ShadowMethod::Exact, ShadowMethod::Hybrid] {
         view.shadow.method = method;
         let f = r.render(&view, W, H).unwrap();
-        assert_eq!(f.plan.exact_shadows(), method == ShadowMethod::Exact);
+        assert_eq!(f.plan.exact_shadows(), method.traces());
+        assert_eq!(f.plan.hybrid_shadows(), method == ShadowMethod::Hybrid);
         let c = classify(&f.image, f.depth.as_deref().unwrap(), &f.plan, &truth);
         assert!(
             c.coverage_mismatch < 200,
@@ -253,7 +255,7 @@ fn measure(scale: f32) -> [Score; 3] {
             _ => PixelClass::Unjudged,
         })
         .collect();
-    [gpu[0].0, gpu[1].0, score(&class, edge)]
+    [gpu[0].0, gpu[1].0, gpu[2].0, score(&class, edge)]
 }
 
 /// The scale table: maps, exact and the reference against the analytic truth at 0.001, 1 and
@@ -265,10 +267,10 @@ fn measure(scale: f32) -> [Score; 3] {
 #[test]
 fn shadows_are_the_same_at_every_scale() {
     let scales = [0.001f32, 1.0, 1000.0];
-    let rows: Vec<[Score; 3]> = scales.iter().map(|&s| measure(s)).collect();
+    let rows: Vec<[Score; 4]> = scales.iter().map(|&s| measure(s)).collect();
     println!("scale   | method    | misclassified | away from edges | judged");
     for (s, row) in scales.iter().zip(&rows) {
-        for (name, sc) in ["map", "exact", "reference"].iter().zip(row) {
+        for (name, sc) in ["map", "exact", "hybrid", "reference"].iter().zip(row) {
             println!(
                 "{s:>7} | {name:<9} | {:>12.4}% | {:>14.4}% | {}",
                 sc.all * 100.0,
@@ -277,11 +279,13 @@ fn shadows_are_the_same_at_every_scale() {
             );
         }
     }
-    for (s, [map, exact, reference]) in scales.iter().zip(&rows) {
+    for (s, [map, exact, hybrid, reference]) in scales.iter().zip(&rows) {
         assert!(
-            exact.all <= 1e-4 && reference.all <= 1e-4,
-            "×{s}: exact {:.4}%, reference {:.4}% of pixels disagree with the truth (bound 0.01 %)",
+            exact.all <= 1e-4 && hybrid.all <= 1e-4 && reference.all <= 1e-4,
+            "×{s}: exact {:.4}%, hybrid {:.4}%, reference {:.4}% of pixels disagree with the \
+             truth (bound 0.01 %)",
             exact.all * 100.0,
+            hybrid.all * 100.0,
             reference.all * 100.0
         );
         assert!(exact.judged > 150_000, "×{s}: only {} judged", exact.judged);

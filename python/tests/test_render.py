@@ -271,6 +271,9 @@ def test_settings_act_like_the_command_line_options(renderer):
     shadowed = ((exact == 0.0) & surface).sum(), ((base["shadow"] < 0.5) & surface).sum()
     # Measured: 11 pixels in shadow in both (the card's thin shadow at this distance).
     assert shadowed[0] >= 8 and abs(shadowed[0] - shadowed[1]) <= 2, shadowed
+    # Hybrid shadows: the exact verdicts (measured: identical at every pixel).
+    hybrid = renderer.render(scene, camera, pose, outputs=("shadow",), shadow_method="hybrid")
+    assert np.array_equal(hybrid["shadow"], exact)
     # Contact shadows only darken (measured: no pixel of this frame changes at 0.5).
     contact = renderer.render(scene, camera, pose, outputs=("shadow",), contact_shadows=True)
     assert ((contact["shadow"] > 0.5) & (base["shadow"] <= 0.5)).sum() == 0

@@ -41,8 +41,8 @@ struct Texels {
     emissive: vec3<f32>,
 }
 
-// The verdict on the shadowed light at the pixel `frag` (1 lit, 0 blocked; -1 none: the maps
-// decide) when the point `p` shaded there is the receiver it was made for (the same position: the
+// The verdict on the shadowed light at the pixel `frag` (1 lit, 0 blocked, plus 2 where hybrid
+// shadows traced it; -1 none: the maps decide) when the point `p` shaded there is the receiver it was made for (the same position: the
 // camera pass and the receiver pass transform alike); -1 otherwise.
 fn exact_verdict(p: vec3<f32>, frag: vec2<f32>) -> f32 {
     let size = exact_samples[0].xy;
@@ -143,8 +143,10 @@ fn shade_texels(in: VsOut, front_facing: bool, base: vec4<f32>, texels: Texels) 
                 verdict = exact_verdict(p, in.clip.xy);
             }
             if verdict >= 0.0 {
-                vis *= verdict;
-                cascade = 0;
+                // Hybrid shadows mark traced verdicts 2 + verdict: the cascade view shows them
+                // as view 1, the map's as view 0.
+                vis *= verdict % 2.0;
+                cascade = select(0, 1, verdict >= 2.0);
             } else if MANY_VIEWS {
                 // Each light its own views.
                 let first = i32(light.shadow.x);

@@ -20,7 +20,8 @@ pub enum Access {
     DepthResolve,
     /// Sampled in a fragment shader (colour textures).
     FragmentSampled,
-    /// A depth image sampled in a fragment shader (shadow map lookups).
+    /// A depth image sampled in a fragment or compute shader (shadow map lookups; the hybrid
+    /// method's certainty test).
     DepthFragmentSampled,
     /// Sampled (read with `textureLoad`) in a compute shader.
     ComputeSampled,
@@ -70,7 +71,7 @@ pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk:
             vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
         ),
         Access::DepthFragmentSampled => (
-            S::FRAGMENT_SHADER,
+            S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
             A::SHADER_SAMPLED_READ,
             vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
         ),

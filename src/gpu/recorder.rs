@@ -109,6 +109,20 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// `vkCmdDrawIndirect`.
+    pub fn draw_indirect(
+        &self,
+        buffer: vk::Buffer,
+        offset: vk::DeviceSize,
+        draw_count: u32,
+        stride: u32,
+    ) {
+        unsafe {
+            self.d
+                .cmd_draw_indirect(self.cmd, buffer, offset, draw_count, stride)
+        }
+    }
+
     /// `vkCmdPushConstants`.
     pub fn push_constants(
         &self,

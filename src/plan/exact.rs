@@ -2,8 +2,6 @@
 //! shown light's visibility per pixel with shadow rays (exact shadows) or marches short rays
 //! beside the maps (contact shadows), and what the exact pass needs to do it.
 
-use super::settings::ShadowMethod;
-
 use super::view::View;
 use glam::{Mat4, Vec3};
 
@@ -55,10 +53,26 @@ pub struct ExactPlan {
     pub receivers: Vec<usize>,
     /// Draws that cast.
     pub casters: Vec<usize>,
+    /// Hybrid shadows ([`crate::plan::ShadowMethod::Hybrid`]): the map's verdict kept where it is certain,
+    /// only the other pixels traced (one light view: directional or spot).
+    pub hybrid: Option<HybridPlan>,
+}
+
+/// What the hybrid method reads of the map behind it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HybridPlan {
+    /// World from the map's clip space (the inverse of `ExactPlan::views[0]`).
+    pub world_from_clip: Mat4,
+    /// The map's side in texels.
+    pub map_size: u32,
+    /// The casters' rectangle in the map (texels: x0, y0, x1, y1): nothing outside it is shadowed.
+    pub rect: [f32; 4],
+    /// A texel's world size (at unit distance for a spot light).
+    pub texel_world: f32,
 }
 
 /// Whether `view` asks for exact shadows and a device that can run the exact pass
 /// (`capable`: fragment-shader stores) draws them.
 pub(crate) fn exact_asked(view: &View, capable: bool) -> bool {
-    view.shadow.enabled && view.shadow.method == ShadowMethod::Exact && capable
+    view.shadow.enabled && view.shadow.method.traces() && capable
 }

@@ -135,6 +135,19 @@ pub enum ShadowMethod {
     /// per cube face); frames with several shadowed lights, and devices without fragment-shader
     /// stores, use maps. Hard: a light's size is ignored.
     Exact,
+    /// Exact shadows where the map cannot prove its answer (`docs/exact-shadows.md`, *Hybrid*):
+    /// a pixel whose nine nearest map texels all agree, by a margin, with the light depth of
+    /// its own surface keeps the map's verdict; the others are traced as [`ShadowMethod::Exact`]
+    /// traces them, against only the casters that reach their cells. Directional and spot
+    /// lights; a point light's cube is traced whole.
+    Hybrid,
+}
+
+impl ShadowMethod {
+    /// Whether shadow rays decide some pixels (exact or hybrid).
+    pub fn traces(self) -> bool {
+        self != Self::Map
+    }
 }
 
 impl std::str::FromStr for ShadowMethod {
@@ -143,7 +156,8 @@ impl std::str::FromStr for ShadowMethod {
         match s.to_ascii_lowercase().as_str() {
             "map" => Ok(Self::Map),
             "exact" => Ok(Self::Exact),
-            _ => Err(format!("shadow method '{s}' is not map or exact")),
+            "hybrid" => Ok(Self::Hybrid),
+            _ => Err(format!("shadow method '{s}' is not map, exact or hybrid")),
         }
     }
 }

@@ -195,13 +195,17 @@ impl FrameCore {
         if post_aa {
             self.post.ensure(extent)?;
         }
+        let shadow = ShadowSettings {
+            slope_bias: plan.slope_bias,
+            ..view.shadow
+        };
         Ok(Prepared {
             post_aa,
             plan,
             camera,
             extent,
             slot,
-            shadow: view.shadow,
+            shadow,
             mode: view.mode,
         })
     }
@@ -217,8 +221,13 @@ impl FrameCore {
         if self.exact.is_none() {
             self.exact = Some(ExactPass::new(&self.ctx, &self.gpu, self.slots)?);
         }
+        let map = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         let pass = self.exact.as_mut().expect("made above");
         pass.ensure(&self.gpu, extent)?;
+        pass.bind_map(slot, map);
+        if exact.hybrid.is_some() {
+            pass.ensure_culling(&self.gpu, exact)?;
+        }
         pass.write_frame(slot, exact)
     }
 

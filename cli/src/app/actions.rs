@@ -37,7 +37,7 @@ pub enum Action {
     CycleTonemap,
     /// FXAA on/off (`Y`; `View::post_aa`).
     ToggleFxaa,
-    /// Shadow maps ↔ exact shadows (`M`; `ShadowSettings::method`).
+    /// Shadow maps → exact → hybrid shadows (`M`; `ShadowSettings::method`).
     ToggleMethod,
     /// Contact shadows on/off (`B`; `ShadowSettings::contact`).
     ToggleContact,
@@ -157,7 +157,8 @@ fn step(a: Action, view: &View, sun: &mut SunAngles) -> Option<Action> {
         }),
         Action::ToggleMethod => Action::SetMethod(match view.shadow.method {
             ShadowMethod::Map => ShadowMethod::Exact,
-            ShadowMethod::Exact => ShadowMethod::Map,
+            ShadowMethod::Exact => ShadowMethod::Hybrid,
+            ShadowMethod::Hybrid => ShadowMethod::Map,
         }),
         Action::ExposureUp | Action::ExposureDown => {
             let step = if a == Action::ExposureUp { 0.5 } else { -0.5 };
@@ -254,6 +255,9 @@ fn apply_set(a: Action, view: &mut View, sun: &mut SunAngles) -> Option<String> 
                 ShadowMethod::Map => "shadows: maps".to_string(),
                 ShadowMethod::Exact => {
                     "shadows: exact (one shadowed light; maps otherwise)".to_string()
+                }
+                ShadowMethod::Hybrid => {
+                    "shadows: hybrid (the map where it is certain, traced elsewhere)".to_string()
                 }
             }
         }
@@ -422,6 +426,8 @@ mod tests {
         assert!(!v.shadow.contact);
         assert!(apply(Action::ToggleMethod, &mut v, &mut sun).contains("exact"));
         assert_eq!(v.shadow.method, ShadowMethod::Exact);
+        assert!(apply(Action::ToggleMethod, &mut v, &mut sun).contains("hybrid"));
+        assert_eq!(v.shadow.method, ShadowMethod::Hybrid);
         apply(Action::ToggleMethod, &mut v, &mut sun);
         assert_eq!(v.shadow.method, ShadowMethod::Map);
         apply(Action::ExposureUp, &mut v, &mut sun);

@@ -62,7 +62,9 @@ pub(crate) fn compare(a: CompareArgs) -> anyhow::Result<()> {
     j["scene"] = serde_json::json!(scene.name);
     j["size"] = serde_json::json!([w, h]);
     j["shadow_map"] = serde_json::json!(view.shadow.map_size);
-    j["shadow_method"] = serde_json::json!(if lit.plan.exact_shadows() {
+    j["shadow_method"] = serde_json::json!(if lit.plan.hybrid_shadows() {
+        "hybrid"
+    } else if lit.plan.exact_shadows() {
         "exact"
     } else if lit.plan.contact_shadows() {
         "map+contact"

@@ -230,6 +230,7 @@ fn shadow_section(ui: &mut egui::Ui, m: &PanelModel, out: &mut Vec<Command>, w: 
             let methods = [
                 (ShadowMethod::Map, "maps".to_string()),
                 (ShadowMethod::Exact, "exact".into()),
+                (ShadowMethod::Hybrid, "hybrid".into()),
             ];
             if let Some(m) = choice(ui, w, "shadow method (M)", "method", s.method, &methods) {
                 out.push(Command::Set(Action::SetMethod(m)));

@@ -16,7 +16,7 @@ pub const ZERO_ERROR_FLOOR: f64 = 1e-6;
 /// Chart size in pixels.
 pub const SIZE: (u32, u32) = (1100, 720);
 
-const METHODS: [(&str, RGBColor); 7] = [
+const METHODS: [(&str, RGBColor); 8] = [
     ("scene", RGBColor(150, 150, 150)),
     ("camera", RGBColor(31, 119, 180)),
     ("cascades2", RGBColor(44, 160, 44)),
@@ -24,6 +24,7 @@ const METHODS: [(&str, RGBColor); 7] = [
     ("auto", RGBColor(148, 103, 189)),
     ("sdsm4", RGBColor(255, 127, 14)),
     ("exact", RGBColor(0, 0, 0)),
+    ("hybrid", RGBColor(190, 30, 160)),
 ];
 
 /// A chart that could not be drawn or written.
@@ -48,10 +49,10 @@ fn register_font() {
 }
 
 /// A configuration's short label: map size, filter, fitting, and format and bias when not the
-/// defaults (`2048 pcf2x2 cascades4`, `4096 nearest scene d16 bias:low`); `exact` for exact
-/// shadows (whose map only the pixels they do not judge read).
+/// defaults (`2048 pcf2x2 cascades4`, `4096 nearest scene d16 bias:low`); `exact` and `hybrid`
+/// for exact and hybrid shadows (whose map only the pixels they do not trace read).
 fn label(map: u32, filter: &str, method: &str, format: &str, bias: &str) -> String {
-    if method == "exact" {
+    if method == "exact" || method == "hybrid" {
         return method.into();
     }
     let mut s = format!("{map} {filter} {method}");
@@ -287,6 +288,7 @@ where
             .draw_series(
                 of("exact")
                     .into_iter()
+                    .chain(of("hybrid"))
                     .map(|p| EmptyElement::at(p) + Rectangle::new([(-6, -6), (6, 6)], fill)),
             )
             .map_err(e)?;
@@ -303,7 +305,7 @@ where
         ("PCF 3x3", 2),
         ("PCF 5x5", 3),
         ("PCSS", 4),
-        ("exact", 5),
+        ("exact, hybrid", 5),
         ("PCF 2x2 + contact", 6),
     ] {
         chart

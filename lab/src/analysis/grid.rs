@@ -39,10 +39,21 @@ impl Config {
         }
     }
 
+    /// Hybrid shadows (`ShadowMethod::Hybrid`): exact shadows' settings, the map's verdict kept
+    /// where it is certain.
+    pub fn hybrid(map_size: u32) -> Self {
+        let mut c = Self::exact(map_size);
+        c.shadow.method = ShadowMethod::Hybrid;
+        c
+    }
+
     /// The fitting method, the chart's colour: `scene`, `camera`, `cascades2`, `cascades4`…
+    /// (`exact`, `hybrid`).
     pub fn method(&self) -> String {
-        if self.shadow.method == ShadowMethod::Exact {
-            return "exact".into();
+        match self.shadow.method {
+            ShadowMethod::Exact => return "exact".into(),
+            ShadowMethod::Hybrid => return "hybrid".into(),
+            ShadowMethod::Map => {}
         }
         if self.shadow.depth_fit {
             return format!("sdsm{}", self.shadow.cascades);
@@ -54,6 +65,8 @@ impl Config {
     pub fn filter(&self) -> &'static str {
         if self.shadow.method == ShadowMethod::Exact {
             "exact"
+        } else if self.shadow.method == ShadowMethod::Hybrid {
+            "hybrid"
         } else if self.shadow.contact {
             "contact"
         } else if self.pcss {
@@ -128,8 +141,9 @@ pub struct Grid {
     /// Also PCSS (filter `pcss`, for every map, format, bias and fitting), the other
     /// configurations then hard whatever the lights' sizes.
     pub pcss: bool,
-    /// Also exact shadows (`ShadowMethod::Exact`, method and filter `exact`): one configuration,
-    /// at the largest map of `maps` (which only the pixels the exact pass does not judge read).
+    /// Also exact and hybrid shadows (`ShadowMethod::Exact` and `Hybrid`, method and filter
+    /// `exact` and `hybrid`): a configuration each, at the largest map of `maps` (which only the
+    /// pixels they do not trace read).
     pub exact: bool,
     /// Also contact shadows over the default maps (`ShadowSettings::contact`, filter
     /// `contact`): one configuration, at the largest map of `maps`.
@@ -220,6 +234,7 @@ impl Grid {
         let largest = self.maps.iter().copied().max().unwrap_or(2048);
         if self.exact {
             out.push(Config::exact(largest));
+            out.push(Config::hybrid(largest));
         }
         if self.contact {
             out.push(Config {
@@ -325,18 +340,22 @@ mod tests {
     }
 
     #[test]
-    fn exact_and_contact_shadows_join_the_grid_as_one_configuration_each() {
+    fn exact_hybrid_and_contact_shadows_join_the_grid_as_one_configuration_each() {
         let g = Grid {
             exact: true,
             ..Grid::quick()
         };
         let all = g.configs();
-        assert_eq!(all.len(), Grid::quick().configs().len() + 1);
+        assert_eq!(all.len(), Grid::quick().configs().len() + 2);
         let exact: Vec<_> = all.iter().filter(|c| c.method() == "exact").collect();
         assert_eq!(exact.len(), 1);
         assert_eq!(exact[0].filter(), "exact");
         assert_eq!(exact[0].shadow.method, ShadowMethod::Exact);
         assert_eq!(exact[0].name(), "4096-auto-exact-exact-default");
+        let hybrid: Vec<_> = all.iter().filter(|c| c.method() == "hybrid").collect();
+        assert_eq!(hybrid.len(), 1);
+        assert_eq!(hybrid[0].shadow.method, ShadowMethod::Hybrid);
+        assert_eq!(hybrid[0].name(), "4096-auto-hybrid-hybrid-default");
         let g = Grid {
             contact: true,
             ..Grid::quick()

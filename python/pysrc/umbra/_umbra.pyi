@@ -174,7 +174,8 @@ class OffscreenRenderer:
         (float32 (H, W, 3), world) and shadow (float32 (H, W): the first shadowed light's
         visibility, or shadow_light's). Settings: shadows, shadow_map, shadow_format ('auto',
         'd32', 'd16'), shadow_method ('map', 'exact': each pixel's shadow ray tested against
-        the caster triangles), contact_shadows (bool: creases finer than a texel), pcf ('none', '2x2', '3x3', '5x5'), cascades (0 = automatic), depth_fit, fit
+        the caster triangles, 'hybrid': the same verdicts, tracing only what the map cannot
+        prove), contact_shadows (bool: creases finer than a texel), pcf ('none', '2x2', '3x3', '5x5'), cascades (0 = automatic), depth_fit, fit
         ('camera', 'sphere', 'scene'), bias_constant, bias_slope, normal_offset, shadow_budget
         (misclassified pixels, %), shadow_light, light_size, exposure ('auto', an EV100, or
         'x1.5'), tonemap ('neutral', 'aces', 'none'), post_aa ('none', 'fxaa'), supersample (1, 2), ambient, background ('sky', '#rrggbb' or an

@@ -4,12 +4,15 @@
 
 use super::FramePlan;
 use crate::plan::casters::Viewpoint;
-use crate::plan::exact::{exact_asked, ExactMode, ExactPlan, CONTACT_TEXELS, CONTACT_THICKNESS};
+use crate::plan::exact::{
+    exact_asked, ExactMode, ExactPlan, HybridPlan, CONTACT_TEXELS, CONTACT_THICKNESS,
+};
 use crate::plan::input::PlanScene;
 use crate::plan::reach::ShadowReach;
 use crate::plan::settings::ViewMode;
 use crate::plan::sight::Sight;
 use crate::plan::view::View;
+use crate::plan::ShadowMethod;
 use crate::scene::LightKind;
 use crate::shader_consts::VariantKey;
 
@@ -62,7 +65,19 @@ pub(super) fn choose_exact(
     };
     let cam = &view.camera;
     let half = cam.half_extent_at(cam.near, aspect);
+    let hybrid =
+        (mode == ExactMode::Exact && views == 1 && view.shadow.method == ShadowMethod::Hybrid)
+            .then(|| {
+                let v = &plan.shadow_views[first];
+                HybridPlan {
+                    world_from_clip: v.light_clip_from_world.as_dmat4().inverse().as_mat4(),
+                    map_size: v.casters.size,
+                    rect: v.casters.lookup.to_array(),
+                    texel_world: v.texel_world,
+                }
+            });
     Some(ExactPlan {
+        hybrid,
         mode,
         views: plan
             .shadow_views

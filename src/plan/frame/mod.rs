@@ -6,7 +6,7 @@ use super::casters::{plan_casters, Viewpoint};
 use super::exact::{exact_asked, ExactMode, ExactPlan};
 use super::input::{PlanScene, PlanTarget};
 use super::lights::{effective_lights, light_uniforms, metering};
-use super::settings::{Pcf, ShadowFormat, ShadowSettings, Tonemap, ViewMode};
+use super::settings::{Pcf, ShadowFormat, ShadowMethod, ShadowSettings, Tonemap, ViewMode};
 use super::sight::Sight;
 use super::uniforms::{FrameUniform, MAX_LIGHTS};
 use super::view::{Ambient, Background, Exposure, HeldLight, ShadowHold, View};
@@ -32,6 +32,9 @@ pub struct FramePlan {
     pub soft: bool,
     /// The shadow map's depth format (`ShadowFormat::Auto` resolved: never `Auto`).
     pub shadow_format: ShadowFormat,
+    /// The slope-scaled depth bias the shadow pass draws with (`ShadowSettings::slope_bias`; 0
+    /// for hybrid shadows, whose map must hold the casters' own depths).
+    pub slope_bias: f32,
     /// The camera's world position.
     pub camera_position: Vec3,
     /// Whether the camera projects in parallel (every pixel seen along its forward direction).
@@ -207,6 +210,12 @@ impl FramePlan {
     /// ([`crate::plan::ShadowMethod::Exact`]) rather than its map.
     pub fn exact_shadows(&self) -> bool {
         matches!(&self.exact, Some(e) if e.mode == ExactMode::Exact)
+    }
+
+    /// Whether this frame's exact shadows are hybrid: the map's verdict kept where it is
+    /// certain ([`crate::plan::ShadowMethod::Hybrid`]).
+    pub fn hybrid_shadows(&self) -> bool {
+        matches!(&self.exact, Some(e) if e.hybrid.is_some())
     }
 
     /// Whether contact shadows darkened the shown light's creases this frame
@@ -391,6 +400,7 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         shadows_on,
         soft,
         shadow_format,
+        slope_bias: view.shadow.slope_bias,
         camera_position: view.camera.position(),
         orthographic: view.camera.is_orthographic(),
         exact: None,
@@ -432,7 +442,9 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
 /// `view` as the plan reads it: the map size settled (the one place: clamped into
 /// `ShadowSettings::MAP_SIZES`, 1 without shadows; the layers' side,
 /// `FramePlan::shadow_map_size`, follows from it), and with exact shadows on a device that
-/// draws them one view (the map's single cascade, for the pixels they do not judge), hard.
+/// draws them one view (the map's single cascade, for the pixels they do not judge), hard; for
+/// hybrid shadows, whose certainty test reads the casters' own depths from the map, that map in
+/// D32 without slope bias.
 fn settled(view: &View, target: &PlanTarget) -> View {
     let mut v = view.clone();
     v.shadow.map_size = if view.shadow.enabled {
@@ -443,6 +455,10 @@ fn settled(view: &View, target: &PlanTarget) -> View {
     if exact_asked(view, target.exact_capable) {
         v.shadow.cascades = 1;
         v.shadow.soft = false;
+        if view.shadow.method == ShadowMethod::Hybrid {
+            v.shadow.slope_bias = 0.0;
+            v.shadow.format = ShadowFormat::D32;
+        }
     }
     v
 }

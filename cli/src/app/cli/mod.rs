@@ -113,8 +113,8 @@ pub struct SweepArgs {
     /// Also 4 cascades fitted to the depths each view sees (method `sdsm4`).
     #[arg(long)]
     pub depth_fit: bool,
-    /// Also exact shadows (`--shadow-method exact`: method and filter `exact`), one
-    /// configuration.
+    /// Also exact and hybrid shadows (`--shadow-method exact` and `hybrid`: method and filter
+    /// `exact` and `hybrid`), a configuration each.
     #[arg(long)]
     pub exact: bool,
     /// Also contact shadows over the default maps (`--contact-shadows`: filter `contact`), one

@@ -142,8 +142,7 @@ pub fn print_warning(scene: &str, w: &umbra::scene::Warning) {
 /// Warns when `view` asked for exact shadows and the frame planned as `plan` could not have
 /// them (it has several shadowed lights, or the device no fragment-shader stores).
 pub fn warn_exact(view: &View, plan: &umbra::FramePlan) {
-    if view.shadow.method == umbra::ShadowMethod::Exact && plan.shadows_on && !plan.exact_shadows()
-    {
+    if view.shadow.method.traces() && plan.shadows_on && !plan.exact_shadows() {
         eprintln!(
             "warning: --shadow-method exact: {} shadow view(s) (exact shadows need one shadowed \
              light, and a device with fragment-shader stores); shadow maps used",

@@ -98,10 +98,11 @@ pub struct ViewArgs {
     /// bias (a directional light's maps, most scenes), else D32.
     #[arg(long, value_parser = ["auto", "d32", "d16"], default_value = "auto")]
     pub shadow_format: String,
-    /// How shadows are decided: `map` (shadow maps, the default) or `exact` (each pixel's shadow
+    /// How shadows are decided: `map` (shadow maps, the default), `exact` (each pixel's shadow
     /// ray tested against the caster triangles on the device: exact hard shadows, no bias; one
-    /// shadowed light, else maps).
-    #[arg(long, value_parser = ["map", "exact"], default_value = "map")]
+    /// shadowed light, else maps) or `hybrid` (the map's verdict where its texels prove it, shadow
+    /// rays elsewhere).
+    #[arg(long, value_parser = ["map", "exact", "hybrid"], default_value = "map")]
     pub shadow_method: String,
     /// Contact shadows over the maps: each pixel's shadow ray marched 8 texels towards the shown
     /// light through the depth the camera sees (contact detail finer than a texel; hard shadows

@@ -18,6 +18,7 @@
 //! The images and buffers are made on first use and remade when the image size changes; they are
 //! shared by the frames in flight (each frame's barriers order it after the previous one's use).
 
+mod cull;
 mod record;
 mod targets;
 
@@ -65,6 +66,10 @@ fn grid_side(views: usize) -> u32 {
     }
 }
 
+/// Words of the hybrid method's culling tiles: one per tile of 4² cells of a `GRID`² grid
+/// (`TILE_CELLS` of `shaders/exact.wgsl`).
+const TILE_WORDS: u64 = (GRID as u64 / 4).pow(2);
+
 const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
@@ -79,6 +84,9 @@ struct ExactFrame {
     eye: Vec4,
     contact: Vec4,
     counts: Vec4,
+    hybrid: Vec4,
+    rect: Vec4,
+    world_from_map: Mat4,
 }
 
 /// `ExactImmediates` of `shaders/exact.wgsl`.
@@ -102,6 +110,8 @@ struct Targets {
     next: Buffer,
     samples: Buffer,
     rays: Buffer,
+    /// Hybrid shadows: a bit per tile of cells holding a traced sample.
+    tiles: Buffer,
 }
 
 /// The exact shadow pass.
@@ -121,6 +131,10 @@ pub struct ExactPass {
     /// A buffer the camera pass binds when no frame has run the pass (its binding must be
     /// written); shaped like an empty sample list.
     empty: Buffer,
+    /// The shadow map view each slot's set holds.
+    bound_map: Vec<vk::ImageView>,
+    /// Hybrid shadows' caster culling.
+    culling: cull::Culling,
 }
 
 impl ExactPass {
@@ -175,6 +189,8 @@ impl ExactPass {
             uniforms,
             targets: None,
             empty,
+            bound_map: vec![vk::ImageView::null(); slots],
+            culling: cull::Culling::new(ctx, set_layout, module)?,
         })
     }
 
@@ -183,6 +199,37 @@ impl ExactPass {
         self.targets
             .as_ref()
             .map_or(self.empty.raw, |t| t.samples.raw)
+    }
+
+    /// Grows the hybrid method's culling buffers to `f`'s casters (rewriting every slot's
+    /// bindings when they are made anew).
+    pub fn ensure_culling(&mut self, scene: &GpuScene, f: &ExactPlan) -> Result<(), GpuError> {
+        if self.culling.ensure(scene, f)? {
+            for &set in &self.sets {
+                write_buffers(&self.ctx, set, &self.culling.bindings());
+            }
+        }
+        Ok(())
+    }
+
+    /// Points slot `slot`'s set at the shadow map `map` (a depth array view; its previous frame
+    /// must have completed). Hybrid shadows read layer 0; the binding is written for every frame.
+    pub fn bind_map(&mut self, slot: usize, map: vk::ImageView) {
+        if self.bound_map[slot] == map || self.targets.is_none() {
+            return;
+        }
+        let info = [vk::DescriptorImageInfo {
+            sampler: vk::Sampler::null(),
+            image_view: map,
+            image_layout: vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
+        }];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.sets[slot])
+            .dst_binding(sh::SHADOW_MAP.binding)
+            .descriptor_type(sh::SHADOW_MAP.descriptor_type())
+            .image_info(&info);
+        unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
+        self.bound_map[slot] = map;
     }
 
     /// Writes slot `slot`'s frame uniform (its previous frame must have completed).
@@ -199,7 +246,13 @@ impl ExactPass {
                 margin,
             } => (length, thickness, margin),
         };
+        let h = f.hybrid.as_ref();
         let u = ExactFrame {
+            hybrid: h.map_or(Vec4::ZERO, |h| {
+                Vec4::new(1.0, h.map_size as f32, h.texel_world, 0.0)
+            }),
+            rect: h.map_or(Vec4::ZERO, |h| Vec4::from_array(h.rect)),
+            world_from_map: h.map_or(Mat4::IDENTITY, |h| h.world_from_clip),
             camera_clip: f.clip_from_world,
             eye: f.eye.0.extend(1.0),
             contact: Vec4::new(length, 0.0, thickness, 0.0),
@@ -219,6 +272,36 @@ impl ExactPass {
         };
         self.uniforms[slot].write(0, bytemuck::bytes_of(&u))
     }
+}
+
+/// Writes storage and uniform buffer `bindings` of `set` (the whole of each buffer).
+fn write_buffers(
+    ctx: &Context,
+    set: vk::DescriptorSet,
+    bindings: &[(&crate::gpu::shaders::ReflectedBinding, &Buffer)],
+) {
+    let infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
+        .iter()
+        .map(|(_, b)| {
+            [vk::DescriptorBufferInfo {
+                buffer: b.raw,
+                offset: 0,
+                range: vk::WHOLE_SIZE,
+            }]
+        })
+        .collect();
+    let writes: Vec<vk::WriteDescriptorSet> = bindings
+        .iter()
+        .zip(&infos)
+        .map(|((b, _), info)| {
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(b.binding)
+                .descriptor_type(b.descriptor_type())
+                .buffer_info(info)
+        })
+        .collect();
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 
 /// The receivers' pipeline (world positions and normals into two targets, depth-tested) and the

@@ -28,8 +28,8 @@ impl ExactPass {
             d,
             cmd,
             (
-                S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
-                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                S::DRAW_INDIRECT | S::VERTEX_SHADER | S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
+                A::INDIRECT_COMMAND_READ | A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
             ),
             (
                 S::ALL_TRANSFER | S::COMPUTE_SHADER,
@@ -37,6 +37,10 @@ impl ExactPass {
             ),
         );
         Recorder::new(d, cmd).fill_buffer(t.heads.raw, 0, vk::WHOLE_SIZE, 0);
+        if f.hybrid.is_some() {
+            Recorder::new(d, cmd).fill_buffer(t.tiles.raw, 0, vk::WHOLE_SIZE, 0);
+            self.culling.clear(cmd);
+        }
         self.record_receivers(cmd, set, scene, f, &mut t);
         let groups = (t.extent.width.div_ceil(8), t.extent.height.div_ceil(8));
         if let ExactMode::Contact { .. } = f.mode {
@@ -57,8 +61,25 @@ impl ExactPass {
             self.targets = Some(t);
             return;
         }
+        if f.hybrid.is_some() {
+            // After the fills (the binning barrier's first half orders them first).
+            memory_barrier(
+                d,
+                cmd,
+                (S::ALL_TRANSFER, A::TRANSFER_WRITE),
+                (
+                    S::COMPUTE_SHADER,
+                    A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                ),
+            );
+            self.culling.record_thin(cmd, set, scene, f);
+        }
         self.record_binning(cmd, set, groups);
-        self.record_casters(cmd, set, scene, f);
+        let kept = f
+            .hybrid
+            .is_some()
+            .then(|| self.culling.record(cmd, set, scene, f));
+        self.record_casters(cmd, set, scene, f, kept.as_deref());
         self.targets = Some(t);
     }
 
@@ -165,13 +186,15 @@ impl ExactPass {
     }
 
     /// Step 3: the casters drawn into the grid (no attachments: the fragments only test and mark
-    /// the rays they hit), then made visible to the camera pass's fragments.
+    /// the rays they hit), then made visible to the camera pass's fragments. With `kept` (hybrid
+    /// shadows: each draw's first kept triangle), only the triangles culling kept, indirectly.
     fn record_casters(
         &self,
         cmd: vk::CommandBuffer,
         set: vk::DescriptorSet,
         scene: &GpuScene,
         f: &ExactPlan,
+        kept: Option<&[u32]>,
     ) {
         let ctx = &self.ctx;
         let d = &ctx.device;
@@ -199,7 +222,7 @@ impl ExactPass {
         set_viewport(ctx, cmd, grid);
         Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
         Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
-        for &i in &f.casters {
+        for (slot, &i) in f.casters.iter().enumerate() {
             let dr = &scene.draws[i].shadow_caster();
             scene.bind_material(d, cmd, self.layout, 1, dr.material);
             for view in 0..f.views.len() {
@@ -214,6 +237,9 @@ impl ExactPass {
                     },
                     view as f32,
                 );
+                if let Some(kept) = kept {
+                    extra.y_axis = Vec4::new(f32::from_bits(kept[slot]), 0.0, 0.0, 0.0);
+                }
                 let pc = ExactImmediates {
                     world_from_model: dr.world_from_model,
                     extra,
@@ -225,7 +251,15 @@ impl ExactPass {
                     bytemuck::bytes_of(&pc),
                 );
                 // Six vertices a triangle: the triangle grown (or its box's two halves).
-                Recorder::new(d, cmd).draw(2 * dr.index_count, 1, 0, 0);
+                match kept {
+                    Some(_) => Recorder::new(d, cmd).draw_indirect(
+                        self.culling.args.raw,
+                        16 * slot as u64,
+                        1,
+                        16,
+                    ),
+                    None => Recorder::new(d, cmd).draw(2 * dr.index_count, 1, 0, 0),
+                }
             }
         }
         Recorder::new(d, cmd).end_rendering();

@@ -53,6 +53,7 @@ impl ExactPass {
             next: storage("exact sample links", pixels * 4)?,
             samples: storage("exact samples", (pixels + 1) * 16)?,
             rays: storage("exact shadow rays", pixels * 16)?,
+            tiles: storage("hybrid traced tiles", TILE_WORDS * 4)?,
         };
         for (slot, &set) in self.sets.iter().enumerate() {
             let buffer = |b: &Buffer| {
@@ -75,6 +76,8 @@ impl ExactPass {
                 (sh::NEXT, buffer(&t.next)),
                 (sh::SAMPLES, buffer(&t.samples)),
                 (sh::RAYS, buffer(&t.rays)),
+                (sh::TILES, buffer(&t.tiles)),
+                (sh::TILES_READ, buffer(&t.tiles)),
                 (sh::POSITIONS, buffer(&scene.positions)),
                 (sh::INDICES, buffer(&scene.indices)),
                 (sh::ATTRIBUTES, buffer(&scene.attributes)),
@@ -102,6 +105,11 @@ impl ExactPass {
             }));
             unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
         }
+        for &set in &self.sets {
+            write_buffers(ctx, set, &self.culling.bindings());
+        }
+        // A new set of targets: every slot's map binding is written again (`bind_map`).
+        self.bound_map.fill(vk::ImageView::null());
         self.targets = Some(t);
         Ok(())
     }
