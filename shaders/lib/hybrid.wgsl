@@ -129,10 +129,10 @@ fn cs_cull(@builtin(global_invocation_id) id: vec3<u32>) {
     if tri >= bitcast<u32>(pc.extra[1].z) {
         return;
     }
-    let view = xf.views[0];
-    let c0 = view * vec4<f32>(world_vertex(vertex_index_of(tri, 0u)), 1.0);
-    let c1 = view * vec4<f32>(world_vertex(vertex_index_of(tri, 1u)), 1.0);
-    let c2 = view * vec4<f32>(world_vertex(vertex_index_of(tri, 2u)), 1.0);
+    let c = light_clip_triangle(tri);
+    let c0 = c[0];
+    let c1 = c[1];
+    let c2 = c[2];
     if max(c0.w, max(c1.w, c2.w)) <= 1e-6 {
         return;
     }
@@ -158,6 +158,16 @@ fn cs_cull(@builtin(global_invocation_id) id: vec3<u32>) {
     kept[bitcast<u32>(pc.extra[1].x) + at] = tri;
 }
 
+// Triangle `tri` of the draw in `pc`, in the clip space of the light's (one) view.
+fn light_clip_triangle(tri: u32) -> array<vec4<f32>, 3> {
+    let view = xf.views[0];
+    return array<vec4<f32>, 3>(
+        view * vec4<f32>(world_vertex(vertex_index_of(tri, 0u)), 1.0),
+        view * vec4<f32>(world_vertex(vertex_index_of(tri, 1u)), 1.0),
+        view * vec4<f32>(world_vertex(vertex_index_of(tri, 2u)), 1.0),
+    );
+}
+
 // Where clip position `c` of the map's view falls in the map, in texels (rows down).
 fn map_texels(c: vec4<f32>) -> vec2<f32> {
     return vec2<f32>(c.x / c.w * 0.5 + 0.5, 0.5 - c.y / c.w * 0.5) * xf.hybrid.y;
@@ -171,10 +181,10 @@ fn cs_thin(@builtin(global_invocation_id) id: vec3<u32>) {
     if tri >= bitcast<u32>(pc.extra[1].z) {
         return;
     }
-    let view = xf.views[0];
-    let c0 = view * vec4<f32>(world_vertex(vertex_index_of(tri, 0u)), 1.0);
-    let c1 = view * vec4<f32>(world_vertex(vertex_index_of(tri, 1u)), 1.0);
-    let c2 = view * vec4<f32>(world_vertex(vertex_index_of(tri, 2u)), 1.0);
+    let c = light_clip_triangle(tri);
+    let c0 = c[0];
+    let c1 = c[1];
+    let c2 = c[2];
     if min(c0.w, min(c1.w, c2.w)) <= 1e-6 {
         // At or behind a spot light's plane: no texel of the map holds it.
         return;

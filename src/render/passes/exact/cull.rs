@@ -4,7 +4,7 @@
 //! the caster pass then draws only those. On llvmpipe, which runs vertex work on one thread,
 //! the triangles never pulled are the saving.
 
-use super::{compute_pipeline, record::bind, ExactImmediates};
+use super::{caster_column, compute_pipeline, record::bind, ExactImmediates};
 use crate::gpu::barrier::memory_barrier;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::resources::Buffer;
@@ -203,16 +203,7 @@ impl Culling {
             let triangles = dr.index_count / 3;
             first.push(at);
             let mut extra = Mat4::ZERO;
-            extra.x_axis = Vec4::new(
-                f32::from_bits(dr.first_index),
-                f32::from_bits(dr.vertex_offset as u32),
-                if dr.alpha.tests_alpha_in_shadow() {
-                    1.0
-                } else {
-                    0.0
-                },
-                0.0,
-            );
+            extra.x_axis = caster_column(dr, 0);
             extra.y_axis = Vec4::new(
                 f32::from_bits(at),
                 f32::from_bits(slot as u32),

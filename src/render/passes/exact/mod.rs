@@ -274,6 +274,21 @@ impl ExactPass {
     }
 }
 
+/// The first column of a caster draw's `ExactImmediates::extra` (`shaders/exact.wgsl`): first
+/// index, vertex offset (bit-cast), 1 when its alpha is tested, the view (cube face).
+fn caster_column(dr: &crate::render::gpu_scene::Draw, view: usize) -> Vec4 {
+    Vec4::new(
+        f32::from_bits(dr.first_index),
+        f32::from_bits(dr.vertex_offset as u32),
+        if dr.alpha.tests_alpha_in_shadow() {
+            1.0
+        } else {
+            0.0
+        },
+        view as f32,
+    )
+}
+
 /// Writes storage and uniform buffer `bindings` of `set` (the whole of each buffer).
 fn write_buffers(
     ctx: &Context,

@@ -227,16 +227,7 @@ impl ExactPass {
             scene.bind_material(d, cmd, self.layout, 1, dr.material);
             for view in 0..f.views.len() {
                 let mut extra = Mat4::ZERO;
-                extra.x_axis = Vec4::new(
-                    f32::from_bits(dr.first_index),
-                    f32::from_bits(dr.vertex_offset as u32),
-                    if dr.alpha.tests_alpha_in_shadow() {
-                        1.0
-                    } else {
-                        0.0
-                    },
-                    view as f32,
-                );
+                extra.x_axis = caster_column(dr, view);
                 if let Some(kept) = kept {
                     extra.y_axis = Vec4::new(f32::from_bits(kept[slot]), 0.0, 0.0, 0.0);
                 }

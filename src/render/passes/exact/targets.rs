@@ -56,13 +56,23 @@ impl ExactPass {
             tiles: storage("hybrid traced tiles", TILE_WORDS * 4)?,
         };
         for (slot, &set) in self.sets.iter().enumerate() {
-            let buffer = |b: &Buffer| {
-                [vk::DescriptorBufferInfo {
-                    buffer: b.raw,
-                    offset: 0,
-                    range: vk::WHOLE_SIZE,
-                }]
-            };
+            write_buffers(
+                ctx,
+                set,
+                &[
+                    (&sh::XF, &self.uniforms[slot]),
+                    (&sh::HEADS, &t.heads),
+                    (&sh::NEXT, &t.next),
+                    (&sh::SAMPLES, &t.samples),
+                    (&sh::RAYS, &t.rays),
+                    (&sh::TILES, &t.tiles),
+                    (&sh::TILES_READ, &t.tiles),
+                    (&sh::POSITIONS, &scene.positions),
+                    (&sh::INDICES, &scene.indices),
+                    (&sh::ATTRIBUTES, &scene.attributes),
+                ],
+            );
+            write_buffers(ctx, set, &self.culling.bindings());
             let image = |view| {
                 [vk::DescriptorImageInfo {
                     sampler: vk::Sampler::null(),
@@ -70,43 +80,21 @@ impl ExactPass {
                     image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                 }]
             };
-            let buffers = [
-                (sh::XF, buffer(&self.uniforms[slot])),
-                (sh::HEADS, buffer(&t.heads)),
-                (sh::NEXT, buffer(&t.next)),
-                (sh::SAMPLES, buffer(&t.samples)),
-                (sh::RAYS, buffer(&t.rays)),
-                (sh::TILES, buffer(&t.tiles)),
-                (sh::TILES_READ, buffer(&t.tiles)),
-                (sh::POSITIONS, buffer(&scene.positions)),
-                (sh::INDICES, buffer(&scene.indices)),
-                (sh::ATTRIBUTES, buffer(&scene.attributes)),
-            ];
             let images = [
                 (sh::RECEIVER_POSITION, image(t.position.view)),
                 (sh::RECEIVER_NORMAL, image(t.normal.view)),
             ];
-            let mut writes: Vec<vk::WriteDescriptorSet> = buffers
+            let writes: Vec<vk::WriteDescriptorSet> = images
                 .iter()
                 .map(|(b, info)| {
                     vk::WriteDescriptorSet::default()
                         .dst_set(set)
                         .dst_binding(b.binding)
                         .descriptor_type(b.descriptor_type())
-                        .buffer_info(info)
+                        .image_info(info)
                 })
                 .collect();
-            writes.extend(images.iter().map(|(b, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(b.binding)
-                    .descriptor_type(b.descriptor_type())
-                    .image_info(info)
-            }));
             unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
-        }
-        for &set in &self.sets {
-            write_buffers(ctx, set, &self.culling.bindings());
         }
         // A new set of targets: every slot's map binding is written again (`bind_map`).
         self.bound_map.fill(vk::ImageView::null());
