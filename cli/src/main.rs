@@ -122,6 +122,9 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     if let Some(n) = a.frames {
         return render_sequence(&a, n);
     }
+    if let Some(poses) = &a.views {
+        return app::views::render_views(&a, poses);
+    }
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut view = make_view(&scene, &a.view)?;
     let ctx = offscreen_context(a.validation, a.device.clone())?;

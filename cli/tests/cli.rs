@@ -13,3 +13,4 @@ mod sweep_cli;
 #[cfg(all(feature = "viewer", feature = "reference"))]
 mod viewer;
 mod viewer_panel;
+mod views;

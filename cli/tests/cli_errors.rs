@@ -305,6 +305,19 @@ fn gltf_1_and_missing_version() {
 #[test]
 fn bad_arguments() {
     let d = tmp("args");
+    let id = "[[1,0,0,0],[0,1,0,0],[0,0,1,5],[0,0,0,1]]";
+    for (name, text) in [
+        ("bad.json", "[[1,2"),
+        (
+            "short.json",
+            &*format!("[{id}, [[1,0,0,0],[0,1,0,0],[0,0,1,5]]]"),
+        ),
+        ("same.json", r#"[{"eye": [1, 2, 3], "target": [1, 2, 3]}]"#),
+        ("empty.json", "[]"),
+        ("one.json", &*format!("[{id}]")),
+    ] {
+        std::fs::write(d.join(name), text).unwrap();
+    }
     for (args, expect) in [
         (vec!["render", "--size", "0x0"], "size"),
         (vec!["render", "--camera", "7"], "camera 7"),
@@ -320,6 +333,31 @@ fn bad_arguments() {
         (vec!["render", "--frames", "3", "-o", "x%q.png"], "%0nd"),
         (vec!["render", "--frames", "2", "--fps", "0"], "frame rate"),
         (vec!["render", "--ssaa", "3"], "3 is not in 1..=2"),
+        (
+            vec!["render", "--views", "missing.json", "-o", "v%d.png"],
+            "missing.json",
+        ),
+        (
+            vec!["render", "--views", "bad.json", "-o", "v%d.png"],
+            "not json",
+        ),
+        (
+            vec!["render", "--views", "short.json", "-o", "v%d.png"],
+            "pose 1: a matrix of 12",
+        ),
+        (
+            vec!["render", "--views", "same.json", "-o", "v%d.png"],
+            "same point",
+        ),
+        (
+            vec!["render", "--views", "empty.json", "-o", "v%d.png"],
+            "no poses",
+        ),
+        (
+            vec!["render", "--views", "one.json", "-o", "v.png"],
+            "pattern",
+        ),
+        (vec!["render", "--outputs", "depth"], "--views"),
     ] {
         let (ok, stderr) = run(&args, &d);
         assert!(!ok, "{args:?} should fail");

@@ -5,6 +5,7 @@
 mod common;
 
 mod animation;
+mod batch;
 #[cfg(feature = "sweep")]
 mod budget;
 mod depth_fit;

@@ -106,6 +106,8 @@ impl OffscreenRenderer {
 
     /// Renders `scene` through `camera` from each of `poses` with `settings`, the `outputs`
     /// stacked (`stacked`: with a leading frame axis).
+    /// `shared`: the poses' shadow maps fitted to them all and drawn once
+    /// (`BatchShadows::Shared`; not with a budget, which chooses per frame).
     #[allow(clippy::too_many_arguments)] // the Python call's arguments, passed on
     fn render_poses<'py>(
         &mut self,
@@ -115,18 +117,29 @@ impl OffscreenRenderer {
         poses: &[glam::Mat4],
         outputs: &[&'static str],
         settings: Option<&Bound<'py, PyDict>>,
-        stacked: bool,
+        (stacked, shared): (bool, bool),
     ) -> PyResult<Bound<'py, PyDict>> {
         let aspect = self.width as f32 / self.height as f32;
         let mut base = View::new(engine_camera(camera, poses[0], aspect)?);
         let extras = settings::apply(&mut base, settings)?;
         let mut s = scene.borrow_mut();
         Self::pose(&mut s, &extras)?;
-        let mut stack = Stack::new(poses.len());
+        let mut views = Vec::with_capacity(poses.len());
         for &pose in poses {
             let mut view = base.clone();
             view.camera = engine_camera(camera, pose, aspect)?;
-            stack.push(self.frame(py, &s, &view, &extras, outputs)?);
+            views.push(view);
+        }
+        if shared && extras.budget.is_none() {
+            let (w, h) = (self.width, self.height);
+            views = self.renderer_for(&s)?.shared_views(&views, w, h);
+        }
+        // A batch keeps a map the next pose plans the same (every pose of a shared batch).
+        let cache = stacked || self.options.shadow_cache;
+        self.renderer_for(&s)?.set_shadow_cache(cache);
+        let mut stack = Stack::new(poses.len());
+        for view in &views {
+            stack.push(self.frame(py, &s, view, &extras, outputs)?);
         }
         stack.into_arrays(py, (self.width, self.height), stacked)
     }
@@ -399,7 +412,7 @@ impl OffscreenRenderer {
     ) -> PyResult<Bound<'py, PyAny>> {
         let names = parse_outputs(outputs)?;
         let pose = matrix4(camera_pose, "camera_pose")?;
-        let d = self.render_poses(py, scene, camera, &[pose], &names, settings, false)?;
+        let d = self.render_poses(py, scene, camera, &[pose], &names, settings, (false, false))?;
         if outputs.is_none() {
             let t = PyTuple::new(py, [d.get_item("color")?, d.get_item("depth")?])?;
             return Ok(t.into_any());
@@ -409,8 +422,12 @@ impl OffscreenRenderer {
 
     /// Renders `scene` from each of `poses` (an (N, 4, 4) array of camera poses) without
     /// uploading it again: a dict of the `outputs` (default color and depth), each stacked
-    /// (N, H, W[, C]). Settings as `render`.
-    #[pyo3(signature = (scene, camera, poses, outputs = None, **settings))]
+    /// (N, H, W[, C]). Settings as `render`. `share_shadows` (the default): each directional
+    /// light gets one map fitted to all the poses, as fine as the finest any pose's own fit
+    /// would be (its side doubled up to 8192), drawn once for the batch; False: each pose
+    /// fitted alone, as `render` fits it.
+    #[pyo3(signature = (scene, camera, poses, outputs = None, share_shadows = true, **settings))]
+    #[allow(clippy::too_many_arguments)] // the Python call's arguments
     fn render_batch<'py>(
         &mut self,
         py: Python<'py>,
@@ -418,6 +435,7 @@ impl OffscreenRenderer {
         camera: &Bound<'py, PyAny>,
         poses: &Bound<'py, PyAny>,
         outputs: Option<&Bound<'py, PyAny>>,
+        share_shadows: bool,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let names = parse_outputs(outputs)?;
@@ -437,7 +455,15 @@ impl OffscreenRenderer {
             }
             list.push(pose);
         }
-        self.render_poses(py, scene, camera, &list, &names, settings, true)
+        self.render_poses(
+            py,
+            scene,
+            camera,
+            &list,
+            &names,
+            settings,
+            (true, share_shadows),
+        )
     }
 
     /// Frees the device's resources (the renderer cannot render afterwards).

@@ -1,5 +1,6 @@
 """The Ray helper on a local cluster of 2 CPUs (loopback only): jobs rendered by 2 worker
-processes land in shards whose arrays equal a direct render, with a manifest naming each job."""
+processes land in shards whose arrays equal a direct batch of the shard's poses, with a manifest
+naming each job and each worker's images per second."""
 
 import json
 import os
@@ -30,18 +31,22 @@ def test_jobs_render_on_two_local_workers(tmp_path):
     # Two worker processes shared the shards, neither of them this one.
     workers = {e["worker"] for e in m["shards"]}
     assert len(workers) == 2 and os.getpid() not in workers, workers
+    # Throughput per worker: every job counted once, at a rate above zero.
+    per = m["per_worker"]
+    assert sorted(int(k) for k in per) == sorted(workers)
+    assert sum(w["jobs"] for w in per.values()) == 6
+    assert all(w["images_per_second"] > 0 for w in per.values())
     r = umbra.OffscreenRenderer(64, 48)
     scene = umbra.load(model)
     seen = []
     for entry in m["shards"]:
         with np.load(tmp_path / "out" / entry["file"]) as z:
             assert list(z["job"]) == entry["jobs"]
-            for k, j in enumerate(entry["jobs"]):
-                color, depth = r.render(
-                    scene, umbra.ray.camera_of(None), np.asarray(jobs[j]["camera_pose"])
-                )
-                assert np.array_equal(z["color"][k], color)
-                assert np.array_equal(z["depth"][k], depth)
-                seen.append(j)
+            # A shard is one batch (its shadow map shared by its poses).
+            poses = np.stack([np.asarray(jobs[j]["camera_pose"]) for j in entry["jobs"]])
+            direct = r.render_batch(scene, umbra.ray.camera_of(None), poses)
+            assert np.array_equal(z["color"], direct["color"])
+            assert np.array_equal(z["depth"], direct["depth"])
+            seen.extend(entry["jobs"])
     assert sorted(seen) == list(range(6))
     r.close()

@@ -4,6 +4,7 @@
 use super::settings::{PostAa, ShadowSettings, Tonemap, ViewMode, CLEAR_COLOR};
 use crate::scene::Camera;
 use glam::Vec3;
+use std::sync::Arc;
 
 /// The default sky ambient as a fraction of the metered direct illuminance: what an up-facing
 /// surface in shadow receives (0.34 under the demo's sun of 1.7). A clear sky gives a horizontal
@@ -216,6 +217,12 @@ pub struct View {
     /// The previous frame's snapped shadow extents, for a camera in motion (the viewer sets it
     /// each frame; see [`ShadowHold`]). None: every frame fitted afresh, as a still is.
     pub shadow_hold: Option<ShadowHold>,
+    /// The cameras of a batch whose views share their shadow maps (`Renderer::render_batch`
+    /// sets it): each directional light gets one map fitted to all of their frusta with the
+    /// scene (no cascades, no hold, no depth fit), the same in every view of the batch, so the
+    /// shadow cache draws it once for the whole batch. Spot and point lights' views never
+    /// depend on the camera. None: fitted to this view alone.
+    pub shadow_batch: Option<Arc<[Camera]>>,
 }
 
 /// The snapped extents a frame's directional lights used (per light: its direction, the side of
@@ -262,6 +269,9 @@ impl View {
         let mut v = self.clone();
         v.camera = v.camera.rebased(origin);
         v.shadow_fit_camera = v.shadow_fit_camera.map(|c| c.rebased(origin));
+        v.shadow_batch = v
+            .shadow_batch
+            .map(|b| b.iter().map(|c| c.rebased(origin)).collect());
         v
     }
 
@@ -299,6 +309,7 @@ impl View {
             shown_light: None,
             visible_depths: None,
             shadow_hold: None,
+            shadow_batch: None,
         }
     }
 }

@@ -333,8 +333,16 @@ pub(super) fn directional_views(
     let size = view.shadow.map_size.max(1);
     // The previous frame's extent of view `c` of `n`, when it had the same views.
     let hold = |c: usize, n: usize| held.filter(|h| h.len() == n).map(|h| h[c]);
+    // A batch's other cameras, whose frusta its shared map covers too.
+    let batch: Vec<CameraFrustum> = view
+        .shadow_batch
+        .iter()
+        .flat_map(|b| b.iter())
+        .map(|c| fitting_frustum(c, aspect, bounds))
+        .collect();
     let fit_sized = |camera, hold: Option<f32>, map_size: u32| {
         fit_directional(&DirectionalFitInput {
+            also: &batch,
             direction: l.direction,
             scene_bounds: *bounds,
             camera,

@@ -112,9 +112,21 @@ impl FrameCore {
     }
 
     /// Takes a new pose of the scene it was made from ([`GpuScene::update_pose`]): vertices,
-    /// draws, bounds and the lights, which may hang on animated nodes.
+    /// draws, bounds and the lights, which may hang on animated nodes. A caster the shadow cache takes as still (not `moving`) that this pose moved empties the
+    /// cache.
     pub fn set_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
+        let still = |g: &GpuScene| -> Vec<u8> {
+            g.draws
+                .iter()
+                .filter(|d| !d.moving)
+                .flat_map(|d| bytemuck::bytes_of(&d.immediates).to_vec())
+                .collect()
+        };
+        let before = still(&self.gpu);
         self.gpu.update_pose(scene)?;
+        if still(&self.gpu) != before {
+            self.shadow.forget();
+        }
         (self.receiver_bounds, self.receiver_planes) = self.gpu.plan_inputs();
         self.lights = scene
             .lights
@@ -124,16 +136,9 @@ impl FrameCore {
         Ok(())
     }
 
-    /// Sizes the shadow map for `view`, plans the frame (with its casters and the camera pass's
-    /// draw selection) and writes slot `slot`'s uniforms (the slot's previous frame must have
-    /// completed). Recording then only does what the returned frame says.
-    pub fn prepare(
-        &mut self,
-        slot: usize,
-        view: &View,
-        width: u32,
-        height: u32,
-    ) -> Result<Prepared, GpuError> {
+    /// The plan of `view` at `width`×`height` pixels (what `prepare` plans, without touching
+    /// the device).
+    pub fn plan(&self, view: &View, width: u32, height: u32) -> FramePlan {
         let mut v = view.rebased(self.origin);
         let scene = PlanScene {
             lights: &self.lights,
@@ -165,9 +170,29 @@ impl FrameCore {
             v.shadow.format = format;
             plan = plan_frame(&scene, &v, &target(hw));
         }
+        plan
+    }
+
+    /// Sizes the shadow map for `view`, plans the frame (with its casters and the camera pass's
+    /// draw selection) and writes slot `slot`'s uniforms (the slot's previous frame must have
+    /// completed). Recording then only does what the returned frame says.
+    pub fn prepare(
+        &mut self,
+        slot: usize,
+        view: &View,
+        width: u32,
+        height: u32,
+    ) -> Result<Prepared, GpuError> {
+        let plan = self.plan(view, width, height);
+        let format = plan.shadow_format;
+        let hw = self.shadow.hardware_filtering(format);
         let layers = plan.shadow_views.len().max(1) as u32;
-        self.shadow
-            .ensure_map(plan.shadow_map_size(), format, layers)?;
+        // A frame without shadows (the AOV pass, a frame with shadows off) keeps the map it
+        // finds, so that the next shadowed frame (and the shadow cache) finds it too.
+        if plan.shadows_on || !self.shadow.holds(format) {
+            self.shadow
+                .ensure_map(plan.shadow_map_size(), format, layers)?;
+        }
         self.shadow.ensure_masked(&self.gpu, format)?;
         let map_view = self.shadow.map.as_ref().map(|m| m.view).unwrap_or_default();
         let extent = vk::Extent2D { width, height };

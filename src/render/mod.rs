@@ -16,7 +16,10 @@ pub(crate) mod targets;
 pub(crate) mod window;
 
 pub use device::device_facts;
-pub use renderer::{view_axis_depths, Aovs, FrameStats, RenderedFrame, Renderer, MAX_SIDE};
+pub use renderer::{
+    view_axis_depths, Aovs, BatchShadows, FrameStats, RenderedFrame, Renderer, MAX_SIDE,
+    SHARED_MAP_MAX,
+};
 #[cfg(feature = "viewer")]
 pub use window::{
     surface_extensions, Capture, DrawResult, FrameSummary, Overlay, WindowRenderer,

@@ -18,7 +18,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 mod aov;
+mod batch;
 pub use aov::Aovs;
+pub use batch::{BatchShadows, SHARED_MAP_MAX};
 
 /// Colour format of offscreen frames (sRGB-encoded on write).
 pub const OFFSCREEN_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
@@ -197,6 +199,18 @@ impl Renderer {
         &self.core.ctx
     }
 
+    /// Turns the shadow cache (`SceneOptions::shadow_cache`) on or off from the next frame.
+    pub fn set_shadow_cache(&mut self, on: bool) {
+        if self.core.shadow.caching() != on {
+            self.core.shadow.set_caching(on);
+        }
+    }
+
+    /// Whether the shadow cache is on.
+    pub fn shadow_cache(&self) -> bool {
+        self.core.shadow.caching()
+    }
+
     /// Also read back the camera depth buffer (into `RenderedFrame::depth`).
     pub fn set_read_depth(&mut self, on: bool) {
         self.read_depth = on;
@@ -316,7 +330,8 @@ impl Renderer {
         let fit = view.shadow.depth_fit
             && view.shadow.enabled
             && view.visible_depths.is_none()
-            && view.shadow_fit_camera.is_none();
+            && view.shadow_fit_camera.is_none()
+            && view.shadow_batch.is_none();
         if !fit {
             return self.render_once(view, width, height);
         }

@@ -29,6 +29,7 @@ pub mod scene_tree;
 pub mod script;
 #[cfg(feature = "viewer")]
 pub mod viewer;
+pub mod views;
 
 /// The binary's pipeline cache file: `UMBRA_PIPELINE_CACHE` (a path, or `off`), else the user's
 /// cache directory (`umbra::gpu::pipeline_cache::default_path`).

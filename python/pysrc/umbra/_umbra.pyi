@@ -187,10 +187,12 @@ class OffscreenRenderer:
         camera: Camera,
         poses: ArrayLike,
         outputs: Optional[Sequence[Output]] = None,
+        share_shadows: bool = True,
         **settings: Any,
     ) -> Dict[str, np.ndarray]:
         """Renders ``scene`` from each of ``poses`` (N, 4, 4) without uploading it again; each
-        output stacked (N, H, W[, C]) (default: color and depth)."""
+        output stacked (N, H, W[, C]) (default: color and depth). ``share_shadows``: one map
+        per directional light fitted to all the poses and drawn once (False: per pose)."""
     def close(self) -> None:
         """Frees the device's resources."""
     def __enter__(self) -> "OffscreenRenderer": ...

@@ -1,7 +1,9 @@
 """Batch rendering beyond one machine, on Ray (https://www.ray.io): a list of (scene, camera pose)
 jobs rendered by a pool of Ray actors, one ``OffscreenRenderer`` per worker process, each scene
-loaded once per worker, results written as compressed ``.npz`` shards (or PNGs) with a
-``manifest.json`` saying which job is where.
+loaded once per worker, each shard's runs of jobs with the same scene, camera and settings
+rendered as one ``render_batch`` (shadow maps drawn once per run), results written as compressed
+``.npz`` shards (or PNGs) with a ``manifest.json`` saying which job is where and each worker's
+images per second.
 
 On one machine::
 
@@ -62,21 +64,26 @@ class _Worker:
         return self.scenes[path]
 
     def render(self, shard, jobs):
-        """Renders ``jobs`` [(index, job)] into shard ``shard``; returns its manifest entry (with
-        the worker's process id)."""
+        """Renders ``jobs`` [(index, job)] into shard ``shard``, each run of jobs with the same
+        scene, camera and settings as one ``render_batch`` (its shadow maps drawn once); returns
+        its manifest entry (with the worker's process id and its rendering seconds)."""
         frames = {name: [] for name in self.outputs}
-        for _, job in jobs:
+        start = time.time()
+        for group in _runs(jobs):
+            job = group[0]
             settings = dict(self.settings)
             settings.update(job.get("settings", {}))
-            out = self.renderer.render(
+            poses = np.stack([np.asarray(j["camera_pose"], dtype=np.float64) for j in group])
+            out = self.renderer.render_batch(
                 self.scene(job["scene"]),
                 camera_of(job.get("camera")),
-                np.asarray(job["camera_pose"], dtype=np.float64),
+                poses,
                 outputs=self.outputs,
                 **settings,
             )
             for name in self.outputs:
-                frames[name].append(out[name])
+                frames[name].extend(out[name])
+        seconds = time.time() - start
         ids = [i for i, _ in jobs]
         if self.png:
             from PIL import Image
@@ -86,11 +93,27 @@ class _Worker:
                 name = f"job_{i:06d}.png"
                 Image.fromarray(frames["color"][k]).save(os.path.join(self.out_dir, name))
                 files.append(name)
-            return {"shard": shard, "jobs": ids, "files": files, "worker": os.getpid()}
+            return {"shard": shard, "jobs": ids, "files": files, "worker": os.getpid(),
+                    "seconds": seconds}
         name = f"shard_{shard:05d}.npz"
         arrays = {k: np.stack(v) for k, v in frames.items()}
         np.savez_compressed(os.path.join(self.out_dir, name), job=np.asarray(ids), **arrays)
-        return {"shard": shard, "jobs": ids, "file": name, "worker": os.getpid()}
+        return {"shard": shard, "jobs": ids, "file": name, "worker": os.getpid(),
+                "seconds": seconds}
+
+
+def _runs(jobs):
+    """``jobs`` [(index, job)] split into runs of consecutive jobs with the same scene, camera
+    and settings (the jobs of one ``render_batch``)."""
+    runs, key = [], None
+    for _, job in jobs:
+        k = (job["scene"], json.dumps(job.get("camera"), sort_keys=True, default=str),
+             json.dumps(job.get("settings", {}), sort_keys=True, default=str))
+        if k != key:
+            runs.append([])
+            key = k
+        runs[-1].append(job)
+    return runs
 
 
 def render_jobs(
@@ -135,6 +158,13 @@ def render_jobs(
         pool.map_unordered(lambda a, shard: a.render.remote(*shard), shards),
         key=lambda e: e["shard"],
     )
+    per_worker = {}
+    for e in entries:
+        w = per_worker.setdefault(e["worker"], {"jobs": 0, "seconds": 0.0})
+        w["jobs"] += len(e["jobs"])
+        w["seconds"] += e["seconds"]
+    for w in per_worker.values():
+        w["images_per_second"] = w["jobs"] / w["seconds"] if w["seconds"] > 0 else None
     manifest = {
         "width": width,
         "height": height,
@@ -142,6 +172,7 @@ def render_jobs(
         "jobs": len(jobs),
         "workers": len(actors),
         "seconds": time.time() - start,
+        "per_worker": {str(k): v for k, v in per_worker.items()},
         "shards": entries,
     }
     with open(os.path.join(out_dir, "manifest.json"), "w") as f:

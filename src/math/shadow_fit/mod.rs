@@ -202,13 +202,16 @@ pub fn frustum_box_intersection(f: &CameraFrustum, b: &Aabb) -> Vec<Vec3> {
 
 /// What a fitted directional-light projection needs.
 #[derive(Clone, Copy, Debug)]
-pub struct DirectionalFitInput {
+pub struct DirectionalFitInput<'a> {
     /// Direction the light travels (from the light into the scene).
     pub direction: Vec3,
     /// Bounds of everything that can cast or receive.
     pub scene_bounds: Aabb,
     /// The camera; `None` fits the whole scene.
     pub camera: Option<CameraFrustum>,
+    /// More cameras whose frusta the fit covers with `camera`'s (the views of a batch sharing
+    /// one map); ignored without `camera` and by the sphere fit.
+    pub also: &'a [CameraFrustum],
     /// Shadow-map size in texels.
     pub map_size: u32,
     /// Quantise the extent and snap the origin to whole texels.
@@ -363,8 +366,11 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
         input.scene_bounds
     };
     let scene_l = scene.transformed(&view);
-    let receivers_world = match &input.camera {
-        Some(c) => frustum_box_intersection(c, &scene),
+    let receivers_world: Vec<Vec3> = match &input.camera {
+        Some(c) => std::iter::once(c)
+            .chain(input.also)
+            .flat_map(|c| frustum_box_intersection(c, &scene))
+            .collect(),
         None => Vec::new(),
     };
     let mut recv = if receivers_world.is_empty() {

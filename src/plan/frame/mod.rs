@@ -6,7 +6,9 @@ use super::casters::{plan_casters, Viewpoint};
 use super::exact::{exact_asked, ExactMode, ExactPlan};
 use super::input::{PlanScene, PlanTarget};
 use super::lights::{effective_lights, light_uniforms, metering};
-use super::settings::{Pcf, ShadowFormat, ShadowMethod, ShadowSettings, Tonemap, ViewMode};
+use super::settings::{
+    Pcf, ShadowFit, ShadowFormat, ShadowMethod, ShadowSettings, Tonemap, ViewMode,
+};
 use super::sight::Sight;
 use super::uniforms::{FrameUniform, MAX_LIGHTS};
 use super::view::{Ambient, Background, Exposure, HeldLight, ShadowHold, View};
@@ -452,6 +454,15 @@ fn settled(view: &View, target: &PlanTarget) -> View {
     } else {
         1
     };
+    if view.shadow_batch.is_some() {
+        // One map per directional light, the same in every view of the batch.
+        v.shadow.cascades = 1;
+        v.shadow.depth_fit = false;
+        v.shadow_hold = None;
+        if v.shadow.fit == ShadowFit::Sphere {
+            v.shadow.fit = ShadowFit::Camera;
+        }
+    }
     if exact_asked(view, target.exact_capable) {
         v.shadow.cascades = 1;
         v.shadow.soft = false;

@@ -101,6 +101,8 @@ pub struct ShadowPass {
     map_at: Option<Attachment>,
     /// Reuse what layers hold across frames (`SceneOptions::shadow_cache`).
     caching: bool,
+    /// The map was made with the usages the cache's copies need.
+    map_copies: bool,
     /// What each layer of the map and of `cache` holds.
     layers: ShadowCache,
     /// The static casters' depth per layer, for frames with moving casters (made on first need).
@@ -133,9 +135,27 @@ impl ShadowPass {
             map: None,
             map_at: None,
             caching: false,
+            map_copies: false,
             layers: ShadowCache::default(),
             cache: None,
         })
+    }
+
+    /// Whether a map of `format` exists (of whatever size).
+    pub fn holds(&self, format: ShadowFormat) -> bool {
+        self.map
+            .as_ref()
+            .is_some_and(|m| m.format == vk_format(format))
+    }
+
+    /// Forgets what the map and the cache hold (a caster taken as still has moved).
+    pub fn forget(&mut self) {
+        self.layers.clear();
+    }
+
+    /// Whether unchanged layers are reused across frames.
+    pub fn caching(&self) -> bool {
+        self.caching
     }
 
     /// Turns reuse of unchanged layers across frames on or off (`shadow_cache`).
@@ -163,8 +183,12 @@ impl ShadowPass {
         debug_assert!((1..=*ShadowSettings::MAP_SIZES.end()).contains(&size));
         // More layers than needed are kept: a frame that needs fewer cascades (the automatic
         // count changes as the camera moves) reuses the map.
+        // A map made while the cache was off cannot be copied from or into.
         if self.map.as_ref().is_some_and(|m| {
-            m.extent.width == size && m.format == fmt && m.layer_views.len() >= layers as usize
+            m.extent.width == size
+                && m.format == fmt
+                && m.layer_views.len() >= layers as usize
+                && (self.map_copies || !self.caching)
         }) {
             return Ok(false);
         }
@@ -190,6 +214,7 @@ impl ShadowPass {
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | copies,
         )?);
         self.map_at = self.map.as_ref().map(Attachment::of);
+        self.map_copies = self.caching;
         self.layers.clear();
         self.cache = None;
         Ok(true)

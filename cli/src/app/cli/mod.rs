@@ -286,4 +286,18 @@ pub struct RenderArgs {
     /// Frames per second of a sequence (--frames).
     #[arg(long, default_value_t = 30.0, value_parser = parse_fps)]
     pub fps: f32,
+    /// A batch: one image per camera pose in this JSON file (a list of 4×4 world-from-camera
+    /// matrices, row by row, or of {"eye": [x, y, z], "target": [x, y, z]}), each written to
+    /// OUT with its index put in the `%04d`. Each directional light's map is fitted to all
+    /// the views and drawn once (see --per-view-shadows).
+    #[arg(long, conflicts_with_all = ["frames", "repeat"])]
+    pub views: Option<PathBuf>,
+    /// With --views: fit each view's shadow maps to it alone, as a single render does.
+    #[arg(long, requires = "views")]
+    pub per_view_shadows: bool,
+    /// With --views: what to write per view, comma-separated: color (the PNG), depth,
+    /// segmentation, normals (.npy beside it: OUT_0001.depth.npy, ...).
+    #[arg(long, value_delimiter = ',', requires = "views", default_value = "color",
+          value_parser = ["color", "depth", "segmentation", "normals"])]
+    pub outputs: Vec<String>,
 }

@@ -37,7 +37,7 @@ pub fn load_named(spec: &str, ground: bool) -> anyhow::Result<Scene> {
 pub fn frame_path(pattern: &std::path::Path, i: u32) -> anyhow::Result<PathBuf> {
     let text = pattern.to_string_lossy();
     let Some(start) = text.find('%') else {
-        bail!("-o {text}: a sequence (--frames) needs a frame-number pattern such as out_%04d.png");
+        bail!("-o {text}: a sequence (--frames, --views) needs a frame-number pattern such as out_%04d.png");
     };
     let rest = &text[start + 1..];
     let digits: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
