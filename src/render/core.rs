@@ -115,16 +115,7 @@ impl FrameCore {
     /// draws, bounds and the lights, which may hang on animated nodes. A caster the shadow cache takes as still (not `moving`) that this pose moved empties the
     /// cache.
     pub fn set_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
-        let still = |g: &GpuScene| -> Vec<u8> {
-            g.draws
-                .iter()
-                .filter(|d| !d.moving)
-                .flat_map(|d| bytemuck::bytes_of(&d.immediates).to_vec())
-                .collect()
-        };
-        let before = still(&self.gpu);
-        self.gpu.update_pose(scene)?;
-        if still(&self.gpu) != before {
+        if self.gpu.update_pose(scene)? {
             self.shadow.forget();
         }
         (self.receiver_bounds, self.receiver_planes) = self.gpu.plan_inputs();

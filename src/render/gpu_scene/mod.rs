@@ -183,8 +183,9 @@ impl GpuScene {
     /// `Scene::apply_pose`): rewrites the deformed primitives' vertices and every draw's
     /// transform and bounds. Waits for the device first. Deformed primitives lose their cluster
     /// and flat-caster culling, which were computed for another shape; closed-mesh culling stays
-    /// (a pose keeps the topology).
-    pub fn update_pose(&mut self, scene: &Scene) -> Result<(), GpuError> {
+    /// (a pose keeps the topology). Returns whether a draw that is not `moving` (one the shadow
+    /// cache keeps) changed its transform.
+    pub fn update_pose(&mut self, scene: &Scene) -> Result<bool, GpuError> {
         unsafe { self.ctx.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
         let attr_size = std::mem::size_of::<VertexAttributes>();
         for (mesh, ranges) in scene.meshes.iter().zip(&mut self.ranges) {
@@ -211,10 +212,14 @@ impl GpuScene {
         }
         let (draws, triangles, bounds) =
             build_draws(scene, &self.ranges, self.origin, &self.moving);
+        let still_moved = draws.len() != self.draws.len()
+            || draws.iter().zip(&self.draws).any(|(a, b)| {
+                !a.moving && bytemuck::bytes_of(&a.immediates) != bytemuck::bytes_of(&b.immediates)
+            });
         self.draws = draws;
         self.triangles = triangles;
         self.bounds = bounds;
-        Ok(())
+        Ok(still_moved)
     }
 
     /// Uploads `scene`.
