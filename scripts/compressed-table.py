@@ -77,10 +77,10 @@ def main():
         doc = json.loads(run([umbra, "inspect", model, "--json"]).stdout)
         if model.endswith(".gltf"):
             # The .gltf and the external files it names.
-            base = os.path.dirname(model)
+            folder = os.path.dirname(model)
             for r in doc["resources"]["buffers"] + doc["resources"]["images"]:
                 if r.get("uri") and not r["uri"].startswith("data:"):
-                    size0 += os.path.getsize(os.path.join(base, r["uri"]))
+                    size0 += os.path.getsize(os.path.join(folder, r["uri"]))
         textured = len(doc["resources"]["images"]) > 0
         for s in SETTINGS:
             if s in ("etc1s", "uastc", "webp") and not textured:

@@ -34,6 +34,7 @@ fn scene() -> Scene {
             width: 2,
             height: 1,
             rgba: vec![255, 255, 255, 0, 255, 255, 255, 255],
+            ktx2: None,
         },
     );
     let mut cut = colored(Vec3::new(0.9, 0.2, 0.1), 0.5);

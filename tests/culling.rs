@@ -166,6 +166,7 @@ fn masked_and_opaque_materials_draw_in_their_pipelines() {
                     [255, 255, 255, a]
                 })
                 .collect(),
+            ktx2: None,
         },
     );
     let masked = Material {

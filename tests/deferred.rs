@@ -36,6 +36,7 @@ fn texture(name: &str, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
         width: 64,
         height: 64,
         rgba: (0..64 * 64).flat_map(|i| f(i % 64, i / 64)).collect(),
+        ktx2: None,
     }
 }
 

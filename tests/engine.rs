@@ -15,6 +15,7 @@ mod gltf_corpus;
 mod gpu_normal_map;
 mod gpu_render;
 mod gpu_shadows;
+mod ktx2_levels;
 mod loader_fuzz;
 mod msaa;
 mod receivers;

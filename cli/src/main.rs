@@ -165,6 +165,16 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         "rendered {} ({} triangles, {} draws of which {} deferred and {} unshadowed beyond the casters' reach, {} casters drawn, {} shadow view(s){}) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
         scene.name, s.triangles, s.draws, s.deferred_draws, s.unshadowed_draws, s.casters_drawn, if frame.plan.shadows_on { frame.plan.shadow_views.len() } else { 0 }, if frame.plan.exact_shadows() { ", exact" } else if frame.plan.contact_shadows() { ", contact shadows" } else { "" }, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
     );
+    let t = renderer.texture_stats();
+    if t.file_mips > 0 {
+        println!(
+            "textures: {} images, {:.1} MiB on the device; {} KTX2 with the file's mips, {} as BC7",
+            t.images,
+            t.bytes as f64 / (1 << 20) as f64,
+            t.file_mips,
+            t.bc7
+        );
+    }
     // Count after the renderer and the context are gone, so destroy-time and leak messages count.
     drop(renderer);
     finish_context(ctx)

@@ -30,6 +30,7 @@ fn checker_alpha() -> Texture {
                 [230, 230, 230, a]
             })
             .collect(),
+        ktx2: None,
     }
 }
 

@@ -46,6 +46,7 @@ fn quad_scene_with(sampler: Sampler, transform: UvTransform) -> (Scene, View) {
                     [r, g, b, 255]
                 })
                 .collect(),
+            ktx2: None,
         },
     );
     let material = Material {
@@ -165,6 +166,7 @@ fn checker_scene(size: u32) -> (Scene, View) {
                 [c, c, c, 255]
             })
             .collect(),
+        ktx2: None,
     };
     (s, v)
 }
@@ -374,6 +376,7 @@ fn texture_transform_moves_the_normal_map_too() {
                 width: 2,
                 height: 1,
                 rgba: vec![204, 128, 230, 255, 51, 128, 230, 255],
+                ktx2: None,
             },
         );
         let material = Material {
@@ -453,6 +456,7 @@ fn occlusion_scales_the_ambient_term_only() {
                 width: 2,
                 height: 1,
                 rgba: vec![255, 0, 0, 255, 64, 0, 0, 255],
+                ktx2: None,
             },
         );
         let material = Material {

@@ -431,6 +431,7 @@ fn read_texture(t: &Bound<'_, PyAny>, name: &str) -> PyResult<Texture> {
         width: w as u32,
         height: h as u32,
         rgba,
+        ktx2: None,
     })
 }
 

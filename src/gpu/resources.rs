@@ -357,12 +357,24 @@ impl Image {
         chain: &crate::math::mips::MipChain,
         srgb: bool,
     ) -> Result<Self, GpuError> {
+        Self::texture_levels(ctx, name, chain, rgba8_format(srgb))
+    }
+
+    /// A sampled texture of `format` (RGBA8 or a block-compressed format, whose levels hold
+    /// whole blocks) with the levels of `chain`, one copy per level. Left in `FragmentSampled`
+    /// layout.
+    pub fn texture_levels(
+        ctx: &Arc<Context>,
+        name: &str,
+        chain: &crate::math::mips::MipChain,
+        format: vk::Format,
+    ) -> Result<Self, GpuError> {
         let (width, height, _) = chain.levels.first().copied().unwrap_or((1, 1, 0));
         let mips = chain.levels.len().max(1) as u32;
-        Self::upload_rgba8(
+        Self::upload_levels(
             ctx,
             name,
-            srgb,
+            format,
             (width, height, mips),
             &chain.bytes,
             &chain.levels,
@@ -398,10 +410,10 @@ impl Image {
             1
         };
         let base = [(width, height, 0)];
-        Self::upload_rgba8(
+        Self::upload_levels(
             ctx,
             name,
-            srgb,
+            rgba8_format(srgb),
             (width, height, mips),
             rgba,
             &base,
@@ -443,29 +455,34 @@ impl Image {
         )
     }
 
-    /// Creates a sampled RGBA8 image of `size` = (width, height, mip levels) and, in one
+    /// Creates a sampled image of `format` and `size` = (width, height, mip levels) and, in one
     /// submission, copies `levels` (width, height, byte offset in `bytes`, level by level from 0)
     /// into it, all levels moved to `TransferDst` first; `then` records what follows the copies
-    /// (their layout changes, blits) on the image.
-    fn upload_rgba8(
+    /// (their layout changes, blits) on the image. Only RGBA8 images are blit sources.
+    fn upload_levels(
         ctx: &Arc<Context>,
         name: &str,
-        srgb: bool,
+        format: vk::Format,
         size: (u32, u32, u32),
         bytes: &[u8],
         levels: &[(u32, u32, usize)],
         then: impl FnOnce(&ash::Device, vk::CommandBuffer, vk::Image),
     ) -> Result<Self, GpuError> {
         let (width, height, mips) = size;
+        let blit_source = [true, false].map(rgba8_format).contains(&format);
         let img = Image::new(
             ctx,
             name,
-            rgba8_format(srgb),
+            format,
             vk::Extent2D { width, height },
             mips,
             vk::ImageUsageFlags::SAMPLED
                 | vk::ImageUsageFlags::TRANSFER_DST
-                | vk::ImageUsageFlags::TRANSFER_SRC,
+                | if blit_source {
+                    vk::ImageUsageFlags::TRANSFER_SRC
+                } else {
+                    vk::ImageUsageFlags::empty()
+                },
         )?;
         let mut staging = Buffer::new(
             ctx,

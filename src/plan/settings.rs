@@ -336,6 +336,13 @@ pub struct SceneOptions {
     /// ones. The same image to the bit. Off by default (each `render` then measures the whole
     /// shadow pass); the viewer and image sequences turn it on.
     pub shadow_cache: bool,
+    /// KTX2 textures (`KHR_texture_basisu`) kept block-compressed on the device: each of the
+    /// file's own mip levels transcoded to BC7 (a quarter of RGBA8's memory and bandwidth).
+    /// `None`: on where the device samples BC7 and is a GPU; off on CPU devices, where lavapipe
+    /// decodes a block on every fetch (`docs/compressed-gltf.md` has the figures). Off, or where
+    /// the device has no BC7, the levels are transcoded to RGBA8. Either way the file's mips are
+    /// kept; a file with one level gets a chain made as for any image (RGBA8).
+    pub block_compressed: Option<bool>,
 }
 
 impl Default for SceneOptions {
@@ -348,6 +355,7 @@ impl Default for SceneOptions {
             deferred: None,
             receiver_split: None,
             shadow_cache: false,
+            block_compressed: None,
         }
     }
 }
@@ -365,6 +373,8 @@ pub struct DeviceFacts {
     pub deferred_formats: bool,
     /// The largest sampler anisotropy, None when the feature is off.
     pub max_anisotropy: Option<f32>,
+    /// Whether BC7 (sRGB and linear) can be sampled with linear filtering and uploaded.
+    pub bc7: bool,
 }
 
 impl SceneOptions {
@@ -381,6 +391,12 @@ impl SceneOptions {
             n /= 2;
         }
         n.max(1)
+    }
+
+    /// Whether KTX2 textures are uploaded as BC7 on the device (`block_compressed`, or its
+    /// default, where the device has BC7).
+    pub fn resolved_block_compressed(&self, device: &DeviceFacts) -> bool {
+        self.block_compressed.unwrap_or(!device.cpu) && device.bc7
     }
 
     /// Whether mip chains are made on the CPU on the device (`cpu_mips`, or its default).

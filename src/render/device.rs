@@ -25,5 +25,14 @@ pub fn device_facts(ctx: &Context) -> DeviceFacts {
                 F::COLOR_ATTACHMENT | F::SAMPLED_IMAGE,
             ),
         max_anisotropy: ctx.anisotropy.then_some(l.max_sampler_anisotropy),
+        bc7: ctx.texture_compression_bc
+            && [Format::BC7_SRGB_BLOCK, Format::BC7_UNORM_BLOCK]
+                .into_iter()
+                .all(|f| {
+                    has(
+                        f,
+                        F::SAMPLED_IMAGE | F::SAMPLED_IMAGE_FILTER_LINEAR | F::TRANSFER_DST,
+                    )
+                }),
     }
 }

@@ -226,6 +226,12 @@ impl Renderer {
         self.core.gpu.triangles
     }
 
+    /// What the scene's textures take on the device: images, KTX2 images with the file's own
+    /// levels, BC7 images, bytes.
+    pub fn texture_stats(&self) -> crate::render::TextureStats {
+        self.core.gpu.texture_stats
+    }
+
     /// Draws whose shadow casters are their lone cutout cards cut to their alpha
     /// (`scene::mesh::trim`; only with `SceneOptions::culling`).
     pub fn cut_casters(&self) -> usize {

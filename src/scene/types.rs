@@ -177,6 +177,10 @@ pub struct Texture {
     pub height: u32,
     /// Row-major RGBA8 pixels, `width * height * 4` bytes.
     pub rgba: Vec<u8>,
+    /// The KTX2 file (`KHR_texture_basisu`) that `rgba` is the first level of: the renderer
+    /// uploads the file's own mip levels, as BC7 where `SceneOptions::block_compressed` says.
+    /// `None` for every other image (its chain is made from `rgba`).
+    pub ktx2: Option<std::sync::Arc<[u8]>>,
 }
 
 /// Kind of punctual light.

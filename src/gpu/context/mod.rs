@@ -70,6 +70,8 @@ pub struct Context {
     pub device_name: String,
     /// Whether sampler anisotropy is enabled.
     pub anisotropy: bool,
+    /// Whether the BC block-compressed formats are enabled (`textureCompressionBC`).
+    pub texture_compression_bc: bool,
     /// Valid bits of timestamps on the queue (0 = no timestamps).
     pub timestamp_valid_bits: u32,
     /// Whether fragment shaders may write storage buffers (`fragmentStoresAndAtomics`, enabled
@@ -139,11 +141,17 @@ impl Context {
         let features = unsafe { instance.get_physical_device_features(physical) };
         let fragment_stores = features.fragment_stores_and_atomics == vk::TRUE;
         let independent_blend = features.independent_blend == vk::TRUE;
+        let texture_compression_bc = features.texture_compression_bc == vk::TRUE;
         let device = create_device(
             &instance,
             physical,
             queue_family,
-            (anisotropy, fragment_stores, independent_blend),
+            (
+                anisotropy,
+                fragment_stores,
+                independent_blend,
+                texture_compression_bc,
+            ),
             desc.swapchain,
         )?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -195,6 +203,7 @@ impl Context {
             properties,
             device_name,
             anisotropy,
+            texture_compression_bc,
             timestamp_valid_bits,
             fragment_stores,
             independent_blend,

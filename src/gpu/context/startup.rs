@@ -172,16 +172,16 @@ pub(super) fn create_instance(
 }
 
 /// Creates the logical device with dynamic rendering, synchronization2 and depth clamp (and the
-/// swapchain extension when asked for), and with sampler anisotropy, fragment-shader stores and
-/// independent blend where `optional` says the device has them.
+/// swapchain extension when asked for), and with sampler anisotropy, fragment-shader stores,
+/// independent blend and BC texture compression where `optional` says the device has them.
 pub(super) fn create_device(
     instance: &InstanceOwner,
     physical: vk::PhysicalDevice,
     queue_family: u32,
-    optional: (bool, bool, bool),
+    optional: (bool, bool, bool, bool),
     swapchain: bool,
 ) -> Result<DeviceOwner, GpuError> {
-    let (anisotropy, fragment_stores, independent_blend) = optional;
+    let (anisotropy, fragment_stores, independent_blend, bc) = optional;
     let priorities = [1.0f32];
     let queue_info = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(queue_family)
@@ -193,7 +193,8 @@ pub(super) fn create_device(
         .depth_clamp(true)
         .sampler_anisotropy(anisotropy)
         .fragment_stores_and_atomics(fragment_stores)
-        .independent_blend(independent_blend);
+        .independent_blend(independent_blend)
+        .texture_compression_bc(bc);
     let mut device_exts: Vec<*const i8> = Vec::new();
     if swapchain {
         device_exts.push(ash::khr::swapchain::NAME.as_ptr());

@@ -4,11 +4,9 @@
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::scene as sh;
 use crate::gpu::{Buffer, Image};
-use crate::math::mips::mip_chain;
-use crate::plan::settings::SceneOptions;
 use crate::plan::uniforms::MaterialUniform;
 use crate::render::samplers::SamplerCache;
-use crate::scene::{AlphaMode, Material, Scene, TextureRef, BLEND_SHADOW_CUTOFF};
+use crate::scene::{AlphaMode, Material, TextureRef, BLEND_SHADOW_CUTOFF};
 use crate::shader_consts::VariantKey;
 use ash::vk;
 use glam::Vec4;
@@ -69,6 +67,7 @@ pub(super) fn packed_occlusion(
         width: occlusion.width,
         height: occlusion.height,
         rgba,
+        ktx2: None,
     }
 }
 
@@ -137,67 +136,6 @@ pub fn material_variant_bits(m: &crate::scene::Material) -> VariantKey {
         }
     }
     bits
-}
-
-/// Uploads the textures the materials use: one per (image, colour space), one per packed
-/// (metallic-roughness, occlusion) pair, then the three defaults (white sRGB, white linear, flat
-/// normal) from the returned index on.
-pub(super) fn upload_textures(
-    ctx: &Arc<Context>,
-    scene: &Scene,
-    options: &SceneOptions,
-) -> Result<Uploaded, GpuError> {
-    // Textures, created per (image, colour space) actually used, and per packed
-    // (metallic-roughness, occlusion) pair; their mip chains computed on all cores first.
-    let mut jobs: Vec<TextureJob> = scene
-        .materials
-        .iter()
-        .flat_map(|m| texture_jobs(m, scene.textures.len()))
-        .flatten()
-        .collect();
-    let mut seen = std::collections::HashSet::new();
-    jobs.retain(|j| seen.insert(*j));
-    // Mip chains computed here (`SceneOptions::cpu_mips`: by default on CPU devices), a few
-    // textures at a time on all cores (a 2048² chain is 21 MiB, dropped once uploaded), or
-    // blitted on the device.
-    let cpu_mips = options.resolved_cpu_mips(&crate::render::device_facts(ctx));
-    let batch = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut textures: Vec<Image> = Vec::new();
-    let mut tex_index: HashMap<TextureJob, usize> = HashMap::new();
-    for part in jobs.chunks(batch.max(1)) {
-        let done = crate::parallel::map(part, |j| {
-            let t = match *j {
-                TextureJob::Image(i, _) => std::borrow::Cow::Borrowed(&scene.textures[i]),
-                TextureJob::Packed((mr, o)) => std::borrow::Cow::Owned(packed_occlusion(
-                    &scene.textures[o],
-                    mr.map(|i| &scene.textures[i]),
-                )),
-            };
-            let srgb = matches!(j, TextureJob::Image(_, true));
-            let chain = cpu_mips.then(|| mip_chain(t.width, t.height, &t.rgba, srgb));
-            (t, chain, srgb)
-        });
-        for (j, (t, chain, srgb)) in part.iter().zip(done) {
-            textures.push(match chain {
-                Some(c) => Image::texture_mips(ctx, &t.name, &c, srgb)?,
-                None => Image::texture_rgba8(ctx, &t.name, t.width, t.height, &t.rgba, srgb)?,
-            });
-            tex_index.insert(*j, textures.len() - 1);
-        }
-    }
-    let white_srgb = Image::texture_rgba8(ctx, "default white sRGB", 1, 1, &[255; 4], true)?;
-    let white_linear = Image::texture_rgba8(ctx, "default white", 1, 1, &[255; 4], false)?;
-    let flat_normal = Image::texture_rgba8(
-        ctx,
-        "default flat normal",
-        1,
-        1,
-        &[128, 128, 255, 255],
-        false,
-    )?;
-    let defaults = textures.len();
-    textures.extend([white_srgb, white_linear, flat_normal]);
-    Ok((textures, tex_index, defaults))
 }
 
 /// Material `m`'s uniform block; `orm_ref` is the texture its metallic-roughness slot reads.
@@ -298,7 +236,3 @@ pub(super) fn write_material_set(
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
     Ok(())
 }
-
-/// What `upload_textures` made: the images, the image of each texture job, and the index of the
-/// first default texture.
-pub(super) type Uploaded = (Vec<Image>, HashMap<TextureJob, usize>, usize);

@@ -2,24 +2,26 @@
 //! stream, one index buffer, textures with mipmaps, and a descriptor set per material.
 //!
 //! `geometry` packs the vertex and index streams, `draws` makes the per-instance draws,
-//! `materials` uploads textures and writes each material's set.
+//! `textures` uploads the textures, `materials` writes each material's set.
 
 mod draws;
 mod geometry;
 mod materials;
+mod textures;
 
 pub use draws::{AlphaDraw, Draw, IndexRange};
 pub use geometry::{vertex_layout, VertexAttributes};
 pub use materials::material_variant_bits;
+pub use textures::TextureStats;
 
 use crate::gpu::Recorder;
 use crate::shader_consts::VariantKey;
 use draws::build_draws;
 use geometry::{pack_geometry, vertex_attributes, Geometry, PrimitiveRange};
 use materials::{
-    material_uniform, orm_slot, reads_texcoord0_only, upload_textures, write_material_set,
-    TextureViews,
+    material_uniform, orm_slot, reads_texcoord0_only, write_material_set, TextureViews,
 };
+use textures::upload_textures;
 
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, scene as sh, set_layout};
@@ -59,6 +61,8 @@ pub struct GpuScene {
     pub triangles: usize,
     /// Whether draws outside the camera's view are skipped (`SceneOptions::culling`).
     pub frustum_culling: bool,
+    /// What the textures take on the device.
+    pub texture_stats: TextureStats,
     /// The distinct (material variant bits, alpha treatment) pairs of the draws: the camera
     /// pipelines the scene needs per frame variant.
     pub pipeline_keys: Vec<(VariantKey, AlphaDraw)>,
@@ -265,7 +269,7 @@ impl GpuScene {
             bytemuck::cast_slice(&indices),
         )?;
 
-        let (textures, tex_index, defaults) = upload_textures(ctx, scene, options)?;
+        let (textures, tex_index, defaults, texture_stats) = upload_textures(ctx, scene, options)?;
 
         let material_layout = set_layout(ctx, sh::BINDINGS, 1, "material set layout")?;
         let (pool, sets) =
@@ -305,6 +309,7 @@ impl GpuScene {
             clusters: all_clusters,
             triangles,
             frustum_culling: options.culling,
+            texture_stats,
             pipeline_keys,
             ranges,
             origin,

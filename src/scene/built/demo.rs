@@ -34,6 +34,7 @@ pub fn checker_texture(size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> Texture
         width: size,
         height: size,
         rgba,
+        ktx2: None,
     }
 }
 
@@ -61,6 +62,7 @@ pub fn bump_normal_map(size: u32, bumps: u32, strength: f32) -> Texture {
         width: size,
         height: size,
         rgba,
+        ktx2: None,
     }
 }
 

@@ -68,6 +68,7 @@ pub fn leaf_texture(size: u32) -> Texture {
         width: size,
         height: size,
         rgba,
+        ktx2: None,
     }
 }
 

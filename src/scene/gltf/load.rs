@@ -190,12 +190,13 @@ fn read_images(
                 );
                 image_slots.push(None);
             }
-            (Ok(_), Ok((w, h, rgba))) => {
+            (Ok(d), Ok((w, h, rgba))) => {
                 scene.textures.push(Texture {
                     name: name.clone(),
                     width: w,
                     height: h,
                     rgba,
+                    ktx2: super::compressed::is_ktx2(d).then(|| d.as_slice().into()),
                 });
                 image_slots.push(Some(scene.textures.len() - 1));
             }

@@ -195,6 +195,7 @@ pub fn scene_options(a: &ViewArgs) -> umbra::plan::SceneOptions {
         deferred: a.deferred,
         receiver_split: a.receiver_split,
         shadow_cache: a.shadow_cache.unwrap_or(false),
+        block_compressed: a.block_compressed,
     }
 }
 

@@ -191,6 +191,10 @@ pub struct ViewArgs {
     /// for CPU devices, off on GPUs.
     #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
     pub receiver_split: Option<bool>,
+    /// Keep KTX2 textures block-compressed on the device (the file's mips transcoded to BC7)
+    /// where it samples BC7; default on for GPUs, off on CPU devices (RGBA8, the file's mips).
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub block_compressed: Option<bool>,
     /// Pose the scene at this time in seconds of `--animation` (each channel clamped to its
     /// keyframes, as glTF says). Without it (and without --animation) the scene is drawn at
     /// rest: the file's node transforms, skins and default morph weights applied.

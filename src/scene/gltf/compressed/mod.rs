@@ -32,6 +32,7 @@ pub use accessor::accessor_type;
 pub use report::{CompressionReport, ExtensionUse};
 pub(super) use sniff::is_ktx2;
 pub(super) use textures::decode_ktx2;
+pub use textures::{ktx2_levels, Ktx2Target};
 
 use super::error::{corrupt, invalid, LoadError};
 use super::input::read_uri;

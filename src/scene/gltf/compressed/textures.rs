@@ -137,6 +137,91 @@ fn transcode(data: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
     Ok((info.width, info.height, rgba[..need].to_vec()))
 }
 
+/// What a KTX2 image's levels are transcoded to for the device.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Ktx2Target {
+    /// 4 bytes a texel, row by row.
+    Rgba8,
+    /// BC7: 16 bytes a 4×4 block, blocks row by row (a level under 4 texels a side is one
+    /// block row or column, padded).
+    Bc7,
+}
+
+impl Ktx2Target {
+    /// Bytes of a `w`×`h` level.
+    pub fn level_bytes(self, w: u32, h: u32) -> usize {
+        match self {
+            Ktx2Target::Rgba8 => w as usize * h as usize * 4,
+            Ktx2Target::Bc7 => w.div_ceil(4) as usize * h.div_ceil(4) as usize * 16,
+        }
+    }
+}
+
+/// Every level of a KTX2 Basis Universal image, the file's own mip chain, transcoded to
+/// `target`. Level l must be max(1, w >> l) × max(1, h >> l) and the chain no longer than a full
+/// one; anything else is an error (the caller then makes its own chain from level 0).
+pub fn ktx2_levels(data: &[u8], target: Ktx2Target) -> Result<crate::math::mips::MipChain, String> {
+    check_ktx2_layout(data)?;
+    #[cfg(feature = "ktx2")]
+    {
+        super::contained("KTX2: the levels do not transcode", || {
+            transcode_levels(data, target)
+        })
+    }
+    #[cfg(not(feature = "ktx2"))]
+    {
+        let _ = target;
+        Err("KTX2 needs umbra's cargo feature `ktx2`, not in this build".into())
+    }
+}
+
+#[cfg(feature = "ktx2")]
+fn transcode_levels(
+    data: &[u8],
+    target: Ktx2Target,
+) -> Result<crate::math::mips::MipChain, String> {
+    use basisu::{DecodeFlags, TargetFormat, Transcoder};
+    let t = Transcoder::new(data).map_err(|e| format!("KTX2: {e:?}"))?;
+    let (w0, h0) = t.base_dimensions();
+    let count = t.level_count().max(1);
+    if count > crate::math::mip_levels(w0, h0) {
+        return Err(format!("KTX2: {count} levels for {w0}x{h0}"));
+    }
+    let format = match target {
+        Ktx2Target::Rgba8 => TargetFormat::Rgba32,
+        Ktx2Target::Bc7 => TargetFormat::Bc7Rgba,
+    };
+    let mut chain = crate::math::mips::MipChain {
+        levels: Vec::with_capacity(count as usize),
+        bytes: Vec::new(),
+    };
+    for level in 0..count {
+        let info = t
+            .image_level_info(level)
+            .map_err(|e| format!("KTX2: {e:?}"))?;
+        let (w, h) = ((w0 >> level).max(1), (h0 >> level).max(1));
+        if (info.width, info.height) != (w, h) {
+            return Err(format!(
+                "KTX2: level {level} is {}x{}, not {w}x{h}",
+                info.width, info.height
+            ));
+        }
+        let out = t
+            .transcode(level, format, DecodeFlags::NONE)
+            .map_err(|e| format!("KTX2: level {level}: {e:?}"))?;
+        let need = target.level_bytes(w, h);
+        if out.len() < need {
+            return Err(format!(
+                "KTX2: level {level} transcoded to {} bytes, expected {need}",
+                out.len()
+            ));
+        }
+        chain.levels.push((w, h, chain.bytes.len()));
+        chain.bytes.extend_from_slice(&out[..need]);
+    }
+    Ok(chain)
+}
+
 /// Without the `ktx2` feature a KTX2 image is not decoded (a warning; the slot falls back).
 #[cfg(not(feature = "ktx2"))]
 pub(in crate::scene) fn decode_ktx2(data: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
