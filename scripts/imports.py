@@ -176,9 +176,9 @@ def main():
         print("cycle: " + ", ".join(name(m) for m in c))
     bad = [(s, t) for s, t in edges if s[1:2] == ("reference",) and t[1:2] == ("render",)]
     bad += [(s, t) for s, t in edges if s[0] == "umbra" and t[0] != "umbra"]
-    # The engine's layers, one way: math -> scene -> gpu -> plan -> render (the plan never sees
+    # The engine's layers, one way: math -> scene -> gpu -> plan -> render -> golden (the plan never sees
     # the device: its device facts are plain inputs, its shader constants ash-free).
-    order = ["math", "scene", "gpu", "plan", "render"]
+    order = ["math", "scene", "gpu", "plan", "render", "golden"]
     rank = lambda m: order.index(m[1]) if m[0] == "umbra" and len(m) > 1 and m[1] in order else None
     bad += [
         (s, t)

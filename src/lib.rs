@@ -27,6 +27,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+#[cfg(feature = "golden")]
+pub mod golden;
 pub mod gpu;
 pub mod math;
 pub(crate) mod parallel;

@@ -12,6 +12,7 @@ mod depth_fit;
 mod exact_shadows;
 mod first_look;
 mod foliage;
+mod golden;
 mod lights;
 mod masked_shadows;
 mod material_inputs;

@@ -6,6 +6,7 @@
 
 mod arrays;
 mod camera;
+mod golden;
 mod render;
 mod scene;
 mod settings;
@@ -50,6 +51,8 @@ fn _umbra(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LoadError", py.get_type::<LoadError>())?;
     m.add("GpuError", py.get_type::<GpuError>())?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(golden::golden_check, m)?)?;
+    m.add("GoldenMismatch", py.get_type::<golden::GoldenMismatch>())?;
     m.add_class::<scene::PyScene>()?;
     m.add_class::<camera::PerspectiveCamera>()?;
     m.add_class::<camera::OrthographicCamera>()?;

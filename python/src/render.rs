@@ -503,6 +503,14 @@ impl OffscreenRenderer {
         Ok(self.ctx()?.device_name.clone())
     }
 
+    /// The device class whose golden images this renderer's frames are compared with
+    /// (`lavapipe`, `nvidia`, `amd`, `intel`, …; `umbra.testing`).
+    #[getter]
+    fn device_class(&self) -> PyResult<String> {
+        let ctx = self.ctx()?;
+        Ok(umbra::golden::device_class(&ctx))
+    }
+
     /// Samples a pixel of the colour image on this device (`msaa` resolved).
     #[getter]
     fn samples(&self) -> PyResult<u32> {

@@ -16,6 +16,7 @@ trimesh (``Scene.from_trimesh(mesh)``); ``umbra.ray`` renders many jobs on a Ray
 """
 
 from ._umbra import (
+    GoldenMismatch,
     GpuError,
     LoadError,
     OffscreenRenderer,
@@ -28,6 +29,7 @@ from ._umbra import (
 )
 
 __all__ = [
+    "GoldenMismatch",
     "GpuError",
     "LoadError",
     "OffscreenRenderer",

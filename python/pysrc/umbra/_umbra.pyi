@@ -136,6 +136,7 @@ class OffscreenRenderer:
     width: int
     height: int
     device: str
+    device_class: str
     samples: int
     validation_problems: int
     def __init__(
@@ -197,3 +198,21 @@ class OffscreenRenderer:
         """Frees the device's resources."""
     def __enter__(self) -> "OffscreenRenderer": ...
     def __exit__(self, *args: Any) -> None: ...
+
+
+class GoldenMismatch(UmbraError):
+    """A frame that does not match its golden image (the message is one line of figures)."""
+
+def golden_check(
+    color: np.ndarray,
+    path: Union[str, "PathLike[str]"],
+    shadow: Optional[np.ndarray] = None,
+    device_class: str = "",
+    pixel_flip: float = 0.0,
+    pixels_over: int = 0,
+    mean_flip: float = 0.0,
+    shadow_changes: int = 0,
+    bless: bool = False,
+    ci: bool = False,
+) -> Dict[str, Any]:
+    """Compares a frame with its golden (``umbra.testing`` wraps it); raises GoldenMismatch."""
