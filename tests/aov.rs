@@ -117,6 +117,36 @@ fn depth_ids_and_normals_read_what_the_geometry_says() {
         );
         let ids = a.instance.iter().filter(|&&i| i == 2).count();
         eprintln!("{name}: {ids} pixels of the front quad's kept half");
+        // Each output read alone is the same array, the others left empty.
+        for (i, set) in [
+            (true, false, false),
+            (false, true, false),
+            (false, false, true),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let (instance, normal, depth) = set;
+            let set = umbra::render::AovSet {
+                instance,
+                normal,
+                depth,
+            };
+            let b = r.render_aovs_of(&View::new(camera), W, H, set).unwrap();
+            let lens = [b.instance.len(), b.normal.len(), b.depth.len()];
+            let want: [usize; 3] =
+                std::array::from_fn(|k| if k == i { (W * H) as usize } else { 0 });
+            assert_eq!(lens, want, "{name}: {set:?}");
+            assert!(
+                b.instance == a.instance || !instance,
+                "{name}: ids alone differ"
+            );
+            assert!(
+                b.normal == a.normal || !normal,
+                "{name}: normals alone differ"
+            );
+            assert!(b.depth == a.depth || !depth, "{name}: depth alone differs");
+        }
     }
     drop(r);
     assert_validation_clean(&ctx);

@@ -222,7 +222,12 @@ fn render_outputs(
         }
     }
     if !depth_from_frame && (wants("depth") || wants("segmentation") || wants("normals")) {
-        let a = r.render_aovs(view, w, h)?;
+        let set = umbra::render::AovSet {
+            instance: wants("segmentation"),
+            normal: wants("normals"),
+            depth: wants("depth"),
+        };
+        let a = r.render_aovs_of(view, w, h, set)?;
         if wants("depth") {
             out.push(Output {
                 name: "depth",

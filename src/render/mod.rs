@@ -18,7 +18,7 @@ pub(crate) mod window;
 pub use device::device_facts;
 pub use gpu_scene::TextureStats;
 pub use renderer::{
-    view_axis_depths, Aovs, BatchShadows, FrameStats, RenderedFrame, Renderer, MAX_SIDE,
+    view_axis_depths, AovSet, Aovs, BatchShadows, FrameStats, RenderedFrame, Renderer, MAX_SIDE,
     SHARED_MAP_MAX,
 };
 #[cfg(feature = "viewer")]

@@ -19,7 +19,7 @@ use std::time::Instant;
 
 mod aov;
 mod batch;
-pub use aov::Aovs;
+pub use aov::{AovSet, Aovs};
 pub use batch::{BatchShadows, SHARED_MAP_MAX};
 
 /// Colour format of offscreen frames (sRGB-encoded on write).

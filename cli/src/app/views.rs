@@ -55,7 +55,12 @@ pub fn render_views(a: &super::cli::RenderArgs, poses: &Path) -> anyhow::Result<
         }
         let aovs = OUTPUTS[1..].iter().filter(|n| wants(n)).collect::<Vec<_>>();
         if !aovs.is_empty() {
-            let a = renderer.render_aovs(v, w, h)?;
+            let set = umbra::render::AovSet {
+                instance: wants("segmentation"),
+                normal: wants("normals"),
+                depth: wants("depth"),
+            };
+            let a = renderer.render_aovs_of(v, w, h, set)?;
             for n in aovs {
                 write_aov(&output_path(png, n), n, &a)?;
             }

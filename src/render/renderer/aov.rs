@@ -14,7 +14,27 @@ use crate::render::targets::Attachment;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-/// A frame's AOVs, row-major, `width`×`height`.
+/// Which AOVs a call reads back (the pass draws all three; only these are copied and read).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AovSet {
+    /// `Aovs::instance`.
+    pub instance: bool,
+    /// `Aovs::normal`.
+    pub normal: bool,
+    /// `Aovs::depth`.
+    pub depth: bool,
+}
+
+impl AovSet {
+    /// All three.
+    pub const ALL: AovSet = AovSet {
+        instance: true,
+        normal: true,
+        depth: true,
+    };
+}
+
+/// A frame's AOVs, row-major, `width`×`height`; an output not asked for (`AovSet`) is empty.
 pub struct Aovs {
     /// Width in pixels.
     pub width: u32,
@@ -81,6 +101,17 @@ impl Renderer {
     /// Renders `view`'s AOVs at `width`×`height` (the camera and culling of `render`, no shadows,
     /// no shading): see [`Aovs`].
     pub fn render_aovs(&mut self, view: &View, width: u32, height: u32) -> Result<Aovs, GpuError> {
+        self.render_aovs_of(view, width, height, AovSet::ALL)
+    }
+
+    /// `render_aovs`, reading back only the outputs in `set` (the others are left empty).
+    pub fn render_aovs_of(
+        &mut self,
+        view: &View,
+        width: u32,
+        height: u32,
+        set: AovSet,
+    ) -> Result<Aovs, GpuError> {
         super::check_size(width, height)?;
         let mut v = view.clone();
         v.mode = ViewMode::Lit;
@@ -102,42 +133,51 @@ impl Renderer {
             &prepared,
             (&mut t.ids.1, &mut t.normals.1, &mut t.depth.1),
         )?;
-        for (image, at, buffer, aspect) in [
+        for (wanted, image, at, buffer, aspect) in [
             (
+                set.instance,
                 &t.ids.0,
                 &mut t.ids.1,
                 &t.ids.2,
                 vk::ImageAspectFlags::COLOR,
             ),
             (
+                set.normal,
                 &t.normals.0,
                 &mut t.normals.1,
                 &t.normals.2,
                 vk::ImageAspectFlags::COLOR,
             ),
             (
+                set.depth,
                 &t.depth.0,
                 &mut t.depth.1,
                 &t.depth.2,
                 vk::ImageAspectFlags::DEPTH,
             ),
         ] {
+            if !wanted {
+                continue;
+            }
             at.transition(d, cmd, Access::TransferSrc);
             copy_to_buffer(d, cmd, image.raw, aspect, extent, buffer.raw);
         }
         transfer_to_host_barrier(d, cmd);
         unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
         ctx.submit_and_wait_with(cmd, self.fence)?;
-        let n = (width * height) as usize;
         fn read<T: bytemuck::Pod>(b: &mut Buffer, n: usize) -> Result<Vec<T>, GpuError> {
+            if n == 0 {
+                return Ok(Vec::new());
+            }
             let m = b
                 .mapped()
                 .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
             Ok(bytemuck::pod_collect_to_vec(&m[..n * size_of::<T>()]))
         }
-        let ids: Vec<u32> = read(&mut t.ids.2, n)?;
-        let normals: Vec<[f32; 4]> = read(&mut t.normals.2, n)?;
-        let depth: Vec<f32> = read(&mut t.depth.2, n)?;
+        let n = |wanted: bool| if wanted { (width * height) as usize } else { 0 };
+        let ids: Vec<u32> = read(&mut t.ids.2, n(set.instance))?;
+        let normals: Vec<[f32; 4]> = read(&mut t.normals.2, n(set.normal))?;
+        let depth: Vec<f32> = read(&mut t.depth.2, n(set.depth))?;
         let plan = prepared.plan;
         let aspect = width as f32 / height.max(1) as f32;
         let proj = crate::plan::camera_projection(&view.camera, aspect);
