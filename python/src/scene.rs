@@ -310,11 +310,18 @@ impl PyScene {
     }
 
     /// Adds a grey ground plane under the scene, wide enough for its shadows (the command line's
-    /// `--ground`); returns its instance index.
-    fn add_ground(&mut self) -> usize {
+    /// `--ground`); returns its instance index. Raises ValueError on a scene without geometry,
+    /// which gives the ground no size.
+    fn add_ground(&mut self) -> PyResult<usize> {
+        let before = self.scene.instances.len();
         umbra::scene::built::shapes::add_ground(&mut self.scene);
+        if self.scene.instances.len() == before {
+            return Err(PyValueError::new_err(
+                "add_ground: the scene has no geometry to size the ground by; add meshes first",
+            ));
+        }
         self.geometry += 1;
-        self.scene.instances.len() - 1
+        Ok(before)
     }
 
     /// The camera (and its 4×4 pose) umbra frames this scene with at `width`×`height`: the

@@ -63,6 +63,7 @@ import umbra
 def test_yard(umbra_golden):
     r = umbra.OffscreenRenderer(64, 48, validation=True)
     scene = umbra.Scene()
+    scene.add_mesh(np.array([[-0.5, 0.3, -0.5], [0.5, 0.3, -0.5], [0.5, 0.3, 0.5], [-0.5, 0.3, 0.5]]), np.array([[0, 2, 1], [0, 3, 2]]))
     scene.add_ground()
     scene.add_directional_light((0.4, -1.0, -0.3))
     camera, pose = umbra.PerspectiveCamera(np.pi / 4, 0.1), umbra.look_at((0, 2, 3), (0, 0, 0))

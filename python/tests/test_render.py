@@ -206,6 +206,8 @@ def test_bad_input_raises(tmp_path):
     with pytest.raises(umbra.LoadError):
         umbra.load(broken)
     s = umbra.Scene()
+    with pytest.raises(ValueError, match="add_ground: the scene has no geometry"):
+        s.add_ground()
     with pytest.raises(ValueError, match="index 7 is past the 4 positions"):
         s.add_mesh(quad(1.0)[0], [[0, 1, 7]])
     with pytest.raises(ValueError, match="expected \\(n, 3\\)"):

@@ -126,7 +126,8 @@ class Scene:
     def set_pose(self, instance: int, pose: ArrayLike) -> None:
         """Moves an instance (4x4 world-from-model); a renderer redraws it without a new upload."""
     def add_ground(self) -> int:
-        """A grey ground under the scene (the command line's --ground); its instance index."""
+        """A grey ground under the scene (the command line's --ground); its instance index.
+        ValueError on a scene without geometry (nothing to size the ground by)."""
     def default_view(self, width: int, height: int) -> Tuple[Camera, np.ndarray]:
         """The camera and 4x4 pose umbra frames the scene with at width x height."""
 
