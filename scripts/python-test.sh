@@ -2,10 +2,13 @@
 # The Python package's tests: builds the extension once into a virtual environment
 # (target/pyenv; maturin's dev profile, sharing the workspace's build), installs what the tests
 # use (numpy, pytest, pillow, trimesh, Ray), and runs pytest on python/tests (validation on;
-# the Ray test starts a local 2-CPU cluster on loopback). Run by scripts/test.sh.
+# the Ray test starts a local 2-CPU cluster on loopback; the report test drives a headless
+# Chromium, installed by scripts/ensure-browser.sh). Run by scripts/test.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/ensure-vulkan.sh --validation --python
+# The report's browser test needs Chromium; without it that test skips (and fails under CI).
+bash scripts/ensure-browser.sh || true
 venv=target/pyenv
 if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"

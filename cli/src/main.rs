@@ -32,12 +32,20 @@ fn main() {
         Command::Sweep(a) => sweep(a),
         #[cfg(feature = "sweep")]
         Command::Stability(a) => stability(a),
+        Command::Report(a) => report(&a.dir, a.output.as_deref()),
     };
     if let Err(e) = result {
         let msg = format!("{e:#}").replace('\n', " ");
         eprintln!("error: {msg}");
         std::process::exit(1);
     }
+}
+
+/// `umbra report DIR` and the commands' `--report`: writes the page, says what it holds.
+fn report(dir: &std::path::Path, out: Option<&std::path::Path>) -> anyhow::Result<()> {
+    let summary = umbra_lab::report::write(dir, out)?;
+    eprintln!("report: {summary}");
+    Ok(())
 }
 
 /// An offscreen context on `device` with the binary's pipeline cache, validated when asked.

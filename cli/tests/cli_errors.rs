@@ -318,6 +318,8 @@ fn bad_arguments() {
     ] {
         std::fs::write(d.join(name), text).unwrap();
     }
+    std::fs::create_dir_all(d.join("broken")).unwrap();
+    std::fs::write(d.join("broken/sweep.json"), "{\"rows\": [1").unwrap();
     for (args, expect) in [
         (vec!["render", "--size", "0x0"], "size"),
         (vec!["render", "--camera", "7"], "camera 7"),
@@ -358,6 +360,11 @@ fn bad_arguments() {
             "pattern",
         ),
         (vec!["render", "--outputs", "depth"], "--views"),
+        (
+            vec!["report", "no-such-folder"],
+            "no-such-folder: not a folder",
+        ),
+        (vec!["report", "broken"], "broken/sweep.json: eof"),
     ] {
         let (ok, stderr) = run(&args, &d);
         assert!(!ok, "{args:?} should fail");

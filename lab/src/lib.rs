@@ -8,10 +8,13 @@
 //! - [`analysis`] (feature `sweep`): speed against accuracy (the configuration sweep, its Pareto
 //!   front and charts), the error-budget chooser, and the stability suite.
 //! - [`score`]: renders a view with the engine and scores it against the reference.
+//! - [`report`]: one self-contained HTML page of failed goldens, `compare`, `sweep` and
+//!   `stability` outputs under a folder (`umbra report DIR`).
 
 #[cfg(feature = "sweep")]
 pub mod analysis;
 pub mod reference;
+pub mod report;
 pub mod score;
 pub mod table;
 

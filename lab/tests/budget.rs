@@ -123,6 +123,7 @@ fn sweep_of_one_view_has_sane_rows_and_resumes() {
         repeat: 2,
         batch: 1,
         light_size: None,
+        images: None,
     };
     let mut rows: Vec<Row> = Vec::new();
     let mut ticks = 0;

@@ -207,6 +207,20 @@ fn builtin_scene_meets_the_thresholds_at_the_defaults() {
     }
     let md = std::fs::read_to_string(dir.join("stability.md")).unwrap();
     assert!(md.contains("| criterion | measured | result |"));
+    // The report page: a row per verdict, each judged as the run judged it, and every chart.
+    let summary = umbra_lab::report::write(&dir, None).unwrap();
+    assert_eq!((summary.stabilities, summary.goldens), (1, 0));
+    let page = std::fs::read_to_string(&summary.path).unwrap();
+    let count = |class: &str| page.matches(&format!("<td class=\"{class}\">")).count();
+    let judged = |p: Option<bool>| r.verdicts.iter().filter(|v| v.pass == p).count();
+    assert_eq!(count("pass"), judged(Some(true)));
+    assert_eq!(count("fail"), judged(Some(false)));
+    assert_eq!(count("na"), judged(None));
+    let charts = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().extension().unwrap() == "png")
+        .count();
+    assert_eq!(page.matches("data:image/png;base64,").count(), charts);
     let _ = std::fs::remove_dir_all(&dir);
     drop(r);
     assert_validation_clean(&ctx);

@@ -175,3 +175,50 @@ pub(super) fn write_failure(c: &Capture, path: &Path) -> Result<Vec<PathBuf>, St
     }
     Ok(written)
 }
+
+/// The suffixes of the files a failure leaves beside its golden.
+const FAILURE_FILES: [&str; 5] = [
+    "actual.png",
+    "diff.png",
+    "actual.shadow.png",
+    "shadow-diff.png",
+    "failure.json",
+];
+
+/// Removes what an earlier failure left beside the golden at `path` (a stale `NAME.actual.png`
+/// would show as a failure in `umbra report`). Files that are not there are no error.
+pub(super) fn remove_failure(path: &Path) {
+    for suffix in FAILURE_FILES {
+        let _ = std::fs::remove_file(beside(path, suffix));
+    }
+}
+
+/// `NAME.failure.json`: the one-line reason, the figures and the tolerance (schema
+/// `umbra-golden-failure/1`).
+pub(super) fn failure_json(
+    reason: &str,
+    f: &Figures,
+    t: &Tolerance,
+    device_class: &str,
+) -> serde_json::Value {
+    serde_json::json!({
+        "schema": "umbra-golden-failure/1",
+        "reason": reason,
+        "device_class": device_class,
+        "figures": {
+            "pixels": f.pixels,
+            "differing": f.differing,
+            "mean_flip": f.mean_flip,
+            "pixels_over": f.pixels_over,
+            "pixel_flip": f.pixel_flip,
+            "shadow_changes": f.shadow_changes.map(|(n, _)| n),
+            "now_in_shadow": f.shadow_changes.map(|(_, d)| d),
+        },
+        "tolerance": {
+            "pixel_flip": t.pixel_flip,
+            "pixels_over": t.pixels_over,
+            "mean_flip": t.mean_flip,
+            "shadow_changes": t.shadow_changes,
+        },
+    })
+}

@@ -5,8 +5,9 @@
 //! pixels allowed over a per-pixel threshold, a mean, and a count of pixels allowed to change
 //! their shadow verdict. On failure it writes `NAME.actual.png` and `NAME.diff.png` (the FLIP
 //! heat map) beside the golden, with `NAME.actual.shadow.png` and `NAME.shadow-diff.png` when
-//! the golden keeps a shadow view, and panics with one line of figures that says apart what
-//! changed in the shadows and what changed in the shading.
+//! the golden keeps a shadow view, and `NAME.failure.json` (the line and the figures, what
+//! `umbra report` shows), and panics with one line of figures that says apart what changed in
+//! the shadows and what changed in the shading. A later match or blessing removes them.
 //!
 //! **Where goldens live.** `assert_frame(&c, "tests/golden/demo.png", …)` reads
 //! `tests/golden/<class>/demo.png`, `<class>` the device class ([`device_class`]: `lavapipe`,
@@ -224,22 +225,30 @@ pub fn check_frame(
     };
     let figures = compare::against(capture, &path, &tolerance).map_err(fail)?;
     let Some(why) = figures.exceeds(&tolerance) else {
+        compare::remove_failure(&path);
         return Ok(Outcome::Matched(figures));
     };
     if bless == Bless::On {
+        compare::remove_failure(&path);
         write_golden(capture, &classed).map_err(fail)?;
         return Ok(Outcome::Blessed {
             path: classed,
             replaced: Some(figures),
         });
     }
-    let written = compare::write_failure(capture, &path).map_err(fail)?;
+    let mut written = compare::write_failure(capture, &path).map_err(fail)?;
+    written.push(beside(&path, "failure.json"));
     let names: Vec<String> = written
         .iter()
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
+    let reason = format!("{}: {why}; wrote {}", path.display(), names.join(", "));
+    let json = compare::failure_json(&reason, &figures, &tolerance, &capture.device_class);
+    let json_path = beside(&path, "failure.json");
+    std::fs::write(&json_path, format!("{json:#}\n"))
+        .map_err(|e| fail(format!("{}: {e}", json_path.display())))?;
     Err(Mismatch {
-        reason: format!("{}: {why}; wrote {}", path.display(), names.join(", ")),
+        reason,
         figures: Some(figures),
         written,
     })

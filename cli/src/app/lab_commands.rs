@@ -15,7 +15,7 @@ pub(crate) fn compare(a: CompareArgs) -> anyhow::Result<()> {
     use umbra_lab::score;
     let scene = load_scene(a.scene.as_ref(), &a.view)?;
     let mut view = make_view(&scene, &a.view)?;
-    let ctx = offscreen_context(false, a.device.clone())?;
+    let ctx = offscreen_context(a.validation, a.device.clone())?;
     let mut renderer = Renderer::with_options(&ctx, &scene, &scene_options(&a.view))?;
     crate::app::cli::warn_msaa(&a.view, renderer.samples());
     crate::app::cli::apply_budget(&scene, &mut view, &a.view, &mut renderer)?;
@@ -79,6 +79,13 @@ pub(crate) fn compare(a: CompareArgs) -> anyhow::Result<()> {
         .zip(lit.stats.gpu_camera_ms)
         .map(|(s, c)| s + c));
     println!("{j}");
+    drop(renderer);
+    finish_context(ctx)?;
+    let p = a.out.join("compare.json");
+    std::fs::write(&p, format!("{j:#}\n")).with_context(|| format!("writing {}", p.display()))?;
+    if a.report {
+        crate::report(&a.out, None)?;
+    }
     Ok(())
 }
 
@@ -198,6 +205,9 @@ pub(crate) fn stability(a: crate::app::cli::StabilityArgs) -> anyhow::Result<()>
         a.out.join("stability.md").display()
     );
     finish_context(ctx)?;
+    if a.report {
+        crate::report(&a.out, None)?;
+    }
     if a.strict && failed > 0 {
         anyhow::bail!("{failed} stability threshold(s) not met");
     }
@@ -236,6 +246,7 @@ pub(crate) fn sweep(a: crate::app::cli::SweepArgs) -> anyhow::Result<()> {
         height,
         repeat: a.repeat,
         light_size: a.light_size,
+        images: (a.images || a.report).then(|| a.out.clone()),
         ..Default::default()
     };
     let campaign = Campaign::new(&scenes, grid.configs(), a.views, opts, &a.out)?;
@@ -277,7 +288,11 @@ pub(crate) fn sweep(a: crate::app::cli::SweepArgs) -> anyhow::Result<()> {
         campaign.csv_path().display(),
         names.len()
     );
-    finish_context(ctx)
+    finish_context(ctx)?;
+    if a.report {
+        crate::report(&a.out, None)?;
+    }
+    Ok(())
 }
 
 /// One line per `--check-budget` result.

@@ -80,7 +80,7 @@ impl Row {
 }
 
 /// How each configuration is measured.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct SweepOptions {
     /// Image width.
     pub width: u32,
@@ -94,7 +94,13 @@ pub struct SweepOptions {
     /// Every light's size (`View::light_size`): the reference is then the area light, and
     /// configurations other than PCSS's cast hard shadows from it.
     pub light_size: Option<f32>,
+    /// Where to save each run's lit image (`crate::report::sweep_image_path` under it, at most
+    /// [`IMAGE_WIDTH`] pixels wide), for the report; None saves none.
+    pub images: Option<std::path::PathBuf>,
 }
+
+/// The widest a saved sweep image is (wider frames are scaled down).
+pub const IMAGE_WIDTH: u32 = 320;
 
 impl Default for SweepOptions {
     fn default() -> Self {
@@ -104,6 +110,7 @@ impl Default for SweepOptions {
             repeat: 5,
             batch: 48,
             light_size: None,
+            images: None,
         }
     }
 }
@@ -225,6 +232,13 @@ fn run_batch(
             exact,
         )?;
         let (m, lit) = (s.metrics, s.lit);
+        if let Some(dir) = &opts.images {
+            let p = crate::report::sweep_image_path(dir, scene, view_name, &c.name());
+            if let Err(e) = save_image(&p, &lit.image) {
+                // The images are for the report: a sweep goes on without one.
+                log::warn!("sweep image not saved: {}: {e}", p.display());
+            }
+        }
         scored.push((m, lit.plan.primary_views().len().max(1) as u32));
         tick();
     }
@@ -290,6 +304,24 @@ fn run_batch(
         });
     }
     Ok(())
+}
+
+/// Saves `img` at `path`, scaled down to [`IMAGE_WIDTH`] where wider.
+fn save_image(path: &Path, img: &image::RgbaImage) -> Result<(), String> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    }
+    let (w, h) = img.dimensions();
+    let small;
+    let img = if w > IMAGE_WIDTH {
+        let sh = (h as u64 * IMAGE_WIDTH as u64 / w as u64).max(1) as u32;
+        small =
+            image::imageops::resize(img, IMAGE_WIDTH, sh, image::imageops::FilterType::Triangle);
+        &small
+    } else {
+        img
+    };
+    img.save(path).map_err(|e| e.to_string())
 }
 
 /// One row per configuration of `rows`, its numbers averaged over the rows of that configuration

@@ -52,6 +52,21 @@ pub enum Command {
     /// DIR/stability.json, charts (SVG + PNG) and DIR/stability.md with the thresholds judged.
     #[cfg(feature = "sweep")]
     Stability(StabilityArgs),
+    /// One self-contained HTML page (no server, no network) of what lies under DIR: failed
+    /// goldens (golden, actual and FLIP diff side by side, a slider, a blink, zoom, the figures),
+    /// compare folders, sweep Pareto charts (each point's settings and images) and stability
+    /// verdicts and charts. Writes DIR/report.html.
+    Report(ReportArgs),
+}
+
+/// `umbra report`.
+#[derive(Args, Debug)]
+pub struct ReportArgs {
+    /// The folder to report on (searched below; build trees and hidden folders skipped).
+    pub dir: PathBuf,
+    /// The page to write (default DIR/report.html).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
 }
 
 /// `umbra stability`.
@@ -84,6 +99,9 @@ pub struct StabilityArgs {
     /// Exit 1 when a threshold fails (the summary says which either way).
     #[arg(long)]
     pub strict: bool,
+    /// Also write OUT/report.html (as `umbra report OUT`).
+    #[arg(long)]
+    pub report: bool,
     /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
     #[arg(long)]
     pub device: Option<String>,
@@ -152,6 +170,13 @@ pub struct SweepArgs {
     /// Views per scene (its cameras, else default, high and ground), at most this many.
     #[arg(long, default_value_t = 4)]
     pub views: usize,
+    /// Save each run's lit image as OUT/images/SCENE/VIEW/CONFIG.png (at most 320 pixels wide),
+    /// which the report shows beside its point.
+    #[arg(long)]
+    pub images: bool,
+    /// Also write OUT/report.html (as `umbra report OUT`); implies --images.
+    #[arg(long)]
+    pub report: bool,
     /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
     #[arg(long)]
     pub device: Option<String>,
@@ -247,16 +272,23 @@ pub struct ViewArgsCmd {
 pub struct CompareArgs {
     /// glTF 2.0 file; the built-in demo scene when omitted.
     pub scene: Option<PathBuf>,
-    /// Folder for gpu.png, reference.png, diff.png, shadow.png (the GPU shadow view) and
-    /// coverage.png (the reference's visible fraction of the shown light).
+    /// Folder for gpu.png, reference.png, diff.png, shadow.png (the GPU shadow view),
+    /// coverage.png (the reference's visible fraction of the shown light) and compare.json (the
+    /// line printed).
     #[arg(long, default_value = ".")]
     pub out: PathBuf,
+    /// Also write OUT/report.html (as `umbra report OUT`).
+    #[arg(long)]
+    pub report: bool,
     /// View and shadow options (as for render).
     #[command(flatten)]
     pub view: ViewArgs,
     /// Vulkan device to use (substring of its name); also UMBRA_DEVICE.
     #[arg(long)]
     pub device: Option<String>,
+    /// Enable the Khronos validation layer; exit 1 on any warning or error.
+    #[arg(long)]
+    pub validation: bool,
 }
 
 /// `umbra render`.
