@@ -140,6 +140,9 @@ def main():
         k = args.index("--over")
         over = int(args[k + 1])
         del args[k : k + 2]
+    if any(a.startswith("-") for a in args) or (args and not args[0].isdigit()):
+        print(__doc__.strip() if __doc__ else "usage: sizes.py [N] [--over L] | --figures | --gate FILE FN")
+        return 2
     n = int(args[0]) if args else 15
     rel = lambda p: os.path.relpath(p, ROOT)
     sizes = sorted(((len(open(f).read().split("\n")) - 1, rel(f)) for f in files()), reverse=True)

@@ -3,7 +3,7 @@
 //! reference. Rows go to CSV (the record a sweep resumes from) and JSON.
 
 use super::grid::{format_name, Config};
-use crate::reference::{ReferenceFrame, ReferenceScene};
+use crate::reference::{Metrics, ReferenceFrame, ReferenceScene};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use umbra::gpu::GpuError;
@@ -242,7 +242,25 @@ fn run_batch(
         scored.push((m, lit.plan.primary_views().len().max(1) as u32));
         tick();
     }
-    // Time, in interleaved rounds.
+    let stats = time_rounds(renderer, &todo, &view_of, opts, tick)?;
+    let device = renderer.context().device_name.clone();
+    for ((c, (m, layers)), st) in todo.iter().zip(scored).zip(stats) {
+        on_row(row(view, c, &m, layers, &st, opts, &device));
+    }
+    Ok(())
+}
+
+/// Times every configuration of `todo` in `opts.repeat` interleaved rounds (one frame of each per
+/// round, so drift of a shared machine spreads over all of them); a frame whose map changed is
+/// rendered once untimed first. Returns each configuration's frames.
+fn time_rounds(
+    renderer: &mut Renderer,
+    todo: &[&Config],
+    view_of: &dyn Fn(&Config, ViewMode) -> View,
+    opts: &SweepOptions,
+    tick: &mut dyn FnMut(),
+) -> Result<Vec<Vec<FrameStats>>, GpuError> {
+    let (w, h) = (opts.width, opts.height);
     let mut stats: Vec<Vec<FrameStats>> = vec![Vec::new(); todo.len()];
     for _ in 0..opts.repeat.max(1) {
         let mut last_map = None;
@@ -260,50 +278,61 @@ fn run_batch(
             tick();
         }
     }
-    for ((c, (m, layers)), st) in todo.iter().zip(scored).zip(stats) {
-        let pick = |f: &dyn Fn(&FrameStats) -> Option<f64>| {
-            median(st.iter().filter_map(f).collect::<Vec<_>>())
-        };
-        // The median frame by GPU time, split into its two passes: the split of one frame adds up
-        // to its total, where medians taken pass by pass need not (a compile stall in the shadow
-        // pass of one frame and the camera pass of another counts twice).
-        let gpu = median_split(&st);
-        let bytes = match c.shadow.format {
-            umbra::plan::ShadowFormat::D16 => 2.0,
-            // `auto` may take either: its memory is D32's at most.
-            _ => 4.0,
-        };
-        on_row(Row {
-            scene: scene.into(),
-            view: view_name.into(),
-            config: c.name(),
-            method: c.method(),
-            filter: c.filter().into(),
-            format: format_name(c.shadow.format).into(),
-            bias: c.bias.into(),
-            map_texels: c.shadow.map_size,
-            shadow_views: layers,
-            shadow_memory_mib: (c.shadow.map_size as f64).powi(2) * bytes * layers as f64
-                / (1024.0 * 1024.0),
-            gpu_shadow_ms: gpu.0,
-            gpu_camera_ms: gpu.1,
-            gpu_ms: gpu.0 + gpu.1,
-            wall_ms: pick(&|s| Some(s.wall_ms)),
-            misclassified: m.misclassified,
-            false_shadow: m.false_shadow,
-            false_light: m.false_light,
-            edge_misclassified: m.edge_misclassified,
-            interior_misclassified: m.interior_misclassified,
-            psnr_db: m.psnr.min(PSNR_IDENTICAL_DB),
-            flip: m.flip,
-            judged_pixels: m.judged_pixels as u64,
-            width_px: w,
-            height_px: h,
-            frames: st.len() as u32,
-            device: renderer.context().device_name.clone(),
-        });
+    Ok(stats)
+}
+
+/// The row of configuration `c` on `view`: its accuracy `m` (`layers` shadow views) and the
+/// medians of its timed frames `st`.
+fn row(
+    view: &SweepView,
+    c: &Config,
+    m: &Metrics,
+    layers: u32,
+    st: &[FrameStats],
+    opts: &SweepOptions,
+    device: &str,
+) -> Row {
+    let pick = |f: &dyn Fn(&FrameStats) -> Option<f64>| {
+        median(st.iter().filter_map(f).collect::<Vec<_>>())
+    };
+    // The median frame by GPU time, split into its two passes: the split of one frame adds up
+    // to its total, where medians taken pass by pass need not (a compile stall in the shadow
+    // pass of one frame and the camera pass of another counts twice).
+    let gpu = median_split(st);
+    let bytes = match c.shadow.format {
+        umbra::plan::ShadowFormat::D16 => 2.0,
+        // `auto` may take either: its memory is D32's at most.
+        _ => 4.0,
+    };
+    Row {
+        scene: view.scene.into(),
+        view: view.name.into(),
+        config: c.name(),
+        method: c.method(),
+        filter: c.filter().into(),
+        format: format_name(c.shadow.format).into(),
+        bias: c.bias.into(),
+        map_texels: c.shadow.map_size,
+        shadow_views: layers,
+        shadow_memory_mib: (c.shadow.map_size as f64).powi(2) * bytes * layers as f64
+            / (1024.0 * 1024.0),
+        gpu_shadow_ms: gpu.0,
+        gpu_camera_ms: gpu.1,
+        gpu_ms: gpu.0 + gpu.1,
+        wall_ms: pick(&|s| Some(s.wall_ms)),
+        misclassified: m.misclassified,
+        false_shadow: m.false_shadow,
+        false_light: m.false_light,
+        edge_misclassified: m.edge_misclassified,
+        interior_misclassified: m.interior_misclassified,
+        psnr_db: m.psnr.min(PSNR_IDENTICAL_DB),
+        flip: m.flip,
+        judged_pixels: m.judged_pixels as u64,
+        width_px: opts.width,
+        height_px: opts.height,
+        frames: st.len() as u32,
+        device: device.into(),
     }
-    Ok(())
 }
 
 /// Saves `img` at `path`, scaled down to [`IMAGE_WIDTH`] where wider.
