@@ -110,3 +110,26 @@ pub fn golden_check<'py>(
     }
     Ok(d)
 }
+
+/// Writes `umbra report`'s page for the folder `dir` (to `out`, else `dir/report.html`): failed
+/// goldens side by side with a slider, a blink and zoom, and any `compare`, `sweep` and
+/// `stability` outputs below it. Returns a dict (`path` and the counts found); raises `OSError`
+/// with one line when the folder cannot be read or the page written.
+#[pyfunction]
+#[pyo3(signature = (dir, out = None))]
+pub fn write_report<'py>(
+    py: Python<'py>,
+    dir: std::path::PathBuf,
+    out: Option<std::path::PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let s = py
+        .detach(|| umbra_lab::report::write(&dir, out.as_deref()))
+        .map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))?;
+    let d = PyDict::new(py);
+    d.set_item("path", s.path)?;
+    d.set_item("goldens", s.goldens)?;
+    d.set_item("compares", s.compares)?;
+    d.set_item("sweeps", s.sweeps)?;
+    d.set_item("stabilities", s.stabilities)?;
+    Ok(d)
+}

@@ -52,6 +52,7 @@ fn _umbra(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("GpuError", py.get_type::<GpuError>())?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(golden::golden_check, m)?)?;
+    m.add_function(wrap_pyfunction!(golden::write_report, m)?)?;
     m.add("GoldenMismatch", py.get_type::<golden::GoldenMismatch>())?;
     m.add_class::<scene::PyScene>()?;
     m.add_class::<camera::PerspectiveCamera>()?;

@@ -87,3 +87,16 @@ def test_the_plugin_end_to_end(pytester, monkeypatch):
     pytester.runpytest_subprocess("--umbra-bless").assert_outcomes(passed=1)
     assert (pytester.path / "golden" / "lavapipe" / "test_yard.png").is_file()
     pytester.runpytest_subprocess().assert_outcomes(passed=1)
+    # A deliberate change (the sun moved): the test fails, and --umbra-report writes the page
+    # over the failed golden and names it.
+    pytester.makepyfile(test_yard=PLUGIN_TEST.replace("(0.4, -1.0, -0.3)", "(-0.4, -1.0, -0.3)"))
+    changed = pytester.runpytest_subprocess("--umbra-report", "report.html")
+    changed.assert_outcomes(failed=1)
+    changed.stdout.fnmatch_lines(["umbra report: *report.html (1 failed golden(s))", "*GoldenMismatch*shading changed*"])
+    page = (pytester.path / "report.html").read_text()
+    assert "lavapipe/test_yard.png" in page and page.count("data:image/png;base64,") == 6
+    # Blessing accepts the change; a passing session writes no page.
+    pytester.runpytest_subprocess("--umbra-bless").assert_outcomes(passed=1)
+    (pytester.path / "report.html").unlink()
+    pytester.runpytest_subprocess("--umbra-report", "report.html").assert_outcomes(passed=1)
+    assert not (pytester.path / "report.html").exists()

@@ -165,3 +165,11 @@ def test_a_pareto_point_shows_its_settings_and_image(page):
     d = shots()
     if d:
         page.screenshot(str(d / "report-sweep.png"), "#sweep article")
+
+
+def test_write_report_from_python(report_dir, tmp_path):
+    s = umbra.write_report(str(report_dir[0]), str(tmp_path / "page.html"))
+    assert (s["goldens"], s["compares"], s["sweeps"], s["stabilities"]) == (1, 1, 1, 0)
+    assert (tmp_path / "page.html").read_text().count("<article") == 3
+    with pytest.raises(OSError, match="missing: not a folder"):
+        umbra.write_report(str(tmp_path / "missing"))

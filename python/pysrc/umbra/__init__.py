@@ -26,6 +26,7 @@ from ._umbra import (
     UmbraError,
     __version__,
     load,
+    write_report,
 )
 
 __all__ = [
@@ -38,6 +39,7 @@ __all__ = [
     "Scene",
     "UmbraError",
     "look_at",
+    "write_report",
     "load",
     "__version__",
 ]

@@ -17,6 +17,10 @@ shadows and in the shading, and writes ``NAME.actual.png`` and ``NAME.diff.png``
 ``pytest --umbra-bless`` (or ``UMBRA_BLESS=1``) writes missing and failing goldens; without it a
 missing golden fails. Under CI (``CI`` set, not ``0``/``false``) blessing is refused and every
 check fails, so CI never blesses.
+
+``pytest --umbra-report PAGE.html`` writes, after a session in which a golden failed, the page
+``umbra report`` writes (golden, actual and diff side by side, a slider, a blink, zoom) over the
+golden folders that failed, and names it in the summary.
 """
 
 import os
@@ -54,6 +58,9 @@ def _on(value: Optional[str]) -> bool:
     return value is not None and value not in ("", "0", "false")
 
 
+_FAILED_FOLDERS = set()
+
+
 class Golden:
     """What the ``umbra_golden`` fixture gives a test."""
 
@@ -82,6 +89,13 @@ class Golden:
         if color is None:
             raise ValueError("umbra_golden: the frame has no 'color' output")
         t = tolerance or Tolerance.exact()
+        try:
+            return self._check(color, shadow, name, renderer, t)
+        except _umbra.GoldenMismatch:
+            _FAILED_FOLDERS.add(self.folder.resolve())
+            raise
+
+    def _check(self, color, shadow, name, renderer, t):
         return _umbra.golden_check(
             color,
             str(self.folder / f"{name}.png"),
@@ -103,6 +117,23 @@ def pytest_addoption(parser):
         default=False,
         help="umbra golden images: write missing and failing goldens (refused under CI)",
     )
+    parser.addoption(
+        "--umbra-report",
+        metavar="PAGE",
+        default=None,
+        help="umbra golden images: after a failure, write one HTML page of the failed goldens",
+    )
+
+
+def pytest_sessionfinish(session):
+    page = session.config.getoption("--umbra-report")
+    if not page or not _FAILED_FOLDERS:
+        return
+    root = Path(os.path.commonpath([str(f) for f in _FAILED_FOLDERS]))
+    s = _umbra.write_report(str(root), str(page))
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is not None:
+        reporter.write_line(f"umbra report: {s['path']} ({s['goldens']} failed golden(s))")
 
 
 @pytest.fixture
