@@ -23,6 +23,25 @@ pub fn values<T: Element + Copy>(
     Ok((ro.as_slice()?.to_vec(), shape))
 }
 
+/// An (H, W, 3|4) uint8 array as RGBA8 pixels (opaque where it has no alpha): width, height and
+/// the pixels; a one-line error naming `name` for any other shape.
+pub fn rgba8(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(u32, u32, Vec<u8>)> {
+    let (v, shape) = values::<u8>(obj, "uint8", name)?;
+    let (h, w, k) = match shape.as_slice() {
+        [h, w, k @ (3 | 4)] if *h > 0 && *w > 0 => (*h, *w, *k),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "{name}: shape {shape:?}, expected (h, w, 3) or (h, w, 4)"
+            )))
+        }
+    };
+    let rgba = v
+        .chunks_exact(k)
+        .flat_map(|c| [c[0], c[1], c[2], if k == 4 { c[3] } else { 255 }])
+        .collect();
+    Ok((w as u32, h as u32, rgba))
+}
+
 /// `obj` as rows of `N` floats: an (n, N) array (or a flat one of n·N values).
 pub fn rows<const N: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f32; N]>> {
     let (v, shape) = values::<f32>(obj, "float32", name)?;

@@ -16,22 +16,8 @@ pyo3::create_exception!(
 
 /// An (H, W, 3|4) uint8 colour array as an RGBA image.
 fn color_image(obj: &Bound<'_, PyAny>) -> PyResult<image::RgbaImage> {
-    let (v, shape) = values::<u8>(obj, "uint8", "color")?;
-    let [h, w, c] = shape[..] else {
-        return Err(PyValueError::new_err(format!(
-            "color: shape {shape:?}, expected (H, W, 3) or (H, W, 4)"
-        )));
-    };
-    if !(c == 3 || c == 4) || w == 0 || h == 0 {
-        return Err(PyValueError::new_err(format!(
-            "color: shape {shape:?}, expected (H, W, 3) or (H, W, 4)"
-        )));
-    }
-    let rgba = v
-        .chunks_exact(c)
-        .flat_map(|p| [p[0], p[1], p[2], if c == 4 { p[3] } else { 255 }])
-        .collect();
-    Ok(image::RgbaImage::from_raw(w as u32, h as u32, rgba).expect("sized above"))
+    let (w, h, rgba) = crate::arrays::rgba8(obj, "color")?;
+    Ok(image::RgbaImage::from_raw(w, h, rgba).expect("sized by rgba8"))
 }
 
 /// An (H, W) float visibility array (the `shadow` output, 0–1) as the grey shadow view.

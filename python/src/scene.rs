@@ -420,23 +420,11 @@ impl PyScene {
 /// Vertex colours: (N, 3) or (N, 4), floats within 0..1 or uint8 (/255).
 /// An sRGB uint8 (H, W, 3|4) image as a texture.
 fn read_texture(t: &Bound<'_, PyAny>, name: &str) -> PyResult<Texture> {
-    let (v, shape) = values::<u8>(t, "uint8", "texture")?;
-    let (h, w, k) = match shape.as_slice() {
-        [h, w, k @ (3 | 4)] if *h > 0 && *w > 0 => (*h, *w, *k),
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "texture: shape {shape:?}, expected (h, w, 3) or (h, w, 4)"
-            )))
-        }
-    };
-    let rgba = v
-        .chunks_exact(k)
-        .flat_map(|c| [c[0], c[1], c[2], if k == 4 { c[3] } else { 255 }])
-        .collect();
+    let (width, height, rgba) = crate::arrays::rgba8(t, "texture")?;
     Ok(Texture {
         name: name.to_string(),
-        width: w as u32,
-        height: h as u32,
+        width,
+        height,
         rgba,
         ktx2: None,
     })

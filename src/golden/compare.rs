@@ -92,8 +92,19 @@ fn lit(p: &image::Rgba<u8>) -> bool {
     p[0] >= 128
 }
 
+/// What a comparison read and computed, kept for the failure's images: the golden and the FLIP
+/// map (None where no colour differed).
+pub(super) struct Compared {
+    golden: RgbaImage,
+    flip: Option<nv_flip::FlipImageFloat>,
+}
+
 /// The capture against the golden at `path` (and its shadow view beside it, if both have one).
-pub(super) fn against(c: &Capture, path: &Path, t: &Tolerance) -> Result<Figures, String> {
+pub(super) fn against(
+    c: &Capture,
+    path: &Path,
+    t: &Tolerance,
+) -> Result<(Figures, Compared), String> {
     let golden = load(path)?;
     if golden.dimensions() != c.lit.dimensions() {
         let (gw, gh) = golden.dimensions();
@@ -109,13 +120,15 @@ pub(super) fn against(c: &Capture, path: &Path, t: &Tolerance) -> Result<Figures
         .zip(c.lit.pixels())
         .filter(|(a, b)| differs(a, b))
         .count();
-    let (mean_flip, over) = if differing == 0 {
-        (0.0, 0)
-    } else {
-        let err = flip(&golden, &c.lit).to_vec();
-        let mean = err.iter().map(|&e| e as f64).sum::<f64>() / err.len() as f64;
-        let over = err.iter().filter(|&&e| e > t.pixel_flip).count();
-        (mean as f32, over)
+    let map = (differing > 0).then(|| flip(&golden, &c.lit));
+    let (mean_flip, over) = match &map {
+        None => (0.0, 0),
+        Some(m) => {
+            let err = m.to_vec();
+            let mean = err.iter().map(|&e| e as f64).sum::<f64>() / err.len() as f64;
+            let over = err.iter().filter(|&&e| e > t.pixel_flip).count();
+            (mean as f32, over)
+        }
     };
     let shadow_path = beside(path, "shadow.png");
     let shadow_changes = match (&c.shadow, shadow_path.exists()) {
@@ -135,28 +148,34 @@ pub(super) fn against(c: &Capture, path: &Path, t: &Tolerance) -> Result<Figures
         }
         _ => None,
     };
-    Ok(Figures {
+    let figures = Figures {
         pixels: golden.len() / 4,
         differing,
         mean_flip,
         pixels_over: if t.pixel_flip == 0.0 { differing } else { over },
         pixel_flip: t.pixel_flip,
         shadow_changes,
-    })
+    };
+    Ok((figures, Compared { golden, flip: map }))
 }
 
 /// Writes `NAME.actual.png`, `NAME.diff.png` (FLIP heat map, magma) and, with shadow views,
 /// `NAME.actual.shadow.png` and `NAME.shadow-diff.png` (red: now in shadow, blue: now lit, the
-/// golden's verdicts dimmed elsewhere) beside the golden at `path`.
-pub(super) fn write_failure(c: &Capture, path: &Path) -> Result<Vec<PathBuf>, String> {
+/// golden's verdicts dimmed elsewhere) beside the golden at `path`, from what `against` read.
+pub(super) fn write_failure(
+    c: &Capture,
+    path: &Path,
+    compared: Compared,
+) -> Result<Vec<PathBuf>, String> {
     let save = |img: &dyn Fn(&Path) -> image::ImageResult<()>, p: PathBuf| {
         img(&p).map_err(|e| format!("{}: {e}", p.display()))?;
         Ok::<PathBuf, String>(p)
     };
-    let golden = load(path)?;
+    let Compared { golden, flip: map } = compared;
     let (w, h) = golden.dimensions();
     let mut written = vec![save(&|p| c.lit.save(p), beside(path, "actual.png"))?];
-    let heat = flip(&golden, &c.lit).apply_color_lut(&nv_flip::magma_lut());
+    let map = map.unwrap_or_else(|| flip(&golden, &c.lit));
+    let heat = map.apply_color_lut(&nv_flip::magma_lut());
     let heat = RgbImage::from_raw(w, h, heat.to_vec()).ok_or("FLIP heat map size")?;
     written.push(save(&|p| heat.save(p), beside(path, "diff.png"))?);
     let shadow_path = beside(path, "shadow.png");

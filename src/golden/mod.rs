@@ -223,7 +223,7 @@ pub fn check_frame(
             classed.display()
         )));
     };
-    let figures = compare::against(capture, &path, &tolerance).map_err(fail)?;
+    let (figures, compared) = compare::against(capture, &path, &tolerance).map_err(fail)?;
     let Some(why) = figures.exceeds(&tolerance) else {
         compare::remove_failure(&path);
         return Ok(Outcome::Matched(figures));
@@ -236,7 +236,7 @@ pub fn check_frame(
             replaced: Some(figures),
         });
     }
-    let mut written = compare::write_failure(capture, &path).map_err(fail)?;
+    let mut written = compare::write_failure(capture, &path, compared).map_err(fail)?;
     written.push(beside(&path, "failure.json"));
     let names: Vec<String> = written
         .iter()
