@@ -9,19 +9,5 @@ for b in "${UMBRA_CHROMIUM:-}" chromium chromium-browser google-chrome google-ch
     exit 0
   fi
 done
-if [ "$(id -u)" = 0 ]; then
-  SUDO=""
-elif command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
-  SUDO="sudo"
-else
-  echo "umbra: no Chromium for the report's browser test. Run: sudo apt-get install -y chromium" >&2
-  exit 1
-fi
-if ! command -v apt-get >/dev/null 2>&1; then
-  echo "umbra: no Chromium and no apt-get: install Chromium, or set UMBRA_CHROMIUM" >&2
-  exit 1
-fi
-echo "umbra: installing chromium (the report's browser test)" >&2
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq chromium >/dev/null
+echo "umbra: no Chromium for the report's browser test" >&2
+bash "$(dirname "$0")/apt-install.sh" chromium

@@ -59,20 +59,4 @@ if [ "${#missing[@]}" -eq 0 ]; then
   exit 0
 fi
 
-echo "umbra: installing missing packages: ${missing[*]}" >&2
-if [ "$(id -u)" = 0 ]; then
-  SUDO=""
-elif command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
-  SUDO="sudo"
-else
-  echo "umbra: cannot install as this user. Run: sudo apt-get update && sudo apt-get install -y ${missing[*]}" >&2
-  exit 1
-fi
-if ! command -v apt-get >/dev/null 2>&1; then
-  echo "umbra: no apt-get here. Install a Vulkan loader and driver (Mesa lavapipe) and the Khronos validation layer with your package manager: ${missing[*]}" >&2
-  exit 1
-fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
-echo "umbra: installed ${missing[*]}" >&2
+bash "$(dirname "$0")/apt-install.sh" "${missing[@]}"
