@@ -18,7 +18,7 @@ shadows and in the shading, and writes ``NAME.actual.png`` and ``NAME.diff.png``
 missing golden fails. Under CI (``CI`` set, not ``0``/``false``) blessing is refused and every
 check fails, so CI never blesses.
 
-``pytest --umbra-report PAGE.html`` writes, after a session in which a golden failed, the page
+``pytest --umbra-report PAGE.html`` writes, after a pytest run in which a golden failed, the page
 ``umbra report`` writes (golden, actual and diff side by side, a slider, a blink, zoom) over the
 golden folders that failed, and names it in the summary.
 """
