@@ -118,7 +118,6 @@ figure{margin:0}figcaption{font-size:.9em;color:#444}
 img{image-rendering:pixelated;display:block}
 .stack{position:relative;overflow:hidden}
 .stack img{position:absolute;left:0;top:0;clip-path:inset(0px)}
-.cmp[data-mode=slider] .stack .sb{border-left:0}
 table{border-collapse:collapse;margin:.4em 0}td,th{border:1px solid #ddd;padding:.15em .5em;text-align:left;font-variant-numeric:tabular-nums}
 th{background:#f0f0f0;font-weight:600}
 td.pass{background:#e3f6e3}td.fail{background:#fbdcdc;font-weight:600}td.na{color:#888}

@@ -78,43 +78,41 @@ impl std::fmt::Display for Summary {
 pub fn html(root: &Path, found: &Found) -> Result<String, ReportError> {
     let mut body = String::new();
     let mut nav = Vec::new();
+    // Failed goldens always have their section (saying none failed); the others only when found.
     let mut section = |id: &str, title: &str, n: usize, inner: String| {
+        if n == 0 && id != "goldens" {
+            return;
+        }
         nav.push(format!("<a href=\"#{id}\">{title} ({n})</a>"));
         body += &format!("<section id=\"{id}\"><h2>{title} ({n})</h2>{inner}</section>\n");
     };
-    let mut goldens = String::new();
-    for g in &found.goldens {
-        goldens += &sections::golden(root, g)?;
-    }
+    let mut goldens = articles(&found.goldens, |_, g| sections::golden(root, g))?;
     if found.goldens.is_empty() {
         goldens = "<p>No failed goldens: every golden under this folder matched when last \
                    checked (a match removes what a failure left).</p>"
             .into();
     }
     section("goldens", "Failed goldens", found.goldens.len(), goldens);
-    if !found.compares.is_empty() {
-        let mut s = String::new();
-        for c in &found.compares {
-            s += &sections::compare(root, c)?;
-        }
-        section("compare", "Compare", found.compares.len(), s);
-    }
-    if !found.sweeps.is_empty() {
-        let mut s = String::new();
-        for (n, run) in found.sweeps.iter().enumerate() {
-            s += &sweep::sweep(root, n, run)?;
-        }
-        section("sweep", "Sweep", found.sweeps.len(), s);
-    }
-    if !found.stabilities.is_empty() {
-        let mut s = String::new();
-        for r in &found.stabilities {
-            s += &sections::stability(root, r)?;
-        }
-        section("stability", "Stability", found.stabilities.len(), s);
-    }
+    let c = articles(&found.compares, |_, c| sections::compare(root, c))?;
+    section("compare", "Compare", found.compares.len(), c);
+    let s = articles(&found.sweeps, |n, run| sweep::sweep(root, n, run))?;
+    section("sweep", "Sweep", found.sweeps.len(), s);
+    let s = articles(&found.stabilities, |_, r| sections::stability(root, r))?;
+    section("stability", "Stability", found.stabilities.len(), s);
     let title = format!("umbra report: {}", root.display());
     Ok(html::page(&title, &nav.join(""), &body))
+}
+
+/// The articles `one` makes of `items` (with each one's index), one after another.
+fn articles<T>(
+    items: &[T],
+    one: impl Fn(usize, &T) -> Result<String, ReportError>,
+) -> Result<String, ReportError> {
+    let mut s = String::new();
+    for (n, item) in items.iter().enumerate() {
+        s += &one(n, item)?;
+    }
+    Ok(s)
 }
 
 /// Scans `root` and writes the page to `out` (`root/report.html` when None).

@@ -74,16 +74,6 @@ pub struct Found {
     pub stabilities: Vec<StabilityRun>,
 }
 
-impl Found {
-    /// Nothing at all.
-    pub fn is_empty(&self) -> bool {
-        self.goldens.is_empty()
-            && self.compares.is_empty()
-            && self.sweeps.is_empty()
-            && self.stabilities.is_empty()
-    }
-}
-
 /// Walks `root` (symbolic links are not followed, hidden folders and build trees are skipped)
 /// and collects what a report shows.
 pub fn scan(root: &Path) -> Result<Found, ReportError> {
