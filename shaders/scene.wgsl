@@ -189,6 +189,10 @@ fn lit_opaque(in: VsOut, front_facing: bool) -> vec4<f32> {
 
 @fragment
 fn fs_gbuffer(in: VsOut, @builtin(front_facing) front_facing: bool) -> GBuffer {
+    return gbuffer_of(in, front_facing);
+}
+
+fn gbuffer_of(in: VsOut, front_facing: bool) -> GBuffer {
     var out: GBuffer;
     out.a = vec4<u32>(bitcast<u32>(in.clip.z), pack2x16snorm(oct_encode(in.normal)), select(0u, 2u, front_facing), 0u);
     // What only texture reads and normal mapping use (fs_resolve reads it under the same
@@ -275,25 +279,87 @@ fn fs_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> @location(
 
 // Per-pixel outputs for image tests and datasets (the Python package's `segmentation` and
 // `normals`): the draw's instance + 1 (pc.normal_z.w holds it as a float, exact below 2^24) and
-// the interpolated world normal, turned to face the viewer as shading turns it. Masked materials
-// discard below the cutoff as fs_masked does; blended ones are not drawn.
+// the interpolated world normal, turned to face the viewer as shading turns it. Two entry points,
+// as for the lit image: fs_aov for opaque materials reads no texture and never discards (so
+// llvmpipe tests depth first and hidden fragments cost nothing), fs_aov_masked discards below the
+// cutoff as fs_masked does. Blended materials are not drawn.
 struct Aov {
     @location(0) id: u32,
     @location(1) normal: vec4<f32>,
 }
 
-@fragment
-fn fs_aov(in: VsOut, @builtin(front_facing) front_facing: bool) -> Aov {
-    load_uniforms();
-    let base = base_color(in.uv, in.color);
-    if material.extra.x > 0.0 && base.a < material.extra.x {
-        discard;
-    }
+fn aov_of(in: VsOut, front_facing: bool) -> Aov {
     let n = normalize(in.normal);
     var out: Aov;
-    out.id = u32(pc.normal_z.w + 0.5);
+    out.id = u32(pc_block.normal_z.w + 0.5);
     out.normal = vec4<f32>(select(-n, n, front_facing), 1.0);
     return out;
+}
+
+@fragment
+fn fs_aov(in: VsOut, @builtin(front_facing) front_facing: bool) -> Aov {
+    return aov_of(in, front_facing);
+}
+
+@fragment
+fn fs_aov_masked(in: VsOut, @builtin(front_facing) front_facing: bool) -> Aov {
+    load_uniforms();
+    if base_color(in.uv, in.color).a < material.extra.x {
+        discard;
+    }
+    return aov_of(in, front_facing);
+}
+
+// The lit entry points that also write the per-pixel outputs, for a camera pass that draws them
+// as extra targets (one sample per pixel): the colour as fs_main, fs_main_flat and fs_masked
+// write it, the id and normal as fs_aov writes them. fs_gbuffer_aov writes the G-buffer and
+// both; its targets come first so that the G-buffer's unused target stays the last one.
+struct LitAov {
+    @location(0) color: vec4<f32>,
+    @location(1) id: u32,
+    @location(2) normal: vec4<f32>,
+}
+
+fn lit_aov(color: vec4<f32>, aov: Aov) -> LitAov {
+    return LitAov(color, aov.id, aov.normal);
+}
+
+@fragment
+fn fs_main_aov(in: VsOut, @builtin(front_facing) front_facing: bool) -> LitAov {
+    load_uniforms();
+    return lit_aov(lit_opaque(in, front_facing), aov_of(in, front_facing));
+}
+
+@fragment
+fn fs_main_flat_aov(in: FlatOut, @builtin(front_facing) front_facing: bool) -> LitAov {
+    load_flat_material(in);
+    let v = load_flat(in);
+    return lit_aov(lit_opaque(v, front_facing), aov_of(v, front_facing));
+}
+
+@fragment
+fn fs_masked_aov(in: VsOut, @builtin(front_facing) front_facing: bool) -> LitAov {
+    load_uniforms();
+    let base = base_color(in.uv, in.color);
+    if base.a < material.extra.x {
+        discard;
+    }
+    let color = vec4<f32>(highlight(display_surface(shade(in, front_facing, base).color)), 1.0);
+    return lit_aov(color, aov_of(in, front_facing));
+}
+
+struct GBufferAov {
+    @location(0) id: u32,
+    @location(1) normal: vec4<f32>,
+    @location(2) a: vec4<u32>,
+    @location(3) b: vec4<u32>,
+}
+
+@fragment
+fn fs_gbuffer_aov(in: VsOut, @builtin(front_facing) front_facing: bool) -> GBufferAov {
+    let g = gbuffer_of(in, front_facing);
+    let aov = aov_of(in, front_facing);
+    return GBufferAov(aov.id, aov.normal, g.a, g.b);
 }
 
 // A colour ramp of rising brightness: dark blue, teal, yellow, white over t in [0, 1].

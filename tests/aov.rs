@@ -170,3 +170,62 @@ fn close_up_models_cover_a_third_of_the_frame() {
     assert!((0.30..0.37).contains(&share), "{:.3}", share);
     drop(r);
 }
+
+/// `render_with_aovs` at one sample per pixel draws the ids and normals in the camera pass
+/// itself, and what it returns is what two calls return: the image of `render` to the byte, and
+/// the ids, normals and depth of the AOV pass (`render_aovs_of`) to the bit. Over the masked
+/// cut-out, the demo (sky, normal maps), blended and masked foliage, a sphere grid whose
+/// micro-triangles go through the G-buffer (deferred draws), and FlightHelmet when the extra
+/// corpus is there.
+#[test]
+fn camera_pass_aovs_are_the_aov_pass_and_the_image_is_unchanged() {
+    use umbra::render::AovSet;
+    use umbra::scene::built;
+    let ctx = context();
+    let mut cases: Vec<(String, Scene)> = vec![
+        ("aov".into(), scene()),
+        ("demo".into(), built::demo::demo_scene()),
+        (
+            "foliage blend".into(),
+            built::foliage::foliage_scene(AlphaMode::Blend),
+        ),
+        ("spheres 8".into(), built::synthetic::sphere_grid(8)),
+    ];
+    if let Some(extra) = crate::common::corpus::extra_corpus() {
+        let path = extra.join("FlightHelmet/FlightHelmet.gltf");
+        if let Ok(mut s) = umbra::scene::gltf::load_gltf(&path) {
+            built::shapes::add_ground(&mut s);
+            cases.push(("FlightHelmet".into(), s));
+        }
+    }
+    let (w, h) = (200, 150);
+    let mut deferred_seen = false;
+    for (name, scene) in &cases {
+        let mut r = Renderer::new(&ctx, scene).unwrap();
+        let view = View::new(scene.default_camera(w as f32 / h as f32));
+        for set in [
+            AovSet::ALL,
+            AovSet {
+                instance: true,
+                normal: false,
+                depth: false,
+            },
+        ] {
+            let (frame, aovs) = r.render_with_aovs(&view, w, h, set).unwrap();
+            assert!(
+                frame.stats.aovs_in_camera_pass,
+                "{name}: drawn by the AOV pass"
+            );
+            deferred_seen |= frame.stats.deferred_draws > 0;
+            let image = r.render(&view, w, h).unwrap().image;
+            assert!(frame.image == image, "{name}: the image changed");
+            let pass = r.render_aovs_of(&view, w, h, set).unwrap();
+            assert!(aovs.instance == pass.instance, "{name}: ids differ");
+            assert!(aovs.normal == pass.normal, "{name}: normals differ");
+            assert!(aovs.depth == pass.depth, "{name}: depths differ");
+            assert!(aovs.instance.iter().any(|&i| i > 0), "{name}: no ids");
+        }
+    }
+    assert!(deferred_seen, "no case drew deferred");
+    assert_validation_clean(&ctx);
+}

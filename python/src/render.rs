@@ -183,7 +183,8 @@ fn choose_budget(
     Ok(())
 }
 
-/// The frames `outputs` need: the lit image, the AOV pass, the shadow view.
+/// The frames `outputs` need: the lit image (with the AOVs drawn by its own camera pass at one
+/// sample per pixel: `Renderer::render_with_aovs`), the AOV pass alone, the shadow view.
 fn render_outputs(
     r: &mut Renderer,
     view: &View,
@@ -192,57 +193,46 @@ fn render_outputs(
 ) -> Result<Vec<Output>, umbra::GpuError> {
     let wants = |n: &str| outputs.contains(&n);
     let mut out = Vec::new();
-    // At one sample a pixel, the lit frame's own depth buffer is the AOV pass's (the same
-    // rasterisation of the same depth-writing draws): read it instead of drawing the scene again.
-    // A supersampled frame's is at twice the size: the AOV pass draws the image's own.
-    let depth_from_frame = wants("color")
-        && wants("depth")
-        && !wants("segmentation")
-        && !wants("normals")
-        && r.samples() == 1
-        && view.supersample == 1;
+    let set = umbra::render::AovSet {
+        instance: wants("segmentation"),
+        normal: wants("normals"),
+        depth: wants("depth"),
+    };
+    let any_aov = set.instance || set.normal || set.depth;
+    let mut aovs = None;
     if wants("color") {
-        r.set_read_depth(depth_from_frame);
-        let f = r.render(view, w, h);
-        r.set_read_depth(false);
-        let f = f?;
+        let f = if any_aov {
+            let (f, a) = r.render_with_aovs(view, w, h, set)?;
+            aovs = Some(a);
+            f
+        } else {
+            r.render(view, w, h)?
+        };
         let rgb: Vec<u8> = f.image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
         out.push(Output {
             name: "color",
             data: Data::U8(rgb),
             channels: 3,
         });
-        if let Some(d) = f.depth.filter(|_| depth_from_frame) {
-            let proj = umbra::plan::camera_projection(&view.camera, w as f32 / h as f32);
-            out.push(Output {
-                name: "depth",
-                data: Data::F32(umbra::render::view_axis_depths(&d, &proj)),
-                channels: 1,
-            });
-        }
+    } else if any_aov {
+        aovs = Some(r.render_aovs_of(view, w, h, set)?);
     }
-    if !depth_from_frame && (wants("depth") || wants("segmentation") || wants("normals")) {
-        let set = umbra::render::AovSet {
-            instance: wants("segmentation"),
-            normal: wants("normals"),
-            depth: wants("depth"),
-        };
-        let a = r.render_aovs_of(view, w, h, set)?;
-        if wants("depth") {
+    if let Some(a) = aovs {
+        if set.depth {
             out.push(Output {
                 name: "depth",
                 data: Data::F32(a.depth),
                 channels: 1,
             });
         }
-        if wants("segmentation") {
+        if set.instance {
             out.push(Output {
                 name: "segmentation",
                 data: Data::U32(a.instance),
                 channels: 1,
             });
         }
-        if wants("normals") {
+        if set.normal {
             out.push(Output {
                 name: "normals",
                 data: Data::F32(a.normal.into_iter().flatten().collect()),

@@ -121,7 +121,7 @@ pub struct SceneImmediates {
     pub normal_x: Vec4,
     /// Normal matrix column 1; w = 1 to tint the draw (the viewer's picked primitive).
     pub normal_y: Vec4,
-    /// Normal matrix column 2.
+    /// Normal matrix column 2; w = the draw's instance + 1 (the id the AOV outputs write).
     pub normal_z: Vec4,
 }
 
@@ -152,5 +152,12 @@ impl SceneImmediates {
             normal_y: nm.y_axis.extend(0.0),
             normal_z: nm.z_axis.extend(0.0),
         }
+    }
+
+    /// These immediates for a draw of scene instance `instance` (its id in the AOV outputs,
+    /// `normal_z.w`; exact as a float below 2^24).
+    pub fn with_instance(mut self, instance: usize) -> Self {
+        self.normal_z.w = (instance + 1) as f32;
+        self
     }
 }

@@ -174,6 +174,19 @@ impl FrameCore {
         width: u32,
         height: u32,
     ) -> Result<Prepared, GpuError> {
+        self.prepare_with(slot, view, (width, height), false)
+    }
+
+    /// `prepare`; with `aovs` the camera pass also draws each pixel's instance id and world
+    /// normal into `Targets::aovs` where it can (a lit image, `CameraPass::can_draw_aovs`:
+    /// `Prepared::draws_aovs` says whether it does).
+    pub fn prepare_with(
+        &mut self,
+        slot: usize,
+        view: &View,
+        (width, height): (u32, u32),
+        aovs: bool,
+    ) -> Result<Prepared, GpuError> {
         let plan = self.plan(view, width, height);
         let format = plan.shadow_format;
         let hw = self.shadow.hardware_filtering(format);
@@ -199,13 +212,14 @@ impl FrameCore {
         self.camera.write_frame(slot, &plan.uniform)?;
         let cull = camera_cull(view, &plan);
         let sky = view.mode == ViewMode::Lit && plan.background == Background::Sky;
-        let camera = self.camera.plan_frame(
+        let mut camera = self.camera.plan_frame(
             &self.gpu,
             cull,
             extent,
             view.mode == ViewMode::ShadowMap,
             sky,
         );
+        camera.aovs = aovs && view.mode == ViewMode::Lit && self.camera.can_draw_aovs();
         self.camera.ensure_pipelines(&self.gpu, &camera, extent)?;
         let post_aa = view.mode == ViewMode::Lit && view.post_aa == PostAa::Fxaa;
         if post_aa {
@@ -271,6 +285,7 @@ impl FrameCore {
             depth,
             msaa,
             resolve_depth,
+            aovs,
         } = targets;
         let ctx = self.ctx.clone();
         let d = &ctx.device;
@@ -316,7 +331,7 @@ impl FrameCore {
             (ViewMode::Lit, Background::Color(c)) => c.extend(1.0).to_array(),
             _ => CLEAR_COLOR,
         };
-        let targets = camera_targets(
+        let mut targets = camera_targets(
             d,
             cmd,
             (color_target, depth, msaa),
@@ -324,6 +339,11 @@ impl FrameCore {
             extent,
             clear,
         );
+        if let Some((ids, normals)) = aovs.filter(|_| camera.aovs) {
+            ids.transition(d, cmd, Access::ColorAttachment);
+            normals.transition(d, cmd, Access::ColorAttachment);
+            targets.aovs = Some([ids.view, normals.view]);
+        }
         let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
         if frame.post_aa {
             self.post.record(cmd, color);
@@ -432,6 +452,7 @@ fn camera_targets(
         resolve,
         extent,
         clear,
+        aovs: None,
     }
 }
 
@@ -478,6 +499,14 @@ pub struct Prepared {
     post_aa: bool,
 }
 
+impl Prepared {
+    /// Whether the camera pass draws the instance ids and normals too
+    /// (`FrameCore::prepare_with`).
+    pub fn draws_aovs(&self) -> bool {
+        self.camera.aovs
+    }
+}
+
 /// The images one frame is recorded into. With `msaa` the camera pass draws into its
 /// multisampled images and resolves colour into `color` (and depth, sample 0, into `depth` when
 /// `resolve_depth`).
@@ -490,6 +519,9 @@ pub struct Targets<'a> {
     pub msaa: Option<&'a mut MsaaTargets>,
     /// Resolve depth too (for depth readback).
     pub resolve_depth: bool,
+    /// The instance-id and normal targets (`AOV_FORMATS`, one sample) of a frame prepared with
+    /// them (`FrameCore::prepare_with`); left alone by a frame that does not draw them.
+    pub aovs: Option<(&'a mut Attachment, &'a mut Attachment)>,
 }
 
 /// Draws recorded in one frame, after culling.

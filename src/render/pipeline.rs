@@ -115,6 +115,8 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
     if ctx.independent_blend {
         for masked in blend_attachments.iter_mut().rev().take(d.masked_targets) {
             masked.color_write_mask = vk::ColorComponentFlags::empty();
+            // Nothing to blend (and integer targets cannot blend).
+            masked.blend_enable = vk::FALSE;
         }
     }
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);

@@ -54,6 +54,9 @@ pub struct FrameStats {
     pub triangles: usize,
     /// Whether comparisons were filtered in hardware.
     pub hardware_compare: bool,
+    /// Whether the camera pass drew the instance ids and normals too
+    /// (`Renderer::render_with_aovs` at one sample per pixel).
+    pub aovs_in_camera_pass: bool,
 }
 
 /// A rendered frame.
@@ -94,6 +97,10 @@ pub struct Renderer {
     seen_depths: Option<SeenDepths>,
     /// The AOV pass's images (`render_aovs`), made at its first call.
     aov: Option<aov::AovTarget>,
+    /// The AOVs `render_with_aovs` asks the next frames' camera passes to draw too.
+    frame_aovs: Option<AovSet>,
+    /// The ids and normals the last such camera pass drew (taken by `render_with_aovs`).
+    drawn_aovs: Option<(Vec<u32>, Vec<[f32; 3]>)>,
 }
 
 /// A camera (view matrix, projection, drawn size) and the (nearest, farthest) view depth it saw
@@ -184,6 +191,8 @@ impl Renderer {
             read_depth: false,
             seen_depths: None,
             aov: None,
+            frame_aovs: None,
+            drawn_aovs: None,
         })
     }
 
@@ -390,7 +399,13 @@ impl Renderer {
         let (dw, dh) = (width * s, height * s);
         check_size(dw, dh)?;
         let start = Instant::now();
-        let prepared = self.core.prepare(0, view, dw, dh)?;
+        // The camera pass draws the AOVs asked for at one sample per pixel (`render_with_aovs`).
+        let aovs = self.frame_aovs.filter(|_| s == 1);
+        let prepared = self.core.prepare_with(0, view, (dw, dh), aovs.is_some())?;
+        let aovs = aovs.filter(|_| prepared.draws_aovs());
+        if aovs.is_some() {
+            aov::AovTarget::ensure(self, extent)?;
+        }
         self.ensure_target(dw, dh, (s > 1).then_some(extent))?;
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
@@ -400,6 +415,7 @@ impl Renderer {
             height: dh,
         };
         let t = self.target.as_mut().expect("target");
+        let mut aov_target = self.aov.as_mut().filter(|_| aovs.is_some());
         ctx.begin_one_time(cmd)?;
         let counts = self.core.record(
             cmd,
@@ -409,9 +425,14 @@ impl Renderer {
                 depth: &mut t.depth_at,
                 msaa: t.msaa.as_mut(),
                 resolve_depth: self.read_depth,
+                aovs: aov_target.as_mut().map(|a| a.color_targets()),
             },
         );
         let plan = prepared.plan;
+        if let (Some(a), Some(set)) = (aov_target, aovs) {
+            // The depth is the frame's own (`read_depth`).
+            a.record_copies(d, cmd, set, false);
+        }
         record_readback(d, cmd, t, (extent, drawn), self.read_depth);
         unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
         ctx.submit_and_wait_with(cmd, self.fence)?;
@@ -428,9 +449,17 @@ impl Renderer {
             draws_total: self.core.gpu.draws.len(),
             triangles: self.core.gpu.triangles,
             hardware_compare: self.core.shadow.hardware_filtering(plan.shadow_format),
+            aovs_in_camera_pass: aovs.is_some(),
         };
         let t = self.target.as_mut().expect("target");
         let (image, depth) = read_back(t, (width, height), drawn, self.read_depth)?;
+        self.drawn_aovs = match (self.aov.as_mut(), aovs) {
+            (Some(a), Some(set)) => {
+                let (ids, normals, _) = a.read(set, false)?;
+                Some((ids, normals))
+            }
+            _ => None,
+        };
         let mut stats = stats;
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(RenderedFrame {

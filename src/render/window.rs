@@ -337,6 +337,7 @@ impl WindowRenderer {
                 depth,
                 msaa: self.msaa.as_mut(),
                 resolve_depth: fit,
+                aovs: None,
             },
         );
         let summary = FrameSummary {

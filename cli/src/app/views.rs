@@ -45,22 +45,32 @@ pub fn render_views(a: &super::cli::RenderArgs, poses: &Path) -> anyhow::Result<
     let mut gpu = Vec::with_capacity(views.len());
     for (v, png) in views.iter().zip(&paths) {
         let t = std::time::Instant::now();
-        if wants("color") {
-            let f = renderer.render(v, w, h)?;
+        let aovs = OUTPUTS[1..].iter().filter(|n| wants(n)).collect::<Vec<_>>();
+        let set = umbra::render::AovSet {
+            instance: wants("segmentation"),
+            normal: wants("normals"),
+            depth: wants("depth"),
+        };
+        // With the image, its own camera pass draws the AOVs where it can (one sample a pixel).
+        let a = if wants("color") {
+            let (f, a) = if aovs.is_empty() {
+                (renderer.render(v, w, h)?, None)
+            } else {
+                let (f, a) = renderer.render_with_aovs(v, w, h, set)?;
+                (f, Some(a))
+            };
             drawn += usize::from(f.stats.casters_drawn > 0);
             gpu.push(f.stats.clone());
             f.image
                 .save(png)
                 .with_context(|| format!("writing {}", png.display()))?;
-        }
-        let aovs = OUTPUTS[1..].iter().filter(|n| wants(n)).collect::<Vec<_>>();
-        if !aovs.is_empty() {
-            let set = umbra::render::AovSet {
-                instance: wants("segmentation"),
-                normal: wants("normals"),
-                depth: wants("depth"),
-            };
-            let a = renderer.render_aovs_of(v, w, h, set)?;
+            a
+        } else if aovs.is_empty() {
+            None
+        } else {
+            Some(renderer.render_aovs_of(v, w, h, set)?)
+        };
+        if let Some(a) = a {
             for n in aovs {
                 write_aov(&output_path(png, n), n, &a)?;
             }

@@ -175,7 +175,7 @@ pub(super) fn build_draws(
                 world_from_model,
                 model_from_world: world_from_model.inverse(),
                 clusters: r.clusters,
-                immediates: SceneImmediates::new(world_from_model),
+                immediates: SceneImmediates::new(world_from_model).with_instance(ii),
                 magnitudes: coordinate_magnitudes(&world_bounds, &world_from_model),
                 world_bounds,
                 world_plane: r.plane.and_then(|pl| world_plane(pl, &world_from_model)),

@@ -51,8 +51,24 @@ pub enum Entry {
     /// `fs_gbuffer`: a deferred draw's varyings into the G-buffer, its material's mark into the
     /// stencil (one pipeline per combination of texture slots: `deferred::gbuffer_variant`).
     GBuffer,
-    /// `fs_aov`: instance ids and world normals into their own targets (`CameraPass::record_aov`).
+    /// `fs_aov`: an opaque material's instance ids and world normals into their own targets
+    /// (`CameraPass::record_aov`; no texture read, no discard).
     Aov,
+    /// `fs_aov_masked`: `Aov` for alpha-masked materials, discarding below the cutoff.
+    AovMasked,
+    /// `fs_main_aov`: `Opaque` in a camera pass that also draws the instance ids and normals as
+    /// targets 1 and 2 (`CameraFrame::aovs`).
+    OpaqueAov,
+    /// `fs_main_flat_aov`: `OpaqueFlat` writing them too.
+    OpaqueFlatAov,
+    /// `fs_masked_aov`: `Masked` writing them too.
+    MaskedAov,
+    /// `fs_blend` in that pass: targets 1 and 2 left alone (blended surfaces have no id).
+    BlendedAov,
+    /// `fs_resolve` in that pass: targets 1 and 2 left alone (the G-buffer pass wrote them).
+    ResolveAov,
+    /// `fs_gbuffer_aov`: the ids and normals (targets 0 and 1) and the G-buffer (2 and 3).
+    GBufferAov,
 }
 
 impl Entry {
@@ -65,6 +81,29 @@ impl Entry {
             (None, AlphaDraw::Masked) => Entry::Masked,
             (None, AlphaDraw::Blended) => Entry::Blended,
             (None, AlphaDraw::Opaque) => Entry::Opaque,
+        }
+    }
+
+    /// This entry's counterpart in a camera pass that also draws the instance ids and normals
+    /// (itself where the pass has none: debug views never draw them).
+    pub fn with_aovs(self) -> Entry {
+        match self {
+            Entry::Opaque => Entry::OpaqueAov,
+            Entry::OpaqueFlat => Entry::OpaqueFlatAov,
+            Entry::Masked => Entry::MaskedAov,
+            Entry::Blended => Entry::BlendedAov,
+            Entry::Resolve => Entry::ResolveAov,
+            Entry::GBuffer => Entry::GBufferAov,
+            e => e,
+        }
+    }
+
+    /// The AOV pass's entry point for a draw of a material treating alpha as `alpha` (blended
+    /// materials are not drawn there).
+    pub fn aov(alpha: AlphaDraw) -> Entry {
+        match alpha {
+            AlphaDraw::Masked => Entry::AovMasked,
+            _ => Entry::Aov,
         }
     }
 }

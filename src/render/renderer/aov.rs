@@ -1,8 +1,10 @@
 //! Per-pixel outputs besides the image (AOVs), for image tests and datasets: each pixel's surface
-//! (instance), world normal and distance along the view axis, from one extra depth-tested pass
-//! (`CameraPass::record_aov`) at one sample per pixel.
+//! (instance), world normal and distance along the view axis. With the image at one sample per
+//! pixel they are targets of the camera pass itself (`Renderer::render_with_aovs`); otherwise,
+//! and alone, they come from one extra depth-tested pass (`CameraPass::record_aov`) at one
+//! sample per pixel.
 
-use super::{copy_to_buffer, transfer_to_host_barrier, Renderer};
+use super::{copy_to_buffer, transfer_to_host_barrier, RenderedFrame, Renderer};
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
@@ -53,6 +55,9 @@ pub struct Aovs {
     pub plan: FramePlan,
 }
 
+/// Instance ids, normals and reversed-z depths as read back (`AovTarget::read`).
+type ReadAovs = (Vec<u32>, Vec<[f32; 3]>, Vec<f32>);
+
 /// The AOV pass's images and readbacks, kept between frames of one size.
 pub(super) struct AovTarget {
     ids: (Image, Attachment, Buffer),
@@ -61,6 +66,78 @@ pub(super) struct AovTarget {
 }
 
 impl AovTarget {
+    /// The images and readbacks of `r` at `extent` (made again when the size changed).
+    pub(super) fn ensure(r: &mut Renderer, extent: vk::Extent2D) -> Result<(), GpuError> {
+        if r.aov.as_ref().is_none_or(|t| t.ids.0.extent != extent) {
+            r.aov = None;
+            r.aov = Some(AovTarget::new(r, extent)?);
+        }
+        Ok(())
+    }
+
+    /// The id and normal targets, for a camera pass that draws them.
+    pub(super) fn color_targets(&mut self) -> (&mut Attachment, &mut Attachment) {
+        (&mut self.ids.1, &mut self.normals.1)
+    }
+
+    /// Records the copies of the outputs in `set` into their readbacks (`depth`: of this
+    /// target's depth image, drawn by the AOV pass); the caller makes them visible to the host.
+    pub(super) fn record_copies(
+        &mut self,
+        d: &ash::Device,
+        cmd: vk::CommandBuffer,
+        set: AovSet,
+        depth: bool,
+    ) {
+        let extent = self.ids.0.extent;
+        let color = vk::ImageAspectFlags::COLOR;
+        for (wanted, (image, at, buffer), aspect) in [
+            (set.instance, &mut self.ids, color),
+            (set.normal, &mut self.normals, color),
+            (
+                set.depth && depth,
+                &mut self.depth,
+                vk::ImageAspectFlags::DEPTH,
+            ),
+        ] {
+            if wanted {
+                at.transition(d, cmd, Access::TransferSrc);
+                copy_to_buffer(d, cmd, image.raw, aspect, extent, buffer.raw);
+            }
+        }
+    }
+
+    /// The (ids, normals, depth) in the readbacks, each empty where `set` (or `depth`) left it
+    /// out.
+    pub(super) fn read(
+        &mut self,
+        set: AovSet,
+        depth: bool,
+    ) -> Result<ReadAovs, GpuError> {
+        fn read<T: bytemuck::Pod>(b: &mut Buffer, n: usize) -> Result<Vec<T>, GpuError> {
+            if n == 0 {
+                return Ok(Vec::new());
+            }
+            let m = b
+                .mapped()
+                .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
+            Ok(bytemuck::pod_collect_to_vec(&m[..n * size_of::<T>()]))
+        }
+        let e = self.ids.0.extent;
+        let n = |wanted: bool| {
+            if wanted {
+                (e.width * e.height) as usize
+            } else {
+                0
+            }
+        };
+        let ids = read(&mut self.ids.2, n(set.instance))?;
+        let normals: Vec<[f32; 4]> = read(&mut self.normals.2, n(set.normal))?;
+        let depth = read(&mut self.depth.2, n(set.depth && depth))?;
+        let normals = normals.iter().map(|n| [n[0], n[1], n[2]]).collect();
+        Ok((ids, normals, depth))
+    }
+
     fn new(r: &Renderer, extent: vk::Extent2D) -> Result<Self, GpuError> {
         let ctx = &r.core.ctx;
         let pixels = extent.width as u64 * extent.height as u64;
@@ -119,10 +196,7 @@ impl Renderer {
         v.highlight = None;
         let prepared = self.core.prepare(0, &v, width, height)?;
         let extent = vk::Extent2D { width, height };
-        if self.aov.as_ref().is_none_or(|t| t.ids.0.extent != extent) {
-            self.aov = None;
-            self.aov = Some(AovTarget::new(self, extent)?);
-        }
+        AovTarget::ensure(self, extent)?;
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
         let cmd = self.cmd;
@@ -133,61 +207,78 @@ impl Renderer {
             &prepared,
             (&mut t.ids.1, &mut t.normals.1, &mut t.depth.1),
         )?;
-        for (wanted, image, at, buffer, aspect) in [
-            (
-                set.instance,
-                &t.ids.0,
-                &mut t.ids.1,
-                &t.ids.2,
-                vk::ImageAspectFlags::COLOR,
-            ),
-            (
-                set.normal,
-                &t.normals.0,
-                &mut t.normals.1,
-                &t.normals.2,
-                vk::ImageAspectFlags::COLOR,
-            ),
-            (
-                set.depth,
-                &t.depth.0,
-                &mut t.depth.1,
-                &t.depth.2,
-                vk::ImageAspectFlags::DEPTH,
-            ),
-        ] {
-            if !wanted {
-                continue;
-            }
-            at.transition(d, cmd, Access::TransferSrc);
-            copy_to_buffer(d, cmd, image.raw, aspect, extent, buffer.raw);
-        }
+        t.record_copies(d, cmd, set, true);
         transfer_to_host_barrier(d, cmd);
         unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
         ctx.submit_and_wait_with(cmd, self.fence)?;
-        fn read<T: bytemuck::Pod>(b: &mut Buffer, n: usize) -> Result<Vec<T>, GpuError> {
-            if n == 0 {
-                return Ok(Vec::new());
+        let (instance, normal, depth) = t.read(set, true)?;
+        Ok(aovs_of(
+            view,
+            (width, height),
+            (instance, normal, &depth),
+            prepared.plan,
+        ))
+    }
+
+    /// Renders `view` as [`Renderer::render`] does, with its AOVs (those in `set`): at one
+    /// sample per pixel the camera pass draws the ids and normals as two more targets and the
+    /// depth is its own depth buffer (one pass over the scene; the image is the same to the
+    /// byte, and the AOVs are those of `render_aovs_of`, as tests check); otherwise (MSAA,
+    /// supersampling, a debug view) the AOV pass draws them after the image. Depth alone adds
+    /// no target at one sample per pixel: it is the frame's depth buffer.
+    pub fn render_with_aovs(
+        &mut self,
+        view: &View,
+        width: u32,
+        height: u32,
+        set: AovSet,
+    ) -> Result<(RenderedFrame, Aovs), GpuError> {
+        let one_sample = self.core.samples == 1 && view.supersample <= 1;
+        let targets = set.instance || set.normal;
+        let was = self.read_depth;
+        self.read_depth = was || (set.depth && one_sample);
+        self.frame_aovs = targets.then_some(set);
+        self.drawn_aovs = None;
+        let frame = self.render(view, width, height);
+        self.read_depth = was;
+        self.frame_aovs = None;
+        let mut frame = frame?;
+        let drawn = match self.drawn_aovs.take() {
+            Some(ids_normals) => Some(ids_normals),
+            None if !targets && one_sample => Some((Vec::new(), Vec::new())),
+            None => None,
+        };
+        let aovs = match drawn {
+            Some((instance, normal)) => {
+                let depth = frame.depth.as_deref().filter(|_| set.depth).unwrap_or(&[]);
+                let plan = frame.plan.clone();
+                aovs_of(view, (width, height), (instance, normal, depth), plan)
             }
-            let m = b
-                .mapped()
-                .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
-            Ok(bytemuck::pod_collect_to_vec(&m[..n * size_of::<T>()]))
+            None => self.render_aovs_of(view, width, height, set)?,
+        };
+        if !was {
+            frame.depth = None;
         }
-        let n = |wanted: bool| if wanted { (width * height) as usize } else { 0 };
-        let ids: Vec<u32> = read(&mut t.ids.2, n(set.instance))?;
-        let normals: Vec<[f32; 4]> = read(&mut t.normals.2, n(set.normal))?;
-        let depth: Vec<f32> = read(&mut t.depth.2, n(set.depth))?;
-        let plan = prepared.plan;
-        let aspect = width as f32 / height.max(1) as f32;
-        let proj = crate::plan::camera_projection(&view.camera, aspect);
-        Ok(Aovs {
-            width,
-            height,
-            depth: super::view_axis_depths(&depth, &proj),
-            instance: ids,
-            normal: normals.iter().map(|n| [n[0], n[1], n[2]]).collect(),
-            plan,
-        })
+        Ok((frame, aovs))
+    }
+}
+
+/// The AOVs of `view` at `width`×`height` from what was read back (`depth`: the reversed-z
+/// depth buffer, made view-axis distances).
+fn aovs_of(
+    view: &View,
+    (width, height): (u32, u32),
+    (instance, normal, depth): (Vec<u32>, Vec<[f32; 3]>, &[f32]),
+    plan: FramePlan,
+) -> Aovs {
+    let aspect = width as f32 / height.max(1) as f32;
+    let proj = crate::plan::camera_projection(&view.camera, aspect);
+    Aovs {
+        width,
+        height,
+        depth: super::view_axis_depths(depth, &proj),
+        instance,
+        normal,
+        plan,
     }
 }

@@ -41,7 +41,8 @@ pub(super) fn aov_draws<'a>(
 
 impl CameraPass {
     /// Records the AOV pass of `frame` (slot `slot`'s uniforms): every visible opaque and masked
-    /// draw, depth-tested, writing its instance id + 1 and world normal (`fs_aov`). Returns the
+    /// draw, depth-tested, writing its instance id + 1 and world normal (`fs_aov`,
+    /// `fs_aov_masked`). Returns the
     /// draws recorded.
     pub fn record_aov(
         &self,
@@ -86,10 +87,10 @@ impl CameraPass {
                 bound_material = dr.material;
             }
             // Made by `ensure_aov_pipelines`.
-            let pipeline = self.pipelines[&(dr.material_bits, Entry::Aov)];
+            let pipeline = self.pipelines[&(dr.material_bits, Entry::aov(dr.alpha))];
             Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
-            let mut imm = dr.immediates;
-            imm.normal_z.w = (dr.source.0 + 1) as f32;
+            // `normal_z.w` holds the instance id (`SceneImmediates::with_instance`).
+            let imm = dr.immediates;
             scene.record_draw(
                 cmd,
                 self.layout,

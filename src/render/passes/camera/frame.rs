@@ -79,21 +79,42 @@ pub struct CameraFrame {
     pub splits: Vec<Split>,
     /// Per forward draw, whether it reads the uniforms as flat inputs (`FLAT_FROM_PIXELS`).
     pub flat: Vec<bool>,
+    /// The pass also draws each pixel's instance id and world normal into two more targets
+    /// (`CameraTargets::aovs`; lit images at one sample per pixel: `CameraPass::can_draw_aovs`).
+    pub aovs: bool,
 }
 
 impl CameraFrame {
     /// The entry point of a forward draw treating alpha as `alpha`, `flat`: reading the uniforms
     /// as flat inputs.
     pub(super) fn entry(&self, alpha: AlphaDraw, flat: bool) -> Entry {
-        if flat {
+        let e = if flat {
             Entry::OpaqueFlat
         } else {
             Entry::of(alpha, self.cull.debug_view)
+        };
+        self.with_aovs(e)
+    }
+
+    /// `e`, or its counterpart writing the ids and normals when the frame draws them.
+    pub(super) fn with_aovs(&self, e: Entry) -> Entry {
+        if self.aovs {
+            e.with_aovs()
+        } else {
+            e
         }
     }
 }
 
 impl CameraPass {
+    /// Whether this pass can draw the instance ids and normals as extra targets of the lit
+    /// image (`CameraFrame::aovs`): at one sample per pixel (an id is never a blend of samples,
+    /// and the depth read with them is the pixel centre's), on a device whose targets can be
+    /// left alone one by one (independent blend; lavapipe and desktop GPUs have it).
+    pub fn can_draw_aovs(&self) -> bool {
+        self.samples == 1 && self.ctx.independent_blend
+    }
+
     /// Decides what the camera pass draws for `cull` at `extent`: the draw order, the deferred
     /// split (`deferred::plan`) and each forward draw's receiver split; `sky`: the background is
     /// the sky (not drawn with the shadow-map view).
@@ -137,6 +158,7 @@ impl CameraPass {
             defer,
             splits,
             flat,
+            aovs: false,
         }
     }
 }
@@ -168,6 +190,9 @@ pub struct CameraTargets {
     pub extent: vk::Extent2D,
     /// The linear clear colour.
     pub clear: [f32; 4],
+    /// The instance-id and normal targets (`AOV_FORMATS`, one sample, in attachment layouts)
+    /// of a frame that draws them (`CameraFrame::aovs`).
+    pub aovs: Option<[vk::ImageView; 2]>,
 }
 
 /// Where a multisampled camera pass resolves to (both None without MSAA).

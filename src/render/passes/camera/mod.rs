@@ -79,6 +79,9 @@ pub struct CameraPass {
     map_pipeline: vk::Pipeline,
     /// The background where nothing was drawn (`fs_sky`).
     sky_pipeline: vk::Pipeline,
+    /// `sky_pipeline` in a pass that also draws the ids and normals (made by the first such
+    /// frame; those targets left alone).
+    sky_aovs: Option<vk::Pipeline>,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
     linear_sampler: vk::Sampler,
@@ -147,6 +150,7 @@ impl CameraPass {
             pipelines: HashMap::new(),
             map_pipeline,
             sky_pipeline,
+            sky_aovs: None,
             pool,
             slots: slot_list,
             linear_sampler,
@@ -245,22 +249,53 @@ fn fixed_pipelines(
         samples: formats.samples,
     };
     let map_pipeline = create_pipeline(ctx, &desc)?;
+    let sky_pipeline = sky_pipeline(
+        ctx,
+        layout,
+        module,
+        &[formats.color],
+        (formats.depth, formats.samples),
+        flat_cpu,
+    )?;
+    Ok((map_pipeline, sky_pipeline))
+}
+
+/// The sky's pipeline for a pass of `color_formats` (the first the image; any others left
+/// alone) and `depth` (format, samples): one full-screen triangle at depth 0, shaded where no
+/// surface was; with `flat_cpu` its uniforms as flat inputs.
+pub(super) fn sky_pipeline(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    module: vk::ShaderModule,
+    color_formats: &[vk::Format],
+    (depth_format, samples): (vk::Format, u32),
+    flat_cpu: bool,
+) -> Result<vk::Pipeline, GpuError> {
     let (sky_vs, sky_fs) = if flat_cpu {
         (sh::ENTRY_VS_SKY, sh::ENTRY_FS_SKY_FLAT)
     } else {
         (sh::ENTRY_VS_FULLSCREEN, sh::ENTRY_FS_SKY)
     };
-    let sky_pipeline = create_pipeline(
+    create_pipeline(
         ctx,
         &PipelineDesc {
             name: "sky pipeline",
+            layout,
             vertex: (module, sky_vs),
             fragment: Some((module, sky_fs)),
+            bindings: &[],
+            attributes: &[],
+            color_formats,
+            masked_targets: color_formats.len() - 1,
+            depth_format,
+            stencil: Stencil::Off,
+            depth_clamp: false,
+            depth_bias: false,
             depth: Depth::Empty,
-            ..desc
+            blend: ColorBlend::Off,
+            samples,
         },
-    )?;
-    Ok((map_pipeline, sky_pipeline))
+    )
 }
 
 /// `slots` frame-uniform slots: each a uniform buffer, its set and an empty exact-sample list.
@@ -334,6 +369,9 @@ impl Drop for CameraPass {
             }
             d.destroy_pipeline(self.map_pipeline, None);
             d.destroy_pipeline(self.sky_pipeline, None);
+            if let Some(p) = self.sky_aovs.take() {
+                d.destroy_pipeline(p, None);
+            }
             self.gbuffer = None;
             d.destroy_descriptor_set_layout(self.gbuffer_layout, None);
             d.destroy_shader_module(self.module, None);

@@ -29,7 +29,12 @@ impl CameraPass {
         let mut keys: Vec<(VariantKey, Entry)> = scene
             .pipeline_keys
             .iter()
-            .map(|&(bits, alpha)| (bits | frame_bits, Entry::of(alpha, debug_view)))
+            .map(|&(bits, alpha)| {
+                (
+                    bits | frame_bits,
+                    frame.with_aovs(Entry::of(alpha, debug_view)),
+                )
+            })
             .collect();
         let defer = &frame.defer;
         // The unshadowed variants of receivers drawn (partly) beyond the casters' reach, and the
@@ -49,11 +54,27 @@ impl CameraPass {
             // Per resolved material its resolve, and the G-buffer pipeline of its texture slots.
             keys.extend(defer.resolved.iter().flat_map(|r| {
                 [
-                    (r.material_bits | frame_bits, Entry::Resolve),
-                    (deferred::gbuffer_variant(r.material_bits), Entry::GBuffer),
+                    (
+                        r.material_bits | frame_bits,
+                        frame.with_aovs(Entry::Resolve),
+                    ),
+                    (
+                        deferred::gbuffer_variant(r.material_bits),
+                        frame.with_aovs(Entry::GBuffer),
+                    ),
                 ]
             }));
             self.ensure_gbuffer(extent)?;
+        }
+        if frame.aovs && self.sky_aovs.is_none() {
+            self.sky_aovs = Some(super::sky_pipeline(
+                &self.ctx,
+                self.layout,
+                self.module,
+                &[self.color_format, AOV_FORMATS[0], AOV_FORMATS[1]],
+                (self.depth_format, self.samples),
+                self.flat_forward,
+            )?);
         }
         self.build_pipelines(keys)
     }
@@ -66,7 +87,10 @@ impl CameraPass {
         frame: &CameraFrame,
     ) -> Result<(), GpuError> {
         let keys = aov_draws(scene, frame)
-            .map(|i| (scene.draws[i].material_bits, Entry::Aov))
+            .map(|i| {
+                let dr = &scene.draws[i];
+                (dr.material_bits, Entry::aov(dr.alpha))
+            })
             .collect();
         self.build_pipelines(keys)
     }
@@ -161,17 +185,24 @@ fn scene_pipeline(
 ) -> Result<vk::Pipeline, GpuError> {
     let (bindings, attributes) = vertex_layout();
     let name = format!("camera pipeline variant {} {entry:?}", variant.bits());
-    let resolve = entry == Entry::Resolve;
-    let gbuffer = entry == Entry::GBuffer;
-    let aov = entry == Entry::Aov;
+    let resolve = matches!(entry, Entry::Resolve | Entry::ResolveAov);
+    let aov = matches!(entry, Entry::Aov | Entry::AovMasked);
+    // A camera pass drawing the ids and normals too: its colour and those two.
+    let lit_aovs = [formats.color, AOV_FORMATS[0], AOV_FORMATS[1]];
+    let gbuffer_aovs = [
+        AOV_FORMATS[0],
+        AOV_FORMATS[1],
+        GBUFFER_FORMAT,
+        GBUFFER_FORMAT,
+    ];
     create_pipeline(
         ctx,
         &PipelineDesc {
             name: &name,
             layout,
             vertex: match entry {
-                Entry::Resolve => (module, sh::ENTRY_VS_FULLSCREEN_FLAT),
-                Entry::OpaqueFlat => (module, sh::ENTRY_VS_MAIN_FLAT),
+                Entry::Resolve | Entry::ResolveAov => (module, sh::ENTRY_VS_FULLSCREEN_FLAT),
+                Entry::OpaqueFlat | Entry::OpaqueFlatAov => (module, sh::ENTRY_VS_MAIN_FLAT),
                 _ => (module, sh::ENTRY_VS_MAIN),
             },
             fragment: Some((
@@ -180,31 +211,41 @@ fn scene_pipeline(
                     Entry::Opaque => sh::ENTRY_FS_MAIN,
                     Entry::OpaqueFlat => sh::ENTRY_FS_MAIN_FLAT,
                     Entry::Masked => sh::ENTRY_FS_MASKED,
-                    Entry::Blended => sh::ENTRY_FS_BLEND,
+                    Entry::Blended | Entry::BlendedAov => sh::ENTRY_FS_BLEND,
                     Entry::Debug | Entry::Overdraw => sh::ENTRY_FS_DEBUG,
-                    Entry::Resolve => sh::ENTRY_FS_RESOLVE,
+                    Entry::Resolve | Entry::ResolveAov => sh::ENTRY_FS_RESOLVE,
                     Entry::GBuffer => sh::ENTRY_FS_GBUFFER,
+                    Entry::OpaqueAov => sh::ENTRY_FS_MAIN_AOV,
+                    Entry::OpaqueFlatAov => sh::ENTRY_FS_MAIN_FLAT_AOV,
+                    Entry::MaskedAov => sh::ENTRY_FS_MASKED_AOV,
+                    Entry::GBufferAov => sh::ENTRY_FS_GBUFFER_AOV,
                     Entry::Aov => sh::ENTRY_FS_AOV,
+                    Entry::AovMasked => sh::ENTRY_FS_AOV_MASKED,
                 },
             )),
             bindings: if resolve { &[] } else { &bindings },
             attributes: if resolve { &[] } else { &attributes },
-            color_formats: if gbuffer {
-                &[GBUFFER_FORMAT; GBUFFER_TARGETS]
-            } else if aov {
-                &AOV_FORMATS
-            } else {
-                std::slice::from_ref(&formats.color)
+            color_formats: match entry {
+                Entry::GBuffer => &[GBUFFER_FORMAT; GBUFFER_TARGETS],
+                Entry::GBufferAov => &gbuffer_aovs,
+                Entry::Aov | Entry::AovMasked => &AOV_FORMATS,
+                Entry::OpaqueAov
+                | Entry::OpaqueFlatAov
+                | Entry::MaskedAov
+                | Entry::BlendedAov
+                | Entry::ResolveAov => &lit_aovs,
+                _ => std::slice::from_ref(&formats.color),
             },
-            masked_targets: if gbuffer {
-                deferred::gbuffer_targets_masked(variant)
-            } else {
-                0
+            masked_targets: match entry {
+                Entry::GBuffer | Entry::GBufferAov => deferred::gbuffer_targets_masked(variant),
+                // Blended surfaces have no id; the resolve's pixels got theirs in the G-buffer pass.
+                Entry::BlendedAov | Entry::ResolveAov => 2,
+                _ => 0,
             },
             depth_format: formats.depth,
             stencil: match entry {
-                Entry::Resolve => Stencil::Equal,
-                Entry::GBuffer => Stencil::Mark,
+                Entry::Resolve | Entry::ResolveAov => Stencil::Equal,
+                Entry::GBuffer | Entry::GBufferAov => Stencil::Mark,
                 _ => Stencil::Off,
             },
             depth_clamp: false,
@@ -216,7 +257,7 @@ fn scene_pipeline(
             },
             blend: match entry {
                 Entry::Overdraw => ColorBlend::Additive,
-                Entry::Blended => ColorBlend::Over,
+                Entry::Blended | Entry::BlendedAov => ColorBlend::Over,
                 _ => ColorBlend::Off,
             },
             // The AOV pass draws one sample per pixel whatever the camera pass's MSAA.

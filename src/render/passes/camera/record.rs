@@ -35,12 +35,15 @@ impl CameraPass {
             resolve,
             extent,
             clear,
+            ..
         } = *targets;
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         ctx.begin_label(cmd, "camera pass");
         let stencil = has_stencil(self.depth_format);
         let deferring = !plan.deferred.is_empty();
+        // `ensure_pipelines` made the frame's pipelines for these targets.
+        debug_assert_eq!(frame.aovs, targets.aovs.is_some());
         let frame_set = self.slots[slot].set;
         let mut drawn = 0;
         let mut unshadowed = 0;
@@ -76,7 +79,25 @@ impl CameraPass {
                 .resolve_image_view(target)
                 .resolve_image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
         }
-        let color_att = [color_att];
+        // The ids and normals: cleared here, or kept from the G-buffer pass, which drew the
+        // deferred draws' ids first.
+        let aov_att = |view, clear| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(if deferring {
+                    vk::AttachmentLoadOp::LOAD
+                } else {
+                    vk::AttachmentLoadOp::CLEAR
+                })
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue { color: clear })
+        };
+        let mut color_att = vec![color_att];
+        if let Some([ids, normals]) = targets.aovs {
+            color_att.push(aov_att(ids, vk::ClearColorValue { uint32: [0; 4] }));
+            color_att.push(aov_att(normals, vk::ClearColorValue { float32: [0.0; 4] }));
+        }
         let mut rendering = vk::RenderingInfo::default()
             .render_area(full_rect(extent))
             .layer_count(1)
@@ -93,7 +114,7 @@ impl CameraPass {
             Recorder::new(d, cmd).draw(3, 1, 0, 0);
         }
         if deferring {
-            self.record_resolve(cmd, scene, plan, cull.frame_bits, extent);
+            self.record_resolve(cmd, scene, frame, extent);
         }
         if !plan.forward.is_empty() || frame.sky {
             let (n, u) = self.record_forward(cmd, scene, frame, extent);
@@ -132,9 +153,8 @@ impl CameraPass {
         for ((&i, split), &flat) in forward.zip(&frame.flat) {
             let dr = &scene.draws[i];
             let entry = frame.entry(dr.alpha, flat);
-            if sky && entry == Entry::Blended {
-                self.record_sky(cmd);
-                bound_pipeline = self.sky_pipeline;
+            if sky && matches!(entry, Entry::Blended | Entry::BlendedAov) {
+                bound_pipeline = self.record_sky(cmd, frame.aovs);
                 sky = false;
             }
             let bits = dr.material_bits | cull.frame_bits;
@@ -173,19 +193,26 @@ impl CameraPass {
             }
         }
         if sky {
-            self.record_sky(cmd);
+            self.record_sky(cmd, frame.aovs);
         }
         (drawn, unshadowed)
     }
 
     /// Records the sky: one full-screen triangle at depth 0, shaded only where no surface was
-    /// drawn (inside a rendering whose set 0 is bound).
-    fn record_sky(&self, cmd: vk::CommandBuffer) {
+    /// drawn (inside a rendering whose set 0 is bound); `aovs`: in a pass that also draws the ids
+    /// and normals. Returns the pipeline bound.
+    fn record_sky(&self, cmd: vk::CommandBuffer, aovs: bool) -> vk::Pipeline {
         let d = &self.ctx.device;
-        Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, self.sky_pipeline);
+        // Made by `ensure_pipelines` for a frame with `aovs`.
+        let pipeline = match self.sky_aovs {
+            Some(p) if aovs => p,
+            _ => self.sky_pipeline,
+        };
+        Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
         Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
         Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
         Recorder::new(d, cmd).draw(3, 1, 0, 0);
+        pipeline
     }
 
     /// Records the G-buffer pass of `plan`'s deferred draws (clearing depth and stencil, each
@@ -209,16 +236,36 @@ impl CameraPass {
         ctx.begin_label(cmd, "G-buffer");
         gbuffer.transition(cmd, Access::ColorAttachment);
         let views = gbuffer.views();
-        let targets: Vec<vk::RenderingAttachmentInfo> = views
-            .into_iter()
-            .map(|v| {
+        // With the ids and normals, those first (cleared; the forward pass keeps them).
+        let aovs = targets.aovs;
+        let entry = if aovs.is_some() {
+            Entry::GBufferAov
+        } else {
+            Entry::GBuffer
+        };
+        let aov_targets = aovs.into_iter().flat_map(|[ids, normals]| {
+            [
+                (ids, vk::ClearColorValue { uint32: [0; 4] }),
+                (normals, vk::ClearColorValue { float32: [0.0; 4] }),
+            ]
+            .map(|(v, clear)| {
+                vk::RenderingAttachmentInfo::default()
+                    .image_view(v)
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue { color: clear })
+            })
+        });
+        let targets: Vec<vk::RenderingAttachmentInfo> = aov_targets
+            .chain(views.into_iter().map(|v| {
                 // Only marked pixels are read, and those are written: nothing to load.
                 vk::RenderingAttachmentInfo::default()
                     .image_view(v)
                     .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
                     .load_op(vk::AttachmentLoadOp::DONT_CARE)
                     .store_op(vk::AttachmentStoreOp::STORE)
-            })
+            }))
             .collect();
         let depth_att = depth_clear_attachment(depth, true);
         let rendering = vk::RenderingInfo::default()
@@ -235,7 +282,7 @@ impl CameraPass {
             let variant = deferred::gbuffer_variant(dr.material_bits);
             if bound != Some(variant) {
                 // Made by `ensure_pipelines` for this frame.
-                let pipeline = self.pipelines[&(variant, Entry::GBuffer)];
+                let pipeline = self.pipelines[&(variant, entry)];
                 Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
                 bound = Some(variant);
             }
@@ -257,16 +304,28 @@ impl CameraPass {
         // wrote (same layout: a memory dependency only).
         let tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
             | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
-        let mb = [vk::MemoryBarrier2::default()
-            .src_stage_mask(tests)
-            .src_access_mask(vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE)
-            .dst_stage_mask(tests)
-            .dst_access_mask(
-                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
-                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
-            )];
-        Recorder::new(d, cmd)
-            .pipeline_barrier2(&vk::DependencyInfo::default().memory_barriers(&mb));
+        // The ids and normals likewise: the forward pass loads them and draws over them.
+        let out = vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT;
+        let mb = [
+            vk::MemoryBarrier2::default()
+                .src_stage_mask(tests)
+                .src_access_mask(vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE)
+                .dst_stage_mask(tests)
+                .dst_access_mask(
+                    vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
+                        | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                ),
+            vk::MemoryBarrier2::default()
+                .src_stage_mask(out)
+                .src_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
+                .dst_stage_mask(out)
+                .dst_access_mask(
+                    vk::AccessFlags2::COLOR_ATTACHMENT_READ
+                        | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                ),
+        ];
+        let mb = if aovs.is_some() { &mb[..] } else { &mb[..1] };
+        Recorder::new(d, cmd).pipeline_barrier2(&vk::DependencyInfo::default().memory_barriers(mb));
         ctx.end_label(cmd);
         plan.deferred.len()
     }
@@ -299,10 +358,11 @@ impl CameraPass {
         &self,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-        plan: &DeferPlan,
-        frame_bits: VariantKey,
+        frame: &CameraFrame,
         extent: vk::Extent2D,
     ) {
+        let (plan, frame_bits) = (&frame.defer, frame.cull.frame_bits);
+        let entry = frame.with_aovs(Entry::Resolve);
         let Some(gbuffer) = self.gbuffer.as_ref() else {
             return;
         };
@@ -317,7 +377,7 @@ impl CameraPass {
         Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
         Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
         for r in &plan.resolved {
-            let pipeline = self.pipelines[&(r.material_bits | frame_bits, Entry::Resolve)];
+            let pipeline = self.pipelines[&(r.material_bits | frame_bits, entry)];
             Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
             scene.bind_material(d, cmd, self.layout, 1, r.material);
             Recorder::new(d, cmd)
