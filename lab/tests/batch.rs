@@ -122,3 +122,44 @@ fn shared_maps_against_per_view_fits() {
     }
     assert_validation_clean(&ctx);
 }
+
+/// `render_each` keeps frames in flight (views k + 1 and k + 2 drawn while view k is read back), and
+/// hands over, in order, each view's frame and AOVs as one `render_with_aovs` call makes them,
+/// to the byte: with each view's own shadow fit (the map drawn again while the view before it
+/// is still in flight) and with the shared map.
+#[test]
+fn frames_in_flight_match_single_renders_with_their_aovs() {
+    use umbra::render::AovSet;
+    let ctx = context();
+    for scene in scenes() {
+        let mut r = Renderer::new(&ctx, &scene).unwrap();
+        let own = ring(&scene, 4);
+        let shared = r.shared_views(&own, W, H);
+        for (fit, views) in [("own fits", own), ("shared map", shared)] {
+            assert!(r.keeps_in_flight(&views, Some(AovSet::ALL)));
+            let mut got = Vec::new();
+            r.render_each(&views, W, H, Some(AovSet::ALL), &mut |k, f, a| {
+                got.push((k, f, a))
+            })
+            .unwrap();
+            let order: Vec<usize> = got.iter().map(|g| g.0).collect();
+            assert_eq!(order, [0, 1, 2, 3], "{}, {fit}", scene.name);
+            for (k, f, a) in got {
+                let a = a.expect("AOVs asked for");
+                assert!(f.stats.aovs_in_camera_pass);
+                let (single, sa) = r.render_with_aovs(&views[k], W, H, AovSet::ALL).unwrap();
+                let what = format!("{}, {fit}, view {k}", scene.name);
+                assert_eq!(
+                    image_diff(&single.image, &f.image).differing(),
+                    0,
+                    "{what}: image"
+                );
+                assert!(sa.instance == a.instance, "{what}: ids");
+                assert!(sa.normal == a.normal, "{what}: normals");
+                assert!(sa.depth == a.depth, "{what}: depth");
+                assert!(f.depth.is_none(), "{what}: depth kept though not asked for");
+            }
+        }
+    }
+    assert_validation_clean(&ctx);
+}

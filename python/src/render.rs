@@ -138,8 +138,21 @@ impl OffscreenRenderer {
         let cache = stacked || self.options.shadow_cache;
         self.renderer_for(&s)?.set_shadow_cache(cache);
         let mut stack = Stack::new(poses.len());
-        for view in &views {
-            stack.push(self.frame(py, &s, view, &extras, outputs)?);
+        if extras.budget.is_none() && outputs.contains(&"color") && !outputs.contains(&"shadow") {
+            // One call for the poses, the next drawn while the last is read back and converted.
+            let (w, h) = (self.width, self.height);
+            let set = aov_set(outputs);
+            let renderer = self.renderer_for(&s)?;
+            py.detach(|| {
+                renderer.render_each(&views, w, h, set, &mut |_, f, a| {
+                    stack.push(outputs_of(Some(f), a, set))
+                })
+            })
+            .map_err(gpu_error)?;
+        } else {
+            for view in &views {
+                stack.push(self.frame(py, &s, view, &extras, outputs)?);
+            }
         }
         stack.into_arrays(py, (self.width, self.height), stacked)
     }
@@ -183,41 +196,32 @@ fn choose_budget(
     Ok(())
 }
 
-/// The frames `outputs` need: the lit image (with the AOVs drawn by its own camera pass at one
-/// sample per pixel: `Renderer::render_with_aovs`), the AOV pass alone, the shadow view.
-fn render_outputs(
-    r: &mut Renderer,
-    view: &View,
-    (w, h): (u32, u32),
-    outputs: &[&'static str],
-) -> Result<Vec<Output>, umbra::GpuError> {
-    let wants = |n: &str| outputs.contains(&n);
-    let mut out = Vec::new();
+/// The AOVs `outputs` asks for (None: none).
+fn aov_set(outputs: &[&'static str]) -> Option<umbra::render::AovSet> {
     let set = umbra::render::AovSet {
-        instance: wants("segmentation"),
-        normal: wants("normals"),
-        depth: wants("depth"),
+        instance: outputs.contains(&"segmentation"),
+        normal: outputs.contains(&"normals"),
+        depth: outputs.contains(&"depth"),
     };
-    let any_aov = set.instance || set.normal || set.depth;
-    let mut aovs = None;
-    if wants("color") {
-        let f = if any_aov {
-            let (f, a) = r.render_with_aovs(view, w, h, set)?;
-            aovs = Some(a);
-            f
-        } else {
-            r.render(view, w, h)?
-        };
+    (set.instance || set.normal || set.depth).then_some(set)
+}
+
+/// The outputs of a frame (`color`) and its AOVs (those in `set`), in the order of `OUTPUTS`.
+fn outputs_of(
+    frame: Option<umbra::RenderedFrame>,
+    aovs: Option<umbra::render::Aovs>,
+    set: Option<umbra::render::AovSet>,
+) -> Vec<Output> {
+    let mut out = Vec::new();
+    if let Some(f) = frame {
         let rgb: Vec<u8> = f.image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
         out.push(Output {
             name: "color",
             data: Data::U8(rgb),
             channels: 3,
         });
-    } else if any_aov {
-        aovs = Some(r.render_aovs_of(view, w, h, set)?);
     }
-    if let Some(a) = aovs {
+    if let (Some(a), Some(set)) = (aovs, set) {
         if set.depth {
             out.push(Output {
                 name: "depth",
@@ -240,6 +244,33 @@ fn render_outputs(
             });
         }
     }
+    out
+}
+
+/// The frames `outputs` need: the lit image (with the AOVs drawn by its own camera pass at one
+/// sample per pixel: `Renderer::render_with_aovs`), the AOV pass alone, the shadow view.
+fn render_outputs(
+    r: &mut Renderer,
+    view: &View,
+    (w, h): (u32, u32),
+    outputs: &[&'static str],
+) -> Result<Vec<Output>, umbra::GpuError> {
+    let wants = |n: &str| outputs.contains(&n);
+    let set = aov_set(outputs);
+    let mut out = if wants("color") {
+        match set {
+            Some(s) => {
+                let (f, a) = r.render_with_aovs(view, w, h, s)?;
+                outputs_of(Some(f), Some(a), set)
+            }
+            None => outputs_of(Some(r.render(view, w, h)?), None, set),
+        }
+    } else {
+        match set {
+            Some(s) => outputs_of(None, Some(r.render_aovs_of(view, w, h, s)?), set),
+            None => Vec::new(),
+        }
+    };
     if wants("shadow") {
         let mut v = view.clone();
         v.mode = ViewMode::Shadow;

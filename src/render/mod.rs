@@ -18,8 +18,8 @@ pub(crate) mod window;
 pub use device::device_facts;
 pub use gpu_scene::TextureStats;
 pub use renderer::{
-    view_axis_depths, AovSet, Aovs, BatchShadows, FrameStats, RenderedFrame, Renderer, MAX_SIDE,
-    SHARED_MAP_MAX,
+    view_axis_depths, AovSet, Aovs, BatchShadows, FrameStats, RenderedFrame, Renderer, Sink,
+    MAX_SIDE, RING, SHARED_MAP_MAX,
 };
 #[cfg(feature = "viewer")]
 pub use window::{

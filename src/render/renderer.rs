@@ -20,7 +20,7 @@ use std::time::Instant;
 mod aov;
 mod batch;
 pub use aov::{AovSet, Aovs};
-pub use batch::{BatchShadows, SHARED_MAP_MAX};
+pub use batch::{BatchShadows, Sink, RING, SHARED_MAP_MAX};
 
 /// Colour format of offscreen frames (sRGB-encoded on write).
 pub const OFFSCREEN_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
@@ -77,8 +77,9 @@ struct Target {
     depth: Image,
     color_at: Attachment,
     depth_at: Attachment,
-    readback: Buffer,
-    depth_readback: Buffer,
+    /// Per ring slot (`batch::RING`), the colour and depth readbacks.
+    readback: [Buffer; batch::RING],
+    depth_readback: [Buffer; batch::RING],
     /// The multisampled images drawn into (resolved into `color`, `depth`) with MSAA.
     msaa: Option<MsaaTargets>,
     /// With supersampling, the image at the asked size `color` is filtered into (read back
@@ -90,8 +91,9 @@ struct Target {
 pub struct Renderer {
     core: FrameCore,
     target: Option<Target>,
-    cmd: vk::CommandBuffer,
-    fence: vk::Fence,
+    /// Per ring slot (`batch::RING`: frames in flight in a batch), a command buffer and its fence.
+    cmds: [vk::CommandBuffer; batch::RING],
+    fences: [vk::Fence; batch::RING],
     read_depth: bool,
     /// The depths the last measured camera saw (`ShadowSettings::depth_fit`).
     seen_depths: Option<SeenDepths>,
@@ -100,7 +102,7 @@ pub struct Renderer {
     /// The AOVs `render_with_aovs` asks the next frames' camera passes to draw too.
     frame_aovs: Option<AovSet>,
     /// The ids and normals the last such camera pass drew (taken by `render_with_aovs`).
-    drawn_aovs: Option<(Vec<u32>, Vec<[f32; 3]>)>,
+    drawn_aovs: Option<aov::IdsNormals>,
 }
 
 /// A camera (view matrix, projection, drawn size) and the (nearest, farthest) view depth it saw
@@ -176,18 +178,22 @@ impl Renderer {
         scene: &Scene,
         options: &SceneOptions,
     ) -> Result<Self, GpuError> {
-        let core = FrameCore::new(ctx, scene, options, OFFSCREEN_FORMAT, 1)?;
-        let cmd = ctx.allocate_command_buffer()?;
-        let fence = unsafe {
-            ctx.device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
+        let core = FrameCore::new(ctx, scene, options, OFFSCREEN_FORMAT, batch::RING)?;
+        let mut cmds = [vk::CommandBuffer::null(); batch::RING];
+        let mut fences = [vk::Fence::null(); batch::RING];
+        for (cmd, fence) in cmds.iter_mut().zip(&mut fences) {
+            *cmd = ctx.allocate_command_buffer()?;
+            *fence = unsafe {
+                ctx.device
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+            }
+            .vk("vkCreateFence")?;
         }
-        .vk("vkCreateFence")?;
         Ok(Self {
             core,
             target: None,
-            cmd,
-            fence,
+            cmds,
+            fences,
             read_depth: false,
             seen_depths: None,
             aov: None,
@@ -284,20 +290,20 @@ impl Renderer {
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | usage,
         )?;
         let bytes = w as u64 * h as u64 * 4;
-        let readback = Buffer::new(
-            ctx,
-            "offscreen readback",
-            bytes,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
-        let depth_readback = Buffer::new(
-            ctx,
-            "depth readback",
-            bytes,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let readbacks = |name: &str| -> Result<[Buffer; batch::RING], GpuError> {
+            let b = |i| {
+                Buffer::new(
+                    ctx,
+                    &format!("{name} {i}"),
+                    bytes,
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuToCpu,
+                )
+            };
+            ring_of(b)
+        };
+        let readback = readbacks("offscreen readback")?;
+        let depth_readback = readbacks("depth readback")?;
         let samples = self.core.samples;
         let msaa = if samples > 1 {
             Some(MsaaTargets::new(ctx, OFFSCREEN_FORMAT, extent, samples)?)
@@ -342,12 +348,7 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<RenderedFrame, GpuError> {
-        let fit = view.shadow.depth_fit
-            && view.shadow.enabled
-            && view.visible_depths.is_none()
-            && view.shadow_fit_camera.is_none()
-            && view.shadow_batch.is_none();
-        if !fit {
+        if !self.measures_depths(view) {
             return self.render_once(view, width, height);
         }
         // The drawn size: a supersampled frame measures its own depths.
@@ -386,12 +387,38 @@ impl Renderer {
         self.render_once(&v, width, height)
     }
 
+    /// Whether `render` of `view` fits its shadows to the depths the camera sees
+    /// (`ShadowSettings::depth_fit`), measured by a frame of its own for a camera not seen before.
+    fn measures_depths(&self, view: &View) -> bool {
+        view.shadow.depth_fit
+            && view.shadow.enabled
+            && view.visible_depths.is_none()
+            && view.shadow_fit_camera.is_none()
+            && view.shadow_batch.is_none()
+    }
+
     fn render_once(
         &mut self,
         view: &View,
         width: u32,
         height: u32,
     ) -> Result<RenderedFrame, GpuError> {
+        let p = self.submit_frame(0, view, (width, height), self.frame_aovs)?;
+        let (frame, drawn) = self.finish_frame(p)?;
+        self.drawn_aovs = drawn;
+        Ok(frame)
+    }
+
+    /// Prepares, records and submits `view` at `width`×`height` in ring slot `slot` (whose
+    /// previous frame must have been finished), without waiting: `finish_frame` reads it back.
+    /// With `aovs` the camera pass draws the instance ids and normals too where it can.
+    fn submit_frame(
+        &mut self,
+        slot: usize,
+        view: &View,
+        (width, height): (u32, u32),
+        aovs: Option<AovSet>,
+    ) -> Result<Pending, GpuError> {
         check_size(width, height)?;
         let s = view.supersample;
         check_supersample(&self.core.ctx, s)?;
@@ -400,8 +427,10 @@ impl Renderer {
         check_size(dw, dh)?;
         let start = Instant::now();
         // The camera pass draws the AOVs asked for at one sample per pixel (`render_with_aovs`).
-        let aovs = self.frame_aovs.filter(|_| s == 1);
-        let prepared = self.core.prepare_with(0, view, (dw, dh), aovs.is_some())?;
+        let aovs = aovs.filter(|_| s == 1);
+        let prepared = self
+            .core
+            .prepare_with(slot, view, (dw, dh), aovs.is_some())?;
         let aovs = aovs.filter(|_| prepared.draws_aovs());
         if aovs.is_some() {
             aov::AovTarget::ensure(self, extent)?;
@@ -409,7 +438,7 @@ impl Renderer {
         self.ensure_target(dw, dh, (s > 1).then_some(extent))?;
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
-        let cmd = self.cmd;
+        let cmd = self.cmds[slot];
         let drawn = vk::Extent2D {
             width: dw,
             height: dh,
@@ -428,16 +457,35 @@ impl Renderer {
                 aovs: aov_target.as_mut().map(|a| a.color_targets()),
             },
         );
-        let plan = prepared.plan;
         if let (Some(a), Some(set)) = (aov_target, aovs) {
             // The depth is the frame's own (`read_depth`).
-            a.record_copies(d, cmd, set, false);
+            a.record_copies(d, cmd, set, false, slot);
         }
-        record_readback(d, cmd, t, (extent, drawn), self.read_depth);
+        record_readback(d, cmd, t, (extent, drawn), self.read_depth, slot);
         unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
-        ctx.submit_and_wait_with(cmd, self.fence)?;
-        let times = self.core.gpu_times(0);
-        let stats = FrameStats {
+        ctx.submit_with(cmd, self.fences[slot])?;
+        Ok(Pending {
+            slot,
+            start,
+            plan: prepared.plan,
+            counts,
+            size: (width, height),
+            drawn,
+            read_depth: self.read_depth,
+            aovs,
+        })
+    }
+
+    /// Waits for a frame `submit_frame` submitted and reads it back, with the instance ids and
+    /// normals its camera pass drew (those asked for; None when it drew none).
+    fn finish_frame(
+        &mut self,
+        p: Pending,
+    ) -> Result<(RenderedFrame, Option<aov::IdsNormals>), GpuError> {
+        self.core.ctx.wait_and_reset(self.fences[p.slot])?;
+        let times = self.core.gpu_times(p.slot);
+        let (plan, counts) = (p.plan, p.counts);
+        let mut stats = FrameStats {
             gpu_shadow_ms: times.map(|t| t.0),
             gpu_camera_ms: times.map(|t| t.1),
             wall_ms: 0.0,
@@ -449,26 +497,47 @@ impl Renderer {
             draws_total: self.core.gpu.draws.len(),
             triangles: self.core.gpu.triangles,
             hardware_compare: self.core.shadow.hardware_filtering(plan.shadow_format),
-            aovs_in_camera_pass: aovs.is_some(),
+            aovs_in_camera_pass: p.aovs.is_some(),
         };
         let t = self.target.as_mut().expect("target");
-        let (image, depth) = read_back(t, (width, height), drawn, self.read_depth)?;
-        self.drawn_aovs = match (self.aov.as_mut(), aovs) {
+        let (image, depth) = read_back(t, p.size, p.drawn, p.read_depth, p.slot)?;
+        let drawn = match (self.aov.as_mut(), p.aovs) {
             (Some(a), Some(set)) => {
-                let (ids, normals, _) = a.read(set, false)?;
+                let (ids, normals, _) = a.read(set, false, p.slot)?;
                 Some((ids, normals))
             }
             _ => None,
         };
-        let mut stats = stats;
-        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        Ok(RenderedFrame {
+        stats.wall_ms = p.start.elapsed().as_secs_f64() * 1e3;
+        let frame = RenderedFrame {
             image,
             stats,
             plan,
             depth,
-        })
+        };
+        Ok((frame, drawn))
     }
+}
+
+/// One of `make(slot)` per ring slot (`batch::RING`).
+fn ring_of<T>(make: impl Fn(usize) -> Result<T, GpuError>) -> Result<[T; batch::RING], GpuError> {
+    let v = (0..batch::RING).map(make).collect::<Result<Vec<T>, _>>()?;
+    Ok(v.try_into().unwrap_or_else(|_| unreachable!("RING items")))
+}
+
+/// A frame submitted by `Renderer::submit_frame`, not yet read back.
+struct Pending {
+    slot: usize,
+    start: Instant,
+    plan: FramePlan,
+    counts: crate::render::core::PassCounts,
+    /// The image size.
+    size: (u32, u32),
+    /// The drawn size (supersampled).
+    drawn: vk::Extent2D,
+    read_depth: bool,
+    /// The AOVs its camera pass draws.
+    aovs: Option<AovSet>,
 }
 
 /// An error for a supersampling factor outside [`SUPERSAMPLE_FACTORS`], or one the device
@@ -522,13 +591,17 @@ pub fn visible_depths(depth: &[f32], proj: &Mat4) -> Option<(f32, f32)> {
 /// Each pixel's distance along the view axis (scene units) from a reversed-z depth buffer drawn
 /// with the camera projection `proj`; 0 where nothing was drawn (a depth of 0).
 pub fn view_axis_depths(depth: &[f32], proj: &Mat4) -> Vec<f32> {
+    // The view-space point at (0, 0, z, 1) in clip space: only its z and w are needed, each
+    // z·(third column) + fourth column, the same sums as the full product's (the x and y
+    // columns add exact zeros), so the same bits.
     let inv = proj.inverse();
+    let (c, d) = (inv.z_axis, inv.w_axis);
     depth
         .iter()
         .map(|&z| {
             if z > 0.0 {
-                let p = inv * glam::Vec4::new(0.0, 0.0, z, 1.0);
-                -p.z / p.w
+                let (pz, pw) = (c.z * z + d.z, c.w * z + d.w);
+                -pz / pw
             } else {
                 0.0
             }
@@ -541,8 +614,10 @@ impl Drop for Renderer {
         unsafe {
             let _ = self.core.ctx.device.device_wait_idle();
         }
-        self.core.ctx.free_command_buffer(self.cmd);
-        unsafe { self.core.ctx.device.destroy_fence(self.fence, None) };
+        for (&cmd, &fence) in self.cmds.iter().zip(&self.fences) {
+            self.core.ctx.free_command_buffer(cmd);
+            unsafe { self.core.ctx.device.destroy_fence(fence, None) };
+        }
     }
 }
 
@@ -555,6 +630,7 @@ fn record_readback(
     t: &mut Target,
     (extent, drawn): (vk::Extent2D, vk::Extent2D),
     read_depth: bool,
+    slot: usize,
 ) {
     let (dw, dh, width, height) = (drawn.width, drawn.height, extent.width, extent.height);
     t.color_at.transition(d, cmd, Access::TransferSrc);
@@ -575,7 +651,7 @@ fn record_readback(
         shown,
         vk::ImageAspectFlags::COLOR,
         extent,
-        t.readback.raw,
+        t.readback[slot].raw,
     );
     if read_depth {
         t.depth_at.transition(d, cmd, Access::TransferSrc);
@@ -585,7 +661,7 @@ fn record_readback(
             t.depth.raw,
             vk::ImageAspectFlags::DEPTH,
             drawn,
-            t.depth_readback.raw,
+            t.depth_readback[slot].raw,
         );
     }
     transfer_to_host_barrier(d, cmd);
@@ -598,16 +674,15 @@ fn read_back(
     (width, height): (u32, u32),
     drawn: vk::Extent2D,
     read_depth: bool,
+    slot: usize,
 ) -> Result<(image::RgbaImage, Option<Vec<f32>>), GpuError> {
     let (dw, dh) = (drawn.width, drawn.height);
-    let bytes = t
-        .readback
+    let bytes = t.readback[slot]
         .mapped()
         .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
     let image = rgba_from_readback(bytes, width, height, false);
     let depth = if read_depth {
-        let bytes = t
-            .depth_readback
+        let bytes = t.depth_readback[slot]
             .mapped()
             .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
         Some(bytemuck::pod_collect_to_vec(
@@ -636,5 +711,35 @@ mod tests {
             "{lo} {hi}"
         );
         assert_eq!(visible_depths(&[0.0; 4], &proj), None);
+    }
+
+    /// `view_axis_depths` is the full inverse product's `-z / w`, to the bit.
+    #[test]
+    fn view_axis_depths_equal_the_full_inverse_product() {
+        let projections = [
+            perspective_infinite_reversed(0.8, 1.5, 0.05),
+            crate::math::projection::perspective_reversed(0.8, 1.5, 0.05, 100.0),
+            crate::math::projection::orthographic_reversed(-2.0, 2.0, -1.5, 1.5, 0.1, 50.0),
+        ];
+        let depth: Vec<f32> = (0..4096).map(|i| i as f32 / 4095.0).collect();
+        for proj in projections {
+            let inv = proj.inverse();
+            let full: Vec<u32> = depth
+                .iter()
+                .map(|&z| {
+                    if z > 0.0 {
+                        let p = inv * glam::Vec4::new(0.0, 0.0, z, 1.0);
+                        (-p.z / p.w).to_bits()
+                    } else {
+                        0f32.to_bits()
+                    }
+                })
+                .collect();
+            let fast: Vec<u32> = view_axis_depths(&depth, &proj)
+                .iter()
+                .map(|d| d.to_bits())
+                .collect();
+            assert!(fast == full, "{proj:?}");
+        }
     }
 }

@@ -43,39 +43,40 @@ pub fn render_views(a: &super::cli::RenderArgs, poses: &Path) -> anyhow::Result<
     let wants = |n: &str| a.outputs.iter().any(|o| o == n);
     let (mut walls, mut drawn) = (Vec::with_capacity(views.len()), 0);
     let mut gpu = Vec::with_capacity(views.len());
-    for (v, png) in views.iter().zip(&paths) {
-        let t = std::time::Instant::now();
-        let aovs = OUTPUTS[1..].iter().filter(|n| wants(n)).collect::<Vec<_>>();
-        let set = umbra::render::AovSet {
-            instance: wants("segmentation"),
-            normal: wants("normals"),
-            depth: wants("depth"),
-        };
-        // With the image, its own camera pass draws the AOVs where it can (one sample a pixel).
-        let a = if wants("color") {
-            let (f, a) = if aovs.is_empty() {
-                (renderer.render(v, w, h)?, None)
-            } else {
-                let (f, a) = renderer.render_with_aovs(v, w, h, set)?;
-                (f, Some(a))
-            };
+    let aovs = OUTPUTS[1..].iter().filter(|n| wants(n)).collect::<Vec<_>>();
+    let set = umbra::render::AovSet {
+        instance: wants("segmentation"),
+        normal: wants("normals"),
+        depth: wants("depth"),
+    };
+    let set = (!aovs.is_empty()).then_some(set);
+    if wants("color") {
+        // Frames in flight: each view's files are written while the next views are drawn; its
+        // camera pass draws the AOVs where it can (one sample a pixel). A view's time is the
+        // time between two hand-overs.
+        let mut failed = None;
+        let mut last = std::time::Instant::now();
+        renderer.render_each(&views, w, h, set, &mut |k, f, a| {
             drawn += usize::from(f.stats.casters_drawn > 0);
             gpu.push(f.stats.clone());
-            f.image
-                .save(png)
-                .with_context(|| format!("writing {}", png.display()))?;
-            a
-        } else if aovs.is_empty() {
-            None
-        } else {
-            Some(renderer.render_aovs_of(v, w, h, set)?)
-        };
-        if let Some(a) = a {
-            for n in aovs {
+            if failed.is_none() {
+                failed = write_view(&paths[k], &f.image, a.as_ref(), &aovs).err();
+            }
+            walls.push(last.elapsed().as_secs_f64() * 1e3);
+            last = std::time::Instant::now();
+        })?;
+        if let Some(e) = failed {
+            return Err(e);
+        }
+    } else if let Some(set) = set {
+        for (v, png) in views.iter().zip(&paths) {
+            let t = std::time::Instant::now();
+            let a = renderer.render_aovs_of(v, w, h, set)?;
+            for n in &aovs {
                 write_aov(&output_path(png, n), n, &a)?;
             }
+            walls.push(t.elapsed().as_secs_f64() * 1e3);
         }
-        walls.push(t.elapsed().as_secs_f64() * 1e3);
     }
     let total = start.elapsed().as_secs_f64();
     walls.sort_by(f64::total_cmp);
@@ -92,6 +93,24 @@ pub fn render_views(a: &super::cli::RenderArgs, poses: &Path) -> anyhow::Result<
     );
     drop(renderer);
     crate::finish_context(ctx)
+}
+
+/// Writes one view's PNG and the AOVs `names` beside it.
+fn write_view(
+    png: &Path,
+    image: &image::RgbaImage,
+    a: Option<&Aovs>,
+    names: &[&&str],
+) -> anyhow::Result<()> {
+    image
+        .save(png)
+        .with_context(|| format!("writing {}", png.display()))?;
+    if let Some(a) = a {
+        for n in names {
+            write_aov(&output_path(png, n), n, a)?;
+        }
+    }
+    Ok(())
 }
 
 /// The outputs `--outputs` takes.

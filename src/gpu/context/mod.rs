@@ -350,12 +350,25 @@ impl Context {
         cmd: vk::CommandBuffer,
         fence: vk::Fence,
     ) -> Result<(), GpuError> {
+        self.submit_with(cmd, fence)?;
+        self.wait_and_reset(fence)
+    }
+
+    /// Submits one command buffer, signalling the unsignalled `fence` (`wait_and_reset` waits
+    /// for it).
+    pub fn submit_with(&self, cmd: vk::CommandBuffer, fence: vk::Fence) -> Result<(), GpuError> {
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
         unsafe {
             self.device
                 .queue_submit2(self.queue, &submit, fence)
-                .vk("vkQueueSubmit2")?;
+                .vk("vkQueueSubmit2")
+        }
+    }
+
+    /// Waits for `fence` and resets it.
+    pub fn wait_and_reset(&self, fence: vk::Fence) -> Result<(), GpuError> {
+        unsafe {
             self.device
                 .wait_for_fences(&[fence], true, u64::MAX)
                 .vk("vkWaitForFences")?;

@@ -58,11 +58,17 @@ pub struct Aovs {
 /// Instance ids, normals and reversed-z depths as read back (`AovTarget::read`).
 type ReadAovs = (Vec<u32>, Vec<[f32; 3]>, Vec<f32>);
 
+/// Instance ids and normals drawn by a camera pass, as read back.
+pub(super) type IdsNormals = (Vec<u32>, Vec<[f32; 3]>);
+
+/// An AOV target's image, its attachment state and a readback per ring slot.
+type Output = (Image, Attachment, [Buffer; super::batch::RING]);
+
 /// The AOV pass's images and readbacks, kept between frames of one size.
 pub(super) struct AovTarget {
-    ids: (Image, Attachment, Buffer),
-    normals: (Image, Attachment, Buffer),
-    depth: (Image, Attachment, Buffer),
+    ids: Output,
+    normals: Output,
+    depth: Output,
 }
 
 impl AovTarget {
@@ -80,18 +86,20 @@ impl AovTarget {
         (&mut self.ids.1, &mut self.normals.1)
     }
 
-    /// Records the copies of the outputs in `set` into their readbacks (`depth`: of this
-    /// target's depth image, drawn by the AOV pass); the caller makes them visible to the host.
+    /// Records the copies of the outputs in `set` into ring slot `slot`'s readbacks (`depth`:
+    /// of this target's depth image, drawn by the AOV pass); the caller makes them visible to
+    /// the host.
     pub(super) fn record_copies(
         &mut self,
         d: &ash::Device,
         cmd: vk::CommandBuffer,
         set: AovSet,
         depth: bool,
+        slot: usize,
     ) {
         let extent = self.ids.0.extent;
         let color = vk::ImageAspectFlags::COLOR;
-        for (wanted, (image, at, buffer), aspect) in [
+        for (wanted, (image, at, buffers), aspect) in [
             (set.instance, &mut self.ids, color),
             (set.normal, &mut self.normals, color),
             (
@@ -102,17 +110,18 @@ impl AovTarget {
         ] {
             if wanted {
                 at.transition(d, cmd, Access::TransferSrc);
-                copy_to_buffer(d, cmd, image.raw, aspect, extent, buffer.raw);
+                copy_to_buffer(d, cmd, image.raw, aspect, extent, buffers[slot].raw);
             }
         }
     }
 
-    /// The (ids, normals, depth) in the readbacks, each empty where `set` (or `depth`) left it
-    /// out.
+    /// The (ids, normals, depth) in ring slot `slot`'s readbacks, each empty where `set` (or
+    /// `depth`) left it out.
     pub(super) fn read(
         &mut self,
         set: AovSet,
         depth: bool,
+        slot: usize,
     ) -> Result<ReadAovs, GpuError> {
         fn read<T: bytemuck::Pod>(b: &mut Buffer, n: usize) -> Result<Vec<T>, GpuError> {
             if n == 0 {
@@ -131,9 +140,9 @@ impl AovTarget {
                 0
             }
         };
-        let ids = read(&mut self.ids.2, n(set.instance))?;
-        let normals: Vec<[f32; 4]> = read(&mut self.normals.2, n(set.normal))?;
-        let depth = read(&mut self.depth.2, n(set.depth && depth))?;
+        let ids = read(&mut self.ids.2[slot], n(set.instance))?;
+        let normals: Vec<[f32; 4]> = read(&mut self.normals.2[slot], n(set.normal))?;
+        let depth = read(&mut self.depth.2[slot], n(set.depth && depth))?;
         let normals = normals.iter().map(|n| [n[0], n[1], n[2]]).collect();
         Ok((ids, normals, depth))
     }
@@ -151,14 +160,16 @@ impl AovTarget {
                 usage | vk::ImageUsageFlags::TRANSFER_SRC,
             )?;
             let at = Attachment::of(&image);
-            let buffer = Buffer::new(
-                ctx,
-                &format!("{name} readback"),
-                pixels * texel,
-                vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuToCpu,
-            )?;
-            Ok((image, at, buffer))
+            let buffer = |i| {
+                Buffer::new(
+                    ctx,
+                    &format!("{name} readback {i}"),
+                    pixels * texel,
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuToCpu,
+                )
+            };
+            Ok((image, at, super::ring_of(buffer)?))
         };
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT;
         Ok(Self {
@@ -199,7 +210,7 @@ impl Renderer {
         AovTarget::ensure(self, extent)?;
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
-        let cmd = self.cmd;
+        let cmd = self.cmds[0];
         ctx.begin_one_time(cmd)?;
         let t = self.aov.as_mut().expect("made above");
         self.core.record_aov(
@@ -207,11 +218,11 @@ impl Renderer {
             &prepared,
             (&mut t.ids.1, &mut t.normals.1, &mut t.depth.1),
         )?;
-        t.record_copies(d, cmd, set, true);
+        t.record_copies(d, cmd, set, true, 0);
         transfer_to_host_barrier(d, cmd);
         unsafe { d.end_command_buffer(cmd).vk("vkEndCommandBuffer")? };
-        ctx.submit_and_wait_with(cmd, self.fence)?;
-        let (instance, normal, depth) = t.read(set, true)?;
+        ctx.submit_and_wait_with(cmd, self.fences[0])?;
+        let (instance, normal, depth) = t.read(set, true, 0)?;
         Ok(aovs_of(
             view,
             (width, height),
@@ -265,7 +276,7 @@ impl Renderer {
 
 /// The AOVs of `view` at `width`×`height` from what was read back (`depth`: the reversed-z
 /// depth buffer, made view-axis distances).
-fn aovs_of(
+pub(super) fn aovs_of(
     view: &View,
     (width, height): (u32, u32),
     (instance, normal, depth): (Vec<u32>, Vec<[f32; 3]>, &[f32]),

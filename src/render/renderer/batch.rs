@@ -1,12 +1,24 @@
 //! Batches: many views of one scene, rendered one after another, with their shadow maps shared
 //! while the lights and the casters hold still (a dataset's camera poses around a model).
 
-use super::{RenderedFrame, Renderer};
+use super::aov::{aovs_of, AovSet, Aovs};
+use super::{Pending, RenderedFrame, Renderer};
 use crate::gpu::context::GpuError;
+use crate::plan::settings::ViewMode;
 use crate::plan::view::View;
 use crate::plan::FramePlan;
 use crate::scene::{Camera, LightKind};
+use std::collections::VecDeque;
 use std::sync::Arc;
+
+/// Frames a batch keeps in flight ([`Renderer::render_each`]): views k + 1 and k + 2 are
+/// recorded and queued while view k is read back and handed over, so that the device always has
+/// the next frame to draw.
+pub const RING: usize = 3;
+
+/// What [`Renderer::render_each`] hands over per view: its index, the frame, and its AOVs when
+/// asked for.
+pub type Sink<'a> = dyn FnMut(usize, RenderedFrame, Option<Aovs>) + 'a;
 
 /// The largest side a shared map grows to (`BatchShadows::Shared`): 8192² D32 texels are 256 MiB.
 pub const SHARED_MAP_MAX: u32 = 8192;
@@ -45,12 +57,122 @@ impl Renderer {
         // The cache keeps a map the next view plans the same (every view of a shared batch).
         let was = self.shadow_cache();
         self.set_shadow_cache(true);
-        let frames = views
-            .iter()
-            .map(|v| self.render(v, width, height))
-            .collect();
+        let mut frames = Vec::with_capacity(views.len());
+        let r = self.render_each(&views, width, height, None, &mut |_, f, _| frames.push(f));
         self.set_shadow_cache(was);
-        frames
+        r.map(|()| frames)
+    }
+
+    /// Renders each of `views` at `width`×`height` as [`Renderer::render`] does (with `aovs`, as
+    /// [`Renderer::render_with_aovs`] does) and hands each frame to `sink` in order, as it is
+    /// read back. Up to [`RING`] frames are in flight: the next view is recorded and drawn while
+    /// the last one is read back and `sink` works on it (lit views at one sample per pixel,
+    /// shadow maps, no depth measuring pass; other batches go one view at a time). The frames
+    /// are the same to the byte either way, as tests check.
+    pub fn render_each(
+        &mut self,
+        views: &[View],
+        width: u32,
+        height: u32,
+        aovs: Option<AovSet>,
+        sink: &mut Sink<'_>,
+    ) -> Result<(), GpuError> {
+        if !self.keeps_in_flight(views, aovs) {
+            for (i, v) in views.iter().enumerate() {
+                match aovs {
+                    Some(set) => {
+                        let (f, a) = self.render_with_aovs(v, width, height, set)?;
+                        sink(i, f, Some(a));
+                    }
+                    None => sink(i, self.render(v, width, height)?, None),
+                }
+            }
+            return Ok(());
+        }
+        let keep_depth = self.read_depth;
+        self.read_depth = keep_depth || aovs.is_some_and(|s| s.depth);
+        let r = self.render_ring(views, (width, height), aovs, keep_depth, sink);
+        self.read_depth = keep_depth;
+        r
+    }
+
+    /// Whether [`Renderer::render_each`] keeps several of `views` in flight: each renders in
+    /// one submission (no depth-measuring frame, no exact shadows' per-frame buffers, no
+    /// supersampling), and the AOVs asked for come from the camera pass itself.
+    pub fn keeps_in_flight(&self, views: &[View], aovs: Option<AovSet>) -> bool {
+        let targets = aovs.is_some_and(|s| s.instance || s.normal);
+        let depth = aovs.is_some_and(|s| s.depth);
+        let aovs_fit = !(targets || depth)
+            || self.core.samples == 1 && (!targets || self.core.camera.can_draw_aovs());
+        aovs_fit
+            && views.iter().all(|v| {
+                !self.measures_depths(v)
+                    && !v.shadow.method.traces()
+                    && v.supersample <= 1
+                    && (aovs.is_none() || v.mode == ViewMode::Lit)
+            })
+    }
+
+    /// `render_each`'s ring: submits view i in slot i mod [`RING`] once the frame that used the
+    /// slot has been read back and handed to `sink`.
+    fn render_ring(
+        &mut self,
+        views: &[View],
+        size: (u32, u32),
+        aovs: Option<AovSet>,
+        keep_depth: bool,
+        sink: &mut Sink<'_>,
+    ) -> Result<(), GpuError> {
+        let targets = aovs.filter(|s| s.instance || s.normal);
+        let mut pending: VecDeque<(usize, Pending)> = VecDeque::with_capacity(RING);
+        let mut result = Ok(());
+        for (i, v) in views.iter().enumerate() {
+            if pending.len() == RING {
+                let (k, p) = pending.pop_front().expect("RING in flight");
+                result = self.hand_over(&views[k], k, p, (size, aovs, keep_depth), sink);
+                if result.is_err() {
+                    break;
+                }
+            }
+            match self.submit_frame(i % RING, v, size, targets) {
+                Ok(p) => pending.push_back((i, p)),
+                Err(e) => {
+                    result = Err(e);
+                    break;
+                }
+            }
+        }
+        // What is still in flight is read back (and, after an error, dropped).
+        while let Some((k, p)) = pending.pop_front() {
+            if result.is_ok() {
+                result = self.hand_over(&views[k], k, p, (size, aovs, keep_depth), sink);
+            } else {
+                let _ = self.finish_frame(p);
+            }
+        }
+        result
+    }
+
+    /// Reads back view `k`'s frame `p` and hands it, with its AOVs, to `sink`.
+    fn hand_over(
+        &mut self,
+        view: &View,
+        k: usize,
+        p: Pending,
+        (size, aovs, keep_depth): ((u32, u32), Option<AovSet>, bool),
+        sink: &mut Sink<'_>,
+    ) -> Result<(), GpuError> {
+        let (mut frame, drawn) = self.finish_frame(p)?;
+        let aovs = aovs.map(|set| {
+            let (ids, normals) = drawn.unwrap_or_default();
+            let depth = frame.depth.as_deref().filter(|_| set.depth).unwrap_or(&[]);
+            aovs_of(view, size, (ids, normals, depth), frame.plan.clone())
+        });
+        if !keep_depth {
+            frame.depth = None;
+        }
+        sink(k, frame, aovs);
+        Ok(())
     }
 
     /// `views` set to share their shadow maps ([`BatchShadows::Shared`]).
