@@ -123,7 +123,7 @@ fn shared_maps_against_per_view_fits() {
     assert_validation_clean(&ctx);
 }
 
-/// `render_each` keeps frames in flight (views k + 1 and k + 2 drawn while view k is read back), and
+/// `render_each` keeps frames in flight (view k + 1 drawn while view k is read back), and
 /// hands over, in order, each view's frame and AOVs as one `render_with_aovs` call makes them,
 /// to the byte: with each view's own shadow fit (the map drawn again while the view before it
 /// is still in flight) and with the shared map.

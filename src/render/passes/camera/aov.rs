@@ -26,6 +26,31 @@ pub struct AovTargets {
     pub extent: vk::Extent2D,
 }
 
+/// The attachments of the id and normal targets: cleared to 0 (no surface), or with `load` kept
+/// from an earlier pass (the G-buffer pass drew the deferred draws' first).
+pub(super) fn aov_attachments(
+    ids: vk::ImageView,
+    normals: vk::ImageView,
+    load: bool,
+) -> [vk::RenderingAttachmentInfo<'static>; 2] {
+    [
+        (ids, vk::ClearColorValue { uint32: [0; 4] }),
+        (normals, vk::ClearColorValue { float32: [0.0; 4] }),
+    ]
+    .map(|(view, clear)| {
+        vk::RenderingAttachmentInfo::default()
+            .image_view(view)
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(if load {
+                vk::AttachmentLoadOp::LOAD
+            } else {
+                vk::AttachmentLoadOp::CLEAR
+            })
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { color: clear })
+    })
+}
+
 /// The draws the AOV pass records for `frame`: its visible draws, blended ones left out.
 pub(super) fn aov_draws<'a>(
     scene: &'a GpuScene,
@@ -53,18 +78,7 @@ impl CameraPass {
         frame: &CameraFrame,
     ) -> usize {
         let d = &self.ctx.device;
-        let color = |view, clear| {
-            vk::RenderingAttachmentInfo::default()
-                .image_view(view)
-                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { color: clear })
-        };
-        let colors = [
-            color(t.ids, vk::ClearColorValue { uint32: [0; 4] }),
-            color(t.normals, vk::ClearColorValue { float32: [0.0; 4] }),
-        ];
+        let colors = aov_attachments(t.ids, t.normals, false);
         let stencil = has_stencil(self.depth_format);
         let depth = depth_clear_attachment(t.depth, stencil);
         let mut rendering = vk::RenderingInfo::default()

@@ -11,7 +11,7 @@ mod pipelines;
 mod record;
 
 use crate::shader_consts::VariantKey;
-use aov::aov_draws;
+use aov::{aov_attachments, aov_draws};
 use frame::flat_inputs_fit;
 use pipelines::Formats;
 use record::full_rect;

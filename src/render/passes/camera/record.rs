@@ -80,23 +80,10 @@ impl CameraPass {
                 .resolve_image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
         }
         // The ids and normals: cleared here, or kept from the G-buffer pass, which drew the
-        // deferred draws' ids first.
-        let aov_att = |view, clear| {
-            vk::RenderingAttachmentInfo::default()
-                .image_view(view)
-                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(if deferring {
-                    vk::AttachmentLoadOp::LOAD
-                } else {
-                    vk::AttachmentLoadOp::CLEAR
-                })
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { color: clear })
-        };
+        // deferred draws' first.
         let mut color_att = vec![color_att];
         if let Some([ids, normals]) = targets.aovs {
-            color_att.push(aov_att(ids, vk::ClearColorValue { uint32: [0; 4] }));
-            color_att.push(aov_att(normals, vk::ClearColorValue { float32: [0.0; 4] }));
+            color_att.extend(aov_attachments(ids, normals, deferring));
         }
         let mut rendering = vk::RenderingInfo::default()
             .render_area(full_rect(extent))
@@ -243,20 +230,9 @@ impl CameraPass {
         } else {
             Entry::GBuffer
         };
-        let aov_targets = aovs.into_iter().flat_map(|[ids, normals]| {
-            [
-                (ids, vk::ClearColorValue { uint32: [0; 4] }),
-                (normals, vk::ClearColorValue { float32: [0.0; 4] }),
-            ]
-            .map(|(v, clear)| {
-                vk::RenderingAttachmentInfo::default()
-                    .image_view(v)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(vk::AttachmentLoadOp::CLEAR)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue { color: clear })
-            })
-        });
+        let aov_targets = aovs
+            .into_iter()
+            .flat_map(|[ids, normals]| aov_attachments(ids, normals, false));
         let targets: Vec<vk::RenderingAttachmentInfo> = aov_targets
             .chain(views.into_iter().map(|v| {
                 // Only marked pixels are read, and those are written: nothing to load.
