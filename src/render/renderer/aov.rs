@@ -169,7 +169,7 @@ impl AovTarget {
                     MemoryLocation::GpuToCpu,
                 )
             };
-            Ok((image, at, super::ring_of(buffer)?))
+            Ok((image, at, super::submit::ring_of(buffer)?))
         };
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT;
         Ok(Self {

@@ -2,7 +2,8 @@
 //! while the lights and the casters hold still (a dataset's camera poses around a model).
 
 use super::aov::{aovs_of, AovSet, Aovs};
-use super::{Pending, RenderedFrame, Renderer};
+use super::submit::Pending;
+use super::{RenderedFrame, Renderer};
 use crate::gpu::context::GpuError;
 use crate::plan::settings::ViewMode;
 use crate::plan::view::View;

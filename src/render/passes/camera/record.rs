@@ -29,14 +29,7 @@ impl CameraPass {
         frame: &CameraFrame,
     ) -> CameraCounts {
         let (cull, shadow_map_view, plan) = (&frame.cull, frame.shadow_map_view, &frame.defer);
-        let CameraTargets {
-            color,
-            depth,
-            resolve,
-            extent,
-            clear,
-            ..
-        } = *targets;
+        let extent = targets.extent;
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         ctx.begin_label(cmd, "camera pass");
@@ -51,40 +44,7 @@ impl CameraPass {
         if deferring {
             deferred_draws = self.record_gbuffer(cmd, scene, targets, frame_set, plan, cull);
         }
-        let mut color_att = vk::RenderingAttachmentInfo::default()
-            .image_view(color)
-            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                color: vk::ClearColorValue { float32: clear },
-            });
-        let mut depth_att = depth_clear_attachment(depth, stencil);
-        if deferring {
-            // The G-buffer pass's depth and stencil marks.
-            depth_att = depth_att.load_op(vk::AttachmentLoadOp::LOAD);
-        }
-        if let Some(target) = resolve.color {
-            // The samples are averaged into the target; they need not be kept.
-            color_att = color_att
-                .store_op(vk::AttachmentStoreOp::DONT_CARE)
-                .resolve_mode(vk::ResolveModeFlags::AVERAGE)
-                .resolve_image_view(target)
-                .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
-        }
-        if let Some(target) = resolve.depth {
-            // Sample 0 (every device supports it): the depth of the pixel centre's nearest sample.
-            depth_att = depth_att
-                .resolve_mode(vk::ResolveModeFlags::SAMPLE_ZERO)
-                .resolve_image_view(target)
-                .resolve_image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
-        }
-        // The ids and normals: cleared here, or kept from the G-buffer pass, which drew the
-        // deferred draws' first.
-        let mut color_att = vec![color_att];
-        if let Some([ids, normals]) = targets.aovs {
-            color_att.extend(aov_attachments(ids, normals, deferring));
-        }
+        let (color_att, depth_att) = main_attachments(targets, stencil, deferring);
         let mut rendering = vk::RenderingInfo::default()
             .render_area(full_rect(extent))
             .layer_count(1)
@@ -276,32 +236,7 @@ impl CameraPass {
         if let Some(g) = self.gbuffer.as_mut() {
             g.transition(cmd, Access::FragmentSampled);
         }
-        // The resolve's stencil test and the forward draws' depth test read what this pass
-        // wrote (same layout: a memory dependency only).
-        let tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
-            | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
-        // The ids and normals likewise: the forward pass loads them and draws over them.
-        let out = vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT;
-        let mb = [
-            vk::MemoryBarrier2::default()
-                .src_stage_mask(tests)
-                .src_access_mask(vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE)
-                .dst_stage_mask(tests)
-                .dst_access_mask(
-                    vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
-                        | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
-                ),
-            vk::MemoryBarrier2::default()
-                .src_stage_mask(out)
-                .src_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
-                .dst_stage_mask(out)
-                .dst_access_mask(
-                    vk::AccessFlags2::COLOR_ATTACHMENT_READ
-                        | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-                ),
-        ];
-        let mb = if aovs.is_some() { &mb[..] } else { &mb[..1] };
-        Recorder::new(d, cmd).pipeline_barrier2(&vk::DependencyInfo::default().memory_barriers(mb));
+        gbuffer_written(d, cmd, aovs.is_some());
         ctx.end_label(cmd);
         plan.deferred.len()
     }
@@ -387,4 +322,89 @@ fn pieces(bits: VariantKey, split: Split) -> Vec<(VariantKey, Option<vk::Rect2D>
             )
             .collect(),
     }
+}
+
+/// Makes what the G-buffer pass wrote visible to the rendering after it (same layouts: memory
+/// dependencies only): its depth and stencil to the resolve's stencil test and the forward draws'
+/// depth test, and with `aovs` the ids and normals to the forward pass, which loads them and
+/// draws over them.
+fn gbuffer_written(d: &ash::Device, cmd: vk::CommandBuffer, aovs: bool) {
+    let tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+        | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
+    let out = vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT;
+    let rw = |r, w| (w, r | w);
+    let mb = [
+        (
+            tests,
+            rw(
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            ),
+        ),
+        (
+            out,
+            rw(
+                vk::AccessFlags2::COLOR_ATTACHMENT_READ,
+                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+            ),
+        ),
+    ]
+    .map(|(stage, (src, dst))| {
+        vk::MemoryBarrier2::default()
+            .src_stage_mask(stage)
+            .src_access_mask(src)
+            .dst_stage_mask(stage)
+            .dst_access_mask(dst)
+    });
+    let mb = if aovs { &mb[..] } else { &mb[..1] };
+    Recorder::new(d, cmd).pipeline_barrier2(&vk::DependencyInfo::default().memory_barriers(mb));
+}
+
+/// The camera pass's attachments after the G-buffer pass (`deferring`: its depth, stencil marks,
+/// ids and normals kept): the colour (resolved with MSAA) with the ids and normals when the
+/// frame draws them, and the depth (and `stencil`; sample 0 resolved for depth readback).
+fn main_attachments(
+    targets: &CameraTargets,
+    stencil: bool,
+    deferring: bool,
+) -> (
+    Vec<vk::RenderingAttachmentInfo<'static>>,
+    vk::RenderingAttachmentInfo<'static>,
+) {
+    let t = targets;
+    let mut color_att = vk::RenderingAttachmentInfo::default()
+        .image_view(t.color)
+        .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(vk::ClearValue {
+            color: vk::ClearColorValue { float32: t.clear },
+        });
+    let mut depth_att = depth_clear_attachment(t.depth, stencil);
+    if deferring {
+        // The G-buffer pass's depth and stencil marks.
+        depth_att = depth_att.load_op(vk::AttachmentLoadOp::LOAD);
+    }
+    if let Some(target) = t.resolve.color {
+        // The samples are averaged into the target; they need not be kept.
+        color_att = color_att
+            .store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .resolve_mode(vk::ResolveModeFlags::AVERAGE)
+            .resolve_image_view(target)
+            .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+    }
+    if let Some(target) = t.resolve.depth {
+        // Sample 0 (every device supports it): the depth of the pixel centre's nearest sample.
+        depth_att = depth_att
+            .resolve_mode(vk::ResolveModeFlags::SAMPLE_ZERO)
+            .resolve_image_view(target)
+            .resolve_image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+    }
+    // The ids and normals: cleared here, or kept from the G-buffer pass, which drew the deferred
+    // draws' first.
+    let mut colors = vec![color_att];
+    if let Some([ids, normals]) = t.aovs {
+        colors.extend(aov_attachments(ids, normals, deferring));
+    }
+    (colors, depth_att)
 }
