@@ -179,14 +179,20 @@ def test_a_batch_equals_single_renders(renderer):
     scene.add_ground()
     camera = umbra.PerspectiveCamera(np.pi / 4, znear=0.1)
     poses = np.stack([umbra.look_at((x, 1.0, 3.0), (0, 0, 0)) for x in (-1.0, 0.0, 1.0)])
-    own = renderer.render_batch(
-        scene, camera, poses, outputs=("color", "depth"), share_shadows=False
-    )
+    every = ("color", "depth", "segmentation", "normals")
+    own = renderer.render_batch(scene, camera, poses, outputs=every, share_shadows=False)
     assert own["color"].shape == (3, H, W, 3) and own["depth"].shape == (3, H, W)
+    assert own["segmentation"].shape == (3, H, W) and own["normals"].shape == (3, H, W, 3)
     for k in range(3):
-        one = renderer.render(scene, camera, poses[k], outputs=("color", "depth"))
-        assert np.array_equal(own["color"][k], one["color"])
-        assert np.array_equal(own["depth"][k], one["depth"])
+        # Each output of a batch (frames in flight, ids from the camera pass) is a single call's.
+        one = renderer.render(scene, camera, poses[k], outputs=every)
+        for name in every:
+            assert np.array_equal(own[name][k], one[name]), (k, name)
+        # And the ids and normals are the extra pass's (asked for without the image).
+        alone = renderer.render(scene, camera, poses[k], outputs=("segmentation", "normals"))
+        assert np.array_equal(alone["segmentation"], one["segmentation"]), k
+        assert np.array_equal(alone["normals"], one["normals"]), k
+        assert set(np.unique(one["segmentation"])) == {0, 1, 2}, k
     # The shared map is fitted to all the poses, whatever their order: the same pixels
     # reversed; the same depth as each pose's own fit, and colour within the shadows' outlines.
     shared = renderer.render_batch(scene, camera, poses, outputs=("color", "depth"))
