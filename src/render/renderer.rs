@@ -16,10 +16,11 @@ use std::sync::Arc;
 
 mod aov;
 mod batch;
+mod ring;
 mod submit;
 pub use aov::{AovSet, Aovs};
 pub use batch::{BatchShadows, Sink, RING, SHARED_MAP_MAX};
-use submit::ring_of;
+use ring::ring_of;
 
 /// Colour format of offscreen frames (sRGB-encoded on write).
 pub const OFFSCREEN_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
@@ -76,9 +77,9 @@ struct Target {
     depth: Image,
     color_at: Attachment,
     depth_at: Attachment,
-    /// Per ring slot (`batch::RING`), the colour and depth readbacks.
-    readback: [Buffer; batch::RING],
-    depth_readback: [Buffer; batch::RING],
+    /// Per ring slot (`ring::RING`), the colour and depth readbacks.
+    readback: [Buffer; ring::RING],
+    depth_readback: [Buffer; ring::RING],
     /// The multisampled images drawn into (resolved into `color`, `depth`) with MSAA.
     msaa: Option<MsaaTargets>,
     /// With supersampling, the image at the asked size `color` is filtered into (read back
@@ -90,9 +91,9 @@ struct Target {
 pub struct Renderer {
     core: FrameCore,
     target: Option<Target>,
-    /// Per ring slot (`batch::RING`: frames in flight in a batch), a command buffer and its fence.
-    cmds: [vk::CommandBuffer; batch::RING],
-    fences: [vk::Fence; batch::RING],
+    /// Per ring slot (`ring::RING`: frames in flight in a batch), a command buffer and its fence.
+    cmds: [vk::CommandBuffer; ring::RING],
+    fences: [vk::Fence; ring::RING],
     read_depth: bool,
     /// The depths the last measured camera saw (`ShadowSettings::depth_fit`).
     seen_depths: Option<SeenDepths>,
@@ -177,9 +178,9 @@ impl Renderer {
         scene: &Scene,
         options: &SceneOptions,
     ) -> Result<Self, GpuError> {
-        let core = FrameCore::new(ctx, scene, options, OFFSCREEN_FORMAT, batch::RING)?;
-        let mut cmds = [vk::CommandBuffer::null(); batch::RING];
-        let mut fences = [vk::Fence::null(); batch::RING];
+        let core = FrameCore::new(ctx, scene, options, OFFSCREEN_FORMAT, ring::RING)?;
+        let mut cmds = [vk::CommandBuffer::null(); ring::RING];
+        let mut fences = [vk::Fence::null(); ring::RING];
         for (cmd, fence) in cmds.iter_mut().zip(&mut fences) {
             *cmd = ctx.allocate_command_buffer()?;
             *fence = unsafe {
@@ -289,7 +290,7 @@ impl Renderer {
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | usage,
         )?;
         let bytes = w as u64 * h as u64 * 4;
-        let readbacks = |name: &str| -> Result<[Buffer; batch::RING], GpuError> {
+        let readbacks = |name: &str| -> Result<[Buffer; ring::RING], GpuError> {
             let b = |i| {
                 Buffer::new(
                     ctx,

@@ -62,7 +62,7 @@ type ReadAovs = (Vec<u32>, Vec<[f32; 3]>, Vec<f32>);
 pub(super) type IdsNormals = (Vec<u32>, Vec<[f32; 3]>);
 
 /// An AOV target's image, its attachment state and a readback per ring slot.
-type Output = (Image, Attachment, [Buffer; super::batch::RING]);
+type Output = (Image, Attachment, [Buffer; super::ring::RING]);
 
 /// The AOV pass's images and readbacks, kept between frames of one size.
 pub(super) struct AovTarget {
@@ -169,7 +169,7 @@ impl AovTarget {
                     MemoryLocation::GpuToCpu,
                 )
             };
-            Ok((image, at, super::submit::ring_of(buffer)?))
+            Ok((image, at, super::ring::ring_of(buffer)?))
         };
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT;
         Ok(Self {

@@ -12,11 +12,7 @@ use crate::scene::{Camera, LightKind};
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-/// Frames a batch keeps in flight ([`Renderer::render_each`]): view k + 1 is recorded and drawn
-/// while view k is read back and handed over. Two, not three: on lavapipe (two cores, the
-/// device itself on the CPU) neither ring measured faster than one frame at a time (docs/python.md,
-/// *Batches*), and each slot holds its own readbacks (up to 28 bytes a pixel with normals).
-pub const RING: usize = 2;
+pub use super::ring::RING;
 
 /// What [`Renderer::render_each`] hands over per view: its index, the frame, and its AOVs when
 /// asked for.

@@ -1,10 +1,10 @@
 //! One frame's submission and readback: recorded and submitted without waiting
 //! (`Renderer::submit_frame`), then waited for and read back (`Renderer::finish_frame`), in a
-//! ring slot of its own (`batch::RING`: command buffer, fence, uniform slot, readbacks), so that
+//! ring slot of its own (`RING`: command buffer, fence, uniform slot, readbacks), so that
 //! a batch keeps frames in flight.
 
 use super::{
-    aov, batch, check_size, check_supersample, copy_to_buffer, rgba_from_readback,
+    aov, check_size, check_supersample, copy_to_buffer, rgba_from_readback,
     transfer_to_host_barrier, AovSet, FrameStats, RenderedFrame, Renderer, Target,
 };
 use crate::gpu::barrier::Access;
@@ -137,14 +137,6 @@ impl Renderer {
         };
         Ok((frame, drawn))
     }
-}
-
-/// One of `make(slot)` per ring slot (`batch::RING`).
-pub(super) fn ring_of<T>(
-    make: impl Fn(usize) -> Result<T, GpuError>,
-) -> Result<[T; batch::RING], GpuError> {
-    let v = (0..batch::RING).map(make).collect::<Result<Vec<T>, _>>()?;
-    Ok(v.try_into().unwrap_or_else(|_| unreachable!("RING items")))
 }
 
 /// A frame submitted by `Renderer::submit_frame`, not yet read back.

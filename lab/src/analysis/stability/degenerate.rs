@@ -87,35 +87,23 @@ fn one_triangle() -> Scene {
     s
 }
 
+/// The degenerate cases, in the report's order: the sun's extremes, the camera's, then scenes of
+/// their own (the 1M-triangle grid unless `quick`).
 fn cases(scene: &Scene, view: &View, quick: bool) -> Vec<Case> {
-    let b = scene.bounds();
-    let c = b.center();
-    let r = (b.diagonal() * 0.5).max(1e-3);
+    let mut out = sun_cases(view);
+    out.extend(camera_cases(scene, view));
+    out.extend(scene_cases(view, quick));
+    out
+}
+
+/// The sun overhead, on the horizon and below it.
+fn sun_cases(view: &View) -> Vec<Case> {
     let sun = |e: f32| {
         let mut v = view.clone();
         v.sun_direction = Some(Light::sun_direction(e.to_radians(), 0.6));
         v
     };
-    let cam = |eye: Vec3, target: Vec3, near: f32| {
-        let mut v = view.clone();
-        let fov = view.camera.fov_y();
-        v.camera = Camera::look_at(
-            eye,
-            target,
-            fov.unwrap_or(umbra::scene::mesh::framing::FOV_Y_DEG.to_radians()),
-            near,
-        );
-        v
-    };
-    let inside = scene
-        .draw_bounds()
-        .into_iter()
-        .filter(|a| !a.is_empty())
-        .min_by(|a, b| a.diagonal().total_cmp(&b.diagonal()))
-        .map_or(c, |a| a.center());
-    let mut near = view.clone();
-    near.camera.near = 1e-4;
-    let mut out = vec![
+    vec![
         Case {
             judged: true,
             name: "sun overhead (90°)",
@@ -137,6 +125,39 @@ fn cases(scene: &Scene, view: &View, quick: bool) -> Vec<Case> {
             scene: None,
             view: sun(-10.0),
         },
+    ]
+}
+
+/// `view`'s camera moved to `eye`, looking at `target`, with near plane `near`.
+fn camera_at(view: &View, eye: Vec3, target: Vec3, near: f32) -> View {
+    let mut v = view.clone();
+    let fov = view.camera.fov_y();
+    v.camera = Camera::look_at(
+        eye,
+        target,
+        fov.unwrap_or(umbra::scene::mesh::framing::FOV_Y_DEG.to_radians()),
+        near,
+    );
+    v
+}
+
+/// The camera straight down, straight up, with a tiny near plane and inside a caster.
+fn camera_cases(scene: &Scene, view: &View) -> Vec<Case> {
+    let b = scene.bounds();
+    let c = b.center();
+    let r = (b.diagonal() * 0.5).max(1e-3);
+    let cam = |eye: Vec3, target: Vec3, near: f32| camera_at(view, eye, target, near);
+    let inside = scene
+        .draw_bounds()
+        .into_iter()
+        .filter(|a| !a.is_empty())
+        .min_by(|a, b| a.diagonal().total_cmp(&b.diagonal()))
+        .map_or(c, |a| a.center());
+    let mut near = view.clone();
+    near.camera.near = 1e-4;
+    let mut near = view.clone();
+    near.camera.near = 1e-4;
+    vec![
         Case {
             judged: true,
             name: "camera straight down",
@@ -169,6 +190,13 @@ fn cases(scene: &Scene, view: &View, quick: bool) -> Vec<Case> {
             scene: None,
             view: cam(inside, inside + Vec3::new(1.0, -0.3, 0.4), 1e-3 * r),
         },
+    ]
+}
+
+/// A one-triangle scene, an empty one and, unless `quick`, a 1M-triangle one.
+fn scene_cases(view: &View, quick: bool) -> Vec<Case> {
+    let cam = |eye: Vec3, target: Vec3, near: f32| camera_at(view, eye, target, near);
+    let mut out = vec![
         Case {
             judged: true,
             name: "one-triangle scene",
