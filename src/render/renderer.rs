@@ -99,10 +99,6 @@ pub struct Renderer {
     seen_depths: Option<SeenDepths>,
     /// The AOV pass's images (`render_aovs`), made at its first call.
     aov: Option<aov::AovTarget>,
-    /// The AOVs `render_with_aovs` asks the next frames' camera passes to draw too.
-    frame_aovs: Option<AovSet>,
-    /// The ids and normals the last such camera pass drew (taken by `render_with_aovs`).
-    drawn_aovs: Option<aov::IdsNormals>,
 }
 
 /// A camera (view matrix, projection, drawn size) and the (nearest, farthest) view depth it saw
@@ -197,8 +193,6 @@ impl Renderer {
             read_depth: false,
             seen_depths: None,
             aov: None,
-            frame_aovs: None,
-            drawn_aovs: None,
         })
     }
 
@@ -348,8 +342,20 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<RenderedFrame, GpuError> {
+        self.render_drawing(view, (width, height), None)
+            .map(|(f, _)| f)
+    }
+
+    /// `render`, its camera pass also drawing the ids and normals of `aovs` where it can
+    /// (`render_with_aovs`): the frame, and what was drawn of them.
+    fn render_drawing(
+        &mut self,
+        view: &View,
+        (width, height): (u32, u32),
+        aovs: Option<AovSet>,
+    ) -> Result<(RenderedFrame, Option<aov::IdsNormals>), GpuError> {
         if !self.measures_depths(view) {
-            return self.render_once(view, width, height);
+            return self.render_once(view, (width, height), aovs);
         }
         // The drawn size: a supersampled frame measures its own depths.
         let s = view.supersample;
@@ -370,9 +376,9 @@ impl Renderer {
                 // The depth buffer does not depend on shadows: measure without them.
                 let mut probe = view.clone();
                 probe.shadow.enabled = false;
-                let f = self.render_once(&probe, width, height);
+                let f = self.render_once(&probe, (width, height), None);
                 self.read_depth = was;
-                let f = f?;
+                let (f, _) = f?;
                 let aspect = width as f32 / height.max(1) as f32;
                 let seen = visible_depths(
                     f.depth.as_deref().unwrap_or(&[]),
@@ -384,7 +390,7 @@ impl Renderer {
         };
         let mut v = view.clone();
         v.visible_depths = seen;
-        self.render_once(&v, width, height)
+        self.render_once(&v, (width, height), aovs)
     }
 
     /// Whether `render` of `view` fits its shadows to the depths the camera sees

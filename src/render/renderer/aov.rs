@@ -248,17 +248,11 @@ impl Renderer {
         let targets = set.instance || set.normal;
         let was = self.read_depth;
         self.read_depth = was || (set.depth && one_sample);
-        self.frame_aovs = targets.then_some(set);
-        self.drawn_aovs = None;
-        let frame = self.render(view, width, height);
+        let frame = self.render_drawing(view, (width, height), targets.then_some(set));
         self.read_depth = was;
-        self.frame_aovs = None;
-        let mut frame = frame?;
-        let drawn = match self.drawn_aovs.take() {
-            Some(ids_normals) => Some(ids_normals),
-            None if !targets && one_sample => Some((Vec::new(), Vec::new())),
-            None => None,
-        };
+        let (mut frame, drawn) = frame?;
+        // Depth alone at one sample is the frame's: nothing more to draw.
+        let drawn = drawn.or_else(|| (!targets && one_sample).then(Default::default));
         let aovs = match drawn {
             Some((instance, normal)) => {
                 let depth = frame.depth.as_deref().filter(|_| set.depth).unwrap_or(&[]);

@@ -17,16 +17,15 @@ use ash::vk;
 use std::time::Instant;
 
 impl Renderer {
+    /// One frame in ring slot 0, waited for: `submit_frame`, then `finish_frame`.
     pub(super) fn render_once(
         &mut self,
         view: &View,
-        width: u32,
-        height: u32,
-    ) -> Result<RenderedFrame, GpuError> {
-        let p = self.submit_frame(0, view, (width, height), self.frame_aovs)?;
-        let (frame, drawn) = self.finish_frame(p)?;
-        self.drawn_aovs = drawn;
-        Ok(frame)
+        size: (u32, u32),
+        aovs: Option<AovSet>,
+    ) -> Result<(RenderedFrame, Option<aov::IdsNormals>), GpuError> {
+        let p = self.submit_frame(0, view, size, aovs)?;
+        self.finish_frame(p)
     }
 
     /// Prepares, records and submits `view` at `width`×`height` in ring slot `slot` (whose
