@@ -142,13 +142,6 @@ fn compile(path: &Path, out_dir: &str) -> Result<(String, String), String> {
             e.emit_to_string_with_path(source, &file)
         )
     })?;
-    let options = naga::back::spv::Options {
-        lang_version: (1, 3),
-        // No DEBUG flag: it embeds the WGSL source in each of the (up to 2048) variants.
-        flags: naga::back::spv::WriterFlags::ADJUST_COORDINATE_SPACE
-            | naga::back::spv::WriterFlags::LABEL_VARYINGS,
-        ..Default::default()
-    };
     // Boolean `override`s specialise the shader: one SPIR-V per combination (bit i of the
     // variant index = the i-th override, in declaration order), since naga's SPIR-V writer has
     // no specialization constants. The driver then drops the dead branches, which matters on
@@ -165,6 +158,47 @@ fn compile(path: &Path, out_dir: &str) -> Result<(String, String), String> {
             path.display()
         ));
     }
+    let (requires, excludes) = override_rules(path, source, &overrides)?;
+    let canonical = |mask: usize| {
+        let mut m = mask;
+        for (i, r) in requires.iter().enumerate() {
+            if let Some(r) = r {
+                let off = (mask >> r) & 1 == 0 || excludes[i].iter().any(|x| (mask >> x) & 1 == 1);
+                if off {
+                    m &= !(1 << i);
+                }
+            }
+        }
+        m
+    };
+    let variants = 1usize << overrides.len();
+    let masks: Vec<usize> = (0..variants).filter(|&m| canonical(m) == m).collect();
+    let spirv = spirv_variants(path, (&module, &info), &overrides, &masks)?;
+    let packed = pack(out_dir, &stem, &spirv)?;
+
+    let shader = Shader {
+        file: &file,
+        stem: &stem,
+        module: &module,
+        info: &info,
+        overrides: &overrides,
+        requires: &requires,
+        canonical: (0..variants).map(canonical).collect(),
+        packed: &packed,
+    };
+    reflect(&shader)
+}
+
+/// For each override, the one it requires and those it excludes.
+type OverrideRules = (Vec<Option<usize>>, Vec<Vec<usize>>);
+
+/// The `// requires OTHER; excludes A B` clauses of `source`'s override declarations: for each
+/// override, the one it requires and those it excludes (indices into `overrides`).
+fn override_rules(
+    path: &Path,
+    source: &str,
+    overrides: &[String],
+) -> Result<OverrideRules, String> {
     // An override declared with a trailing `// requires OTHER` means nothing while OTHER is off,
     // and with `// requires OTHER; excludes A B` nothing while A or B is on either: such
     // combinations share the SPIR-V of the one with the override off.
@@ -191,45 +225,38 @@ fn compile(path: &Path, out_dir: &str) -> Result<(String, String), String> {
         requires[i] = Some(r);
         excludes[i] = x;
     }
-    let canonical = |mask: usize| {
-        let mut m = mask;
-        for (i, r) in requires.iter().enumerate() {
-            if let Some(r) = r {
-                let off = (mask >> r) & 1 == 0 || excludes[i].iter().any(|x| (mask >> x) & 1 == 1);
-                if off {
-                    m &= !(1 << i);
-                }
-            }
-        }
-        m
+    Ok((requires, excludes))
+}
+
+/// One SPIR-V (little-endian bytes) per variant in `masks`: bit i of a mask is the value of the
+/// i-th override.
+fn spirv_variants(
+    path: &Path,
+    (module, info): (&naga::Module, &naga::valid::ModuleInfo),
+    overrides: &[String],
+    masks: &[usize],
+) -> Result<Vec<(usize, Vec<u8>)>, String> {
+    let options = naga::back::spv::Options {
+        lang_version: (1, 3),
+        // No DEBUG flag: it embeds the WGSL source in each of the (up to 2048) variants.
+        flags: naga::back::spv::WriterFlags::ADJUST_COORDINATE_SPACE
+            | naga::back::spv::WriterFlags::LABEL_VARYINGS,
+        ..Default::default()
     };
-    let variants = 1usize << overrides.len();
     let mut spirv: Vec<(usize, Vec<u8>)> = Vec::new();
-    for mask in (0..variants).filter(|&m| canonical(m) == m) {
+    for &mask in masks {
         let mut constants = naga::back::PipelineConstants::default();
         for (i, name) in overrides.iter().enumerate() {
             constants.insert(name.clone(), ((mask >> i) & 1) as f64);
         }
         let (m, i) =
-            naga::back::pipeline_constants::process_overrides(&module, &info, None, &constants)
+            naga::back::pipeline_constants::process_overrides(module, info, None, &constants)
                 .map_err(|e| format!("{}:1:1: error: overrides: {e}", path.display()))?;
         let words = naga::back::spv::write_vec(&m, &i, &options, None)
             .map_err(|e| format!("{}:1:1: error: SPIR-V output: {e}", path.display()))?;
         spirv.push((mask, words.iter().flat_map(|w| w.to_le_bytes()).collect()));
     }
-    let packed = pack(out_dir, &stem, &spirv)?;
-
-    let shader = Shader {
-        file: &file,
-        stem: &stem,
-        module: &module,
-        info: &info,
-        overrides: &overrides,
-        requires: &requires,
-        canonical: (0..variants).map(canonical).collect(),
-        packed: &packed,
-    };
-    reflect(&shader)
+    Ok(spirv)
 }
 
 /// What `reflect` writes Rust constants from: a validated module, its overrides and the

@@ -33,6 +33,19 @@ pub fn surface_extensions(display: RawDisplayHandle) -> Result<Vec<CString>, Gpu
         .collect())
 }
 
+/// A frame begun by `WindowRenderer::begin_frame`: its slot, sync objects and command buffer,
+/// the view it draws, whether it reads its depth back, and the acquired image.
+struct Begun {
+    f: usize,
+    fence: vk::Fence,
+    acquired: vk::Semaphore,
+    cmd: vk::CommandBuffer,
+    view: View,
+    fit: bool,
+    index: u32,
+    extent: vk::Extent2D,
+}
+
 /// Frames recorded ahead of the GPU.
 pub const FRAMES_IN_FLIGHT: usize = 2;
 
@@ -294,28 +307,20 @@ impl WindowRenderer {
         let screenshot = capture != Capture::None;
         let ctx = self.core.ctx.clone();
         let d = &ctx.device;
-        let f = self.frame;
-        let (fence, acquired, cmd) = {
-            let sync = &self.frames[f];
-            (sync.fence, sync.acquired, sync.cmd)
+        let Some(Begun {
+            f,
+            fence,
+            acquired,
+            cmd,
+            view: v,
+            fit,
+            index,
+            extent,
+        }) = self.begin_frame(view)?
+        else {
+            return Ok(DrawResult::Skipped);
         };
-        unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")?;
-        if let Some(t) = self.core.gpu_times(f) {
-            self.last_gpu = Some(t);
-        }
-        let (v, fit) = self.frame_view(view, f);
         let view = &v;
-        let extent = self.swapchain.extent;
-        if extent.width == 0 || extent.height == 0 || self.swapchain.raw == vk::SwapchainKHR::null()
-        {
-            return Ok(DrawResult::Skipped);
-        }
-        let Some((index, _suboptimal)) = self.swapchain.acquire(acquired)? else {
-            let (w, h) = self.wanted;
-            self.resize(w, h)?;
-            return Ok(DrawResult::Skipped);
-        };
-        unsafe { d.reset_fences(&[fence]) }.vk("vkResetFences")?;
         let prepared = self.core.prepare(f, view, extent.width, extent.height)?;
         self.held = Some(ShadowHold::from_plan(&prepared.plan));
         let pixels = extent.width as usize * extent.height as usize;
@@ -387,6 +392,45 @@ impl WindowRenderer {
             summary,
             screenshot: shot,
         })
+    }
+
+    /// The start of a frame: waits for its slot's fence, picks the view it draws
+    /// ([`Self::frame_view`]) and acquires a swapchain image. `None`: nothing to draw into (a
+    /// minimised window, or a swapchain out of date and recreated).
+    fn begin_frame(&mut self, view: &View) -> Result<Option<Begun>, GpuError> {
+        let d = &self.core.ctx.device;
+        let f = self.frame;
+        let (fence, acquired, cmd) = {
+            let sync = &self.frames[f];
+            (sync.fence, sync.acquired, sync.cmd)
+        };
+        unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        if let Some(t) = self.core.gpu_times(f) {
+            self.last_gpu = Some(t);
+        }
+        let (view, fit) = self.frame_view(view, f);
+        let extent = self.swapchain.extent;
+        if extent.width == 0 || extent.height == 0 || self.swapchain.raw == vk::SwapchainKHR::null()
+        {
+            return Ok(None);
+        }
+        let Some((index, _suboptimal)) = self.swapchain.acquire(acquired)? else {
+            let (w, h) = self.wanted;
+            self.resize(w, h)?;
+            return Ok(None);
+        };
+        let d = &self.core.ctx.device;
+        unsafe { d.reset_fences(&[fence]) }.vk("vkResetFences")?;
+        Ok(Some(Begun {
+            f,
+            fence,
+            acquired,
+            cmd,
+            view,
+            fit,
+            index,
+            extent,
+        }))
     }
 
     /// The view this frame draws: with a depth fit, the depths the latest completed frame read

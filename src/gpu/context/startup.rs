@@ -66,13 +66,9 @@ pub(super) fn score(kind: vk::PhysicalDeviceType) -> u32 {
     }
 }
 
-/// Creates the instance (with the validation layer and synchronization validation when asked
-/// for) and its debug messenger; returns it owned, and whether validation is on.
-pub(super) fn create_instance(
-    entry: ash::Entry,
-    desc: &ContextDesc,
-    log: &Arc<ValidationLog>,
-) -> Result<(InstanceOwner, bool), GpuError> {
+/// Whether the instance gets the validation layer: as `desc` asks (or `UMBRA_VALIDATION=1`), an
+/// error where it is required and not installed.
+fn validation_enabled(entry: &ash::Entry, desc: &ContextDesc) -> Result<bool, GpuError> {
     let mut validation = desc.validation;
     if validation == Validation::Off && std::env::var("UMBRA_VALIDATION").is_ok_and(|v| v == "1") {
         validation = Validation::Required;
@@ -82,12 +78,20 @@ pub(super) fn create_instance(
     let has_layer = layers
         .iter()
         .any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
-    let enable_validation = match validation {
+    Ok(match validation {
         Validation::Off => false,
         Validation::IfAvailable => has_layer,
         Validation::Required if !has_layer => return Err(GpuError::NoValidationLayer),
         Validation::Required => true,
-    };
+    })
+}
+
+/// The instance extensions `desc` asks for (an error naming one the driver lacks), with
+/// VK_EXT_debug_utils added where the driver has it; and whether it does.
+fn instance_extensions(
+    entry: &ash::Entry,
+    desc: &ContextDesc,
+) -> Result<(Vec<*const i8>, bool), GpuError> {
     let exts = unsafe { entry.enumerate_instance_extension_properties(None) }
         .vk("vkEnumerateInstanceExtensionProperties")?;
     let has_ext = |name: &CStr| {
@@ -109,6 +113,18 @@ pub(super) fn create_instance(
     if has_debug_utils {
         ext_names.push(ash::ext::debug_utils::NAME.as_ptr());
     }
+    Ok((ext_names, has_debug_utils))
+}
+
+/// Creates the instance (with the validation layer and synchronization validation when asked
+/// for) and its debug messenger; returns it owned, and whether validation is on.
+pub(super) fn create_instance(
+    entry: ash::Entry,
+    desc: &ContextDesc,
+    log: &Arc<ValidationLog>,
+) -> Result<(InstanceOwner, bool), GpuError> {
+    let enable_validation = validation_enabled(&entry, desc)?;
+    let (ext_names, has_debug_utils) = instance_extensions(&entry, desc)?;
     let layer_names: Vec<*const i8> = if enable_validation {
         vec![VALIDATION_LAYER.as_ptr()]
     } else {

@@ -115,19 +115,7 @@ impl Swapchain {
             self.extent = vk::Extent2D::default();
             return Ok(());
         }
-        let modes = unsafe {
-            self.surface_loader
-                .get_physical_device_surface_present_modes(self.ctx.physical, self.surface)
-        }
-        .unwrap_or_default();
-        let mode = if self.vsync {
-            vk::PresentModeKHR::FIFO
-        } else {
-            [vk::PresentModeKHR::IMMEDIATE, vk::PresentModeKHR::MAILBOX]
-                .into_iter()
-                .find(|m| modes.contains(m))
-                .unwrap_or(vk::PresentModeKHR::FIFO)
-        };
+        let mode = self.present_mode();
         let mut count = caps.min_image_count + 1;
         if caps.max_image_count > 0 {
             count = count.min(caps.max_image_count);
@@ -164,6 +152,39 @@ impl Swapchain {
         self.extent = extent;
         self.images =
             unsafe { self.loader.get_swapchain_images(self.raw) }.vk("vkGetSwapchainImagesKHR")?;
+        self.create_views()?;
+        log::info!(
+            "swapchain {}x{} {:?} {:?}, {} images",
+            extent.width,
+            extent.height,
+            self.format,
+            mode,
+            self.images.len()
+        );
+        Ok(())
+    }
+
+    /// FIFO with vsync; without, IMMEDIATE or MAILBOX where the surface offers one.
+    fn present_mode(&self) -> vk::PresentModeKHR {
+        let modes = unsafe {
+            self.surface_loader
+                .get_physical_device_surface_present_modes(self.ctx.physical, self.surface)
+        }
+        .unwrap_or_default();
+        if self.vsync {
+            vk::PresentModeKHR::FIFO
+        } else {
+            [vk::PresentModeKHR::IMMEDIATE, vk::PresentModeKHR::MAILBOX]
+                .into_iter()
+                .find(|m| modes.contains(m))
+                .unwrap_or(vk::PresentModeKHR::FIFO)
+        }
+    }
+
+    /// A view and a "render finished" semaphore for each of the swapchain's images.
+    fn create_views(&mut self) -> Result<(), GpuError> {
+        let ctx = self.ctx.clone();
+        let d = &ctx.device;
         for (i, &img) in self.images.iter().enumerate() {
             let view_info = vk::ImageViewCreateInfo::default()
                 .image(img)
@@ -183,14 +204,6 @@ impl Swapchain {
             self.ctx.set_name(sem, &format!("render finished {i}"));
             self.render_finished.push(sem);
         }
-        log::info!(
-            "swapchain {}x{} {:?} {:?}, {} images",
-            extent.width,
-            extent.height,
-            self.format,
-            mode,
-            self.images.len()
-        );
         Ok(())
     }
 

@@ -189,9 +189,64 @@ pub fn run(
     let quick = opts.quick;
     let t_all = std::time::Instant::now();
     let mut seconds = Vec::new();
+    let (light_angle, contact, frames, shimmer) = renderer_probes(
+        ctx,
+        scene,
+        view,
+        scene_options,
+        opts,
+        wall,
+        &mut seconds,
+        progress,
+    )?;
     let mut timed = |name: &str, t: std::time::Instant| {
         seconds.push((name.to_string(), t.elapsed().as_secs_f64()))
     };
+
+    let t = std::time::Instant::now();
+    let motion = motion(ctx, scene, view, scene_options, opts, &mut || {
+        progress("motion")
+    })?;
+    timed("motion", t);
+
+    let t = std::time::Instant::now();
+    let precision = precision(ctx, scene, view, scene_options, size, quick, &mut || {
+        progress("precision")
+    })?;
+    timed("precision", t);
+
+    let t = std::time::Instant::now();
+    let degenerate = degenerate(ctx, scene, view, scene_options, size, quick, &mut || {
+        progress("degenerate")
+    })?;
+    timed("degenerate", t);
+    seconds.push(("total".into(), t_all.elapsed().as_secs_f64()));
+
+    let mut r = StabilityReport {
+        schema: SCHEMA.into(),
+        scene: scene.name.clone(),
+        size,
+        device: ctx.device_name.clone(),
+        quick,
+        defaults: describe(&view.shadow),
+        seconds,
+        light_angle,
+        contact,
+        path_frames: frames,
+        shimmer,
+        motion_frames: super::motion::frames(quick),
+        motion,
+        precision,
+        degenerate,
+        verdicts: Vec::new(),
+    };
+    r.verdicts = verdicts(&r);
+    Ok(r)
+}
+
+/// The azimuth in degrees of the scene's first directional light (0 without one, or with the
+/// built-in wall, whose probes are laid out from 0).
+fn first_azimuth(scene: &Scene, view: &View, wall: Option<Vec3>) -> f32 {
     let lights = umbra::plan::effective_lights(&scene.lights, view);
     let first_azimuth = lights
         .iter()
@@ -200,8 +255,34 @@ pub fn run(
             let to_sun = -l.direction.normalize_or(Vec3::NEG_Y);
             to_sun.x.atan2(to_sun.z).to_degrees()
         });
-    let first_azimuth = if wall.is_some() { 0.0 } else { first_azimuth };
+    if wall.is_some() {
+        0.0
+    } else {
+        first_azimuth
+    }
+}
 
+/// The light angle, contact and shimmer probes' results, and the camera path's frame count.
+type RendererProbes = (Vec<AngleRow>, Vec<ContactRow>, usize, Vec<ShimmerSeries>);
+
+/// The probes that share one renderer: light angle, contact gaps and shimmer along the camera
+/// path (with the path's frame count), each one's seconds pushed to `seconds`.
+#[allow(clippy::too_many_arguments)]
+fn renderer_probes(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    view: &View,
+    scene_options: &SceneOptions,
+    opts: &StabilityOptions,
+    wall: Option<Vec3>,
+    seconds: &mut Vec<(String, f64)>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<RendererProbes, GpuError> {
+    let (size, quick) = (opts.size, opts.quick);
+    let mut timed = |name: &str, t: std::time::Instant| {
+        seconds.push((name.to_string(), t.elapsed().as_secs_f64()))
+    };
+    let first_azimuth = first_azimuth(scene, view, wall);
     let t = std::time::Instant::now();
     let mut renderer = Renderer::with_options(ctx, scene, scene_options)?;
     let reference = ReferenceScene::new(scene);
@@ -248,45 +329,7 @@ pub fn run(
     drop(renderer);
     drop(reference);
 
-    let t = std::time::Instant::now();
-    let motion = motion(ctx, scene, view, scene_options, opts, &mut || {
-        progress("motion")
-    })?;
-    timed("motion", t);
-
-    let t = std::time::Instant::now();
-    let precision = precision(ctx, scene, view, scene_options, size, quick, &mut || {
-        progress("precision")
-    })?;
-    timed("precision", t);
-
-    let t = std::time::Instant::now();
-    let degenerate = degenerate(ctx, scene, view, scene_options, size, quick, &mut || {
-        progress("degenerate")
-    })?;
-    timed("degenerate", t);
-    seconds.push(("total".into(), t_all.elapsed().as_secs_f64()));
-
-    let mut r = StabilityReport {
-        schema: SCHEMA.into(),
-        scene: scene.name.clone(),
-        size,
-        device: ctx.device_name.clone(),
-        quick,
-        defaults: describe(&view.shadow),
-        seconds,
-        light_angle,
-        contact,
-        path_frames: frames,
-        shimmer,
-        motion_frames: super::motion::frames(quick),
-        motion,
-        precision,
-        degenerate,
-        verdicts: Vec::new(),
-    };
-    r.verdicts = verdicts(&r);
-    Ok(r)
+    Ok((light_angle, contact, frames, shimmer))
 }
 
 fn pct(x: f64) -> String {
