@@ -210,7 +210,18 @@ fn camera_pass_aovs_are_the_aov_pass_and_the_image_is_unchanged() {
                 normal: false,
                 depth: false,
             },
+            // The ids' target unbound (its writes discarded), the normals drawn.
+            AovSet {
+                instance: false,
+                normal: true,
+                depth: true,
+            },
         ] {
+            // The targets first hold another view's ids and normals (turned around), so that
+            // one the pass should draw and does not cannot pass for drawn.
+            let mut away = view.clone();
+            away.camera.world_from_view *= Mat4::from_rotation_y(std::f32::consts::PI);
+            r.render_with_aovs(&away, w, h, AovSet::ALL).unwrap();
             let (frame, aovs) = r.render_with_aovs(&view, w, h, set).unwrap();
             assert!(
                 frame.stats.aovs_in_camera_pass,
@@ -223,7 +234,14 @@ fn camera_pass_aovs_are_the_aov_pass_and_the_image_is_unchanged() {
             assert!(aovs.instance == pass.instance, "{name}: ids differ");
             assert!(aovs.normal == pass.normal, "{name}: normals differ");
             assert!(aovs.depth == pass.depth, "{name}: depths differ");
-            assert!(aovs.instance.iter().any(|&i| i > 0), "{name}: no ids");
+            assert!(
+                !set.instance || aovs.instance.iter().any(|&i| i > 0),
+                "{name}: no ids"
+            );
+            assert!(
+                !set.normal || aovs.normal.iter().any(|n| n.iter().any(|c| c.abs() > 0.5)),
+                "{name}: no normals"
+            );
         }
     }
     assert!(deferred_seen, "no case drew deferred");

@@ -340,9 +340,15 @@ impl FrameCore {
             clear,
         );
         if let Some((ids, normals)) = aovs.filter(|_| camera.aovs) {
-            ids.transition(d, cmd, Access::ColorAttachment);
-            normals.transition(d, cmd, Access::ColorAttachment);
-            targets.aovs = Some([ids.view, normals.view]);
+            // A target not asked for is left unbound (a null view): the draws' writes to it are
+            // discarded, which spares llvmpipe a 16-byte normal per pixel when only ids are read.
+            let view_of = |a: Option<&mut Attachment>| {
+                a.map_or(vk::ImageView::null(), |a| {
+                    a.transition(d, cmd, Access::ColorAttachment);
+                    a.view
+                })
+            };
+            targets.aovs = Some([view_of(ids), view_of(normals)]);
         }
         let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
         if frame.post_aa {
@@ -521,7 +527,8 @@ pub struct Targets<'a> {
     pub resolve_depth: bool,
     /// The instance-id and normal targets (`AOV_FORMATS`, one sample) of a frame prepared with
     /// them (`FrameCore::prepare_with`); left alone by a frame that does not draw them.
-    pub aovs: Option<(&'a mut Attachment, &'a mut Attachment)>,
+    /// Each `None` is an output not asked for: its writes are discarded.
+    pub aovs: Option<(Option<&'a mut Attachment>, Option<&'a mut Attachment>)>,
 }
 
 /// Draws recorded in one frame, after culling.

@@ -81,9 +81,16 @@ impl AovTarget {
         Ok(())
     }
 
-    /// The id and normal targets, for a camera pass that draws them.
-    pub(super) fn color_targets(&mut self) -> (&mut Attachment, &mut Attachment) {
-        (&mut self.ids.1, &mut self.normals.1)
+    /// The id and normal targets of the outputs in `set`, for a camera pass that draws them
+    /// (`None`: not asked for, so not drawn).
+    pub(super) fn color_targets(
+        &mut self,
+        set: AovSet,
+    ) -> (Option<&mut Attachment>, Option<&mut Attachment>) {
+        (
+            Some(&mut self.ids.1).filter(|_| set.instance),
+            Some(&mut self.normals.1).filter(|_| set.normal),
+        )
     }
 
     /// Records the copies of the outputs in `set` into ring slot `slot`'s readbacks (`depth`:

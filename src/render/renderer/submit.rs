@@ -63,7 +63,7 @@ impl Renderer {
             height: dh,
         };
         let t = self.target.as_mut().expect("target");
-        let mut aov_target = self.aov.as_mut().filter(|_| aovs.is_some());
+        let mut aov_target = self.aov.as_mut().zip(aovs);
         ctx.begin_one_time(cmd)?;
         let counts = self.core.record(
             cmd,
@@ -73,10 +73,10 @@ impl Renderer {
                 depth: &mut t.depth_at,
                 msaa: t.msaa.as_mut(),
                 resolve_depth: self.read_depth,
-                aovs: aov_target.as_mut().map(|a| a.color_targets()),
+                aovs: aov_target.as_mut().map(|(a, set)| a.color_targets(*set)),
             },
         );
-        if let (Some(a), Some(set)) = (aov_target, aovs) {
+        if let Some((a, set)) = aov_target {
             // The depth is the frame's own (`read_depth`).
             a.record_copies(d, cmd, set, false, slot);
         }
