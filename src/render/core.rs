@@ -293,12 +293,8 @@ impl FrameCore {
         let timestamps = ctx.timestamp_valid_bits > 0;
         if timestamps {
             Recorder::new(d, cmd).reset_query_pool(self.query_pool, q, 3);
-            Recorder::new(d, cmd).write_timestamp2(
-                vk::PipelineStageFlags2::TOP_OF_PIPE,
-                self.query_pool,
-                q,
-            );
         }
+        self.timestamp(cmd, vk::PipelineStageFlags2::TOP_OF_PIPE, q);
         let views: Vec<_> = plan
             .shadow_views
             .iter()
@@ -313,13 +309,7 @@ impl FrameCore {
         if let (Some(inputs), Some(pass)) = (&plan.exact, self.exact.as_mut()) {
             pass.record(cmd, slot, &self.gpu, inputs);
         }
-        if timestamps {
-            Recorder::new(d, cmd).write_timestamp2(
-                vk::PipelineStageFlags2::ALL_COMMANDS,
-                self.query_pool,
-                q + 1,
-            );
-        }
+        self.timestamp(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, q + 1);
         // With post-process AA the camera pass draws into the pass's source image.
         let color_target: &mut Attachment = if frame.post_aa {
             self.post.source().expect("post AA source made by prepare")
@@ -340,27 +330,13 @@ impl FrameCore {
             clear,
         );
         if let Some((ids, normals)) = aovs.filter(|_| camera.aovs) {
-            // A target not asked for is left unbound (a null view): the draws' writes to it are
-            // discarded, which spares llvmpipe a 16-byte normal per pixel when only ids are read.
-            let view_of = |a: Option<&mut Attachment>| {
-                a.map_or(vk::ImageView::null(), |a| {
-                    a.transition(d, cmd, Access::ColorAttachment);
-                    a.view
-                })
-            };
-            targets.aovs = Some([view_of(ids), view_of(normals)]);
+            targets.aovs = Some([ids, normals].map(|a| aov_view(d, cmd, a)));
         }
         let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
         if frame.post_aa {
             self.post.record(cmd, color);
         }
-        if timestamps {
-            Recorder::new(d, cmd).write_timestamp2(
-                vk::PipelineStageFlags2::ALL_COMMANDS,
-                self.query_pool,
-                q + 2,
-            );
-        }
+        self.timestamp(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, q + 2);
         self.timestamps_written[slot] = timestamps;
         PassCounts {
             casters,
@@ -368,6 +344,13 @@ impl FrameCore {
             deferred_draws: counts.deferred,
             unshadowed_draws: counts.unshadowed,
             flat_draws: counts.flat,
+        }
+    }
+
+    /// Writes timestamp `query` after `stage`, where the device has timestamps.
+    fn timestamp(&self, cmd: vk::CommandBuffer, stage: vk::PipelineStageFlags2, query: u32) {
+        if self.ctx.timestamp_valid_bits > 0 {
+            Recorder::new(&self.ctx.device, cmd).write_timestamp2(stage, self.query_pool, query);
         }
     }
 
@@ -529,6 +512,16 @@ pub struct Targets<'a> {
     /// them (`FrameCore::prepare_with`); left alone by a frame that does not draw them.
     /// Each `None` is an output not asked for: its writes are discarded.
     pub aovs: Option<(Option<&'a mut Attachment>, Option<&'a mut Attachment>)>,
+}
+
+/// An AOV target's view for the camera pass, in attachment layout. A target not asked for is
+/// left unbound (a null view): the draws' writes to it are discarded, which spares llvmpipe a
+/// 16-byte normal per pixel when only ids are read.
+fn aov_view(d: &ash::Device, cmd: vk::CommandBuffer, a: Option<&mut Attachment>) -> vk::ImageView {
+    a.map_or(vk::ImageView::null(), |a| {
+        a.transition(d, cmd, Access::ColorAttachment);
+        a.view
+    })
 }
 
 /// Draws recorded in one frame, after culling.

@@ -112,6 +112,49 @@ pub struct RawVulkan<'a> {
     pub queue_family: u32,
 }
 
+/// The device's memory allocator (gpu-allocator).
+fn new_allocator(
+    instance: &InstanceOwner,
+    device: &DeviceOwner,
+    physical: vk::PhysicalDevice,
+) -> Result<Allocator, GpuError> {
+    Allocator::new(&AllocatorCreateDesc {
+        instance: instance.raw.clone(),
+        device: device.0.clone(),
+        physical_device: physical,
+        debug_settings: Default::default(),
+        buffer_device_address: false,
+        allocation_sizes: Default::default(),
+    })
+    .map_err(|e| GpuError::Alloc {
+        name: "allocator".into(),
+        message: e.to_string(),
+    })
+}
+
+/// The pipeline cache, seeded from `desc.pipeline_cache`'s file where it holds one for this
+/// device (`command_pool` is destroyed on failure).
+fn new_pipeline_cache(
+    device: &DeviceOwner,
+    desc: &ContextDesc,
+    properties: &vk::PhysicalDeviceProperties,
+    command_pool: vk::CommandPool,
+) -> Result<vk::PipelineCache, GpuError> {
+    let initial = desc
+        .pipeline_cache
+        .as_deref()
+        .map(|p| super::pipeline_cache::load(p, properties))
+        .unwrap_or_default();
+    let cache_info = vk::PipelineCacheCreateInfo::default().initial_data(&initial);
+    unsafe { device.create_pipeline_cache(&cache_info, None) }.map_err(|e| {
+        unsafe { device.destroy_command_pool(command_pool, None) };
+        GpuError::Vk {
+            call: "vkCreatePipelineCache",
+            result: e,
+        }
+    })
+}
+
 impl Context {
     /// Whether the device is a CPU implementation (lavapipe: llvmpipe's trade-offs apply).
     pub fn is_cpu(&self) -> bool {
@@ -155,39 +198,13 @@ impl Context {
             desc.swapchain,
         )?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        let allocator = Allocator::new(&AllocatorCreateDesc {
-            instance: instance.raw.clone(),
-            device: device.0.clone(),
-            physical_device: physical,
-            debug_settings: Default::default(),
-            buffer_device_address: false,
-            allocation_sizes: Default::default(),
-        })
-        .map_err(|e| GpuError::Alloc {
-            name: "allocator".into(),
-            message: e.to_string(),
-        })?;
+        let allocator = new_allocator(&instance, &device, physical)?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         let command_pool =
             unsafe { device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
-        let initial = desc
-            .pipeline_cache
-            .as_deref()
-            .map(|p| super::pipeline_cache::load(p, &properties))
-            .unwrap_or_default();
-        let cache_info = vk::PipelineCacheCreateInfo::default().initial_data(&initial);
-        let pipeline_cache = match unsafe { device.create_pipeline_cache(&cache_info, None) } {
-            Ok(c) => c,
-            Err(e) => {
-                unsafe { device.destroy_command_pool(command_pool, None) };
-                return Err(GpuError::Vk {
-                    call: "vkCreatePipelineCache",
-                    result: e,
-                });
-            }
-        };
+        let pipeline_cache = new_pipeline_cache(&device, desc, &properties, command_pool)?;
         let debug_device = instance
             .debug_utils
             .as_ref()

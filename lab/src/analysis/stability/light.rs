@@ -3,7 +3,7 @@
 
 use super::{classify_view, finest_texel, shadow_frame, Counts};
 use crate::reference::ReferenceScene;
-use glam::{Vec3, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
 use umbra::gpu::GpuError;
 use umbra::math::projection::pixel_to_ndc;
@@ -201,7 +201,7 @@ pub fn contact_gaps(
         let clip = f.plan.clip_from_scene();
         let inv = clip.inverse();
         let depth_buf = f.depth.as_deref().unwrap_or(&[]);
-        let (w, h) = size;
+        let w = size.0;
         let mut points = 0;
         let mut gap: Option<f64> = None;
         // Lines across the wall, within the observer's view.
@@ -216,26 +216,10 @@ pub fn contact_gaps(
                 if ray_aabb(&Ray::new(p, light), &wall, 1e-6, f32::INFINITY).is_none() {
                     continue;
                 }
-                let c = clip * p.extend(1.0);
-                if c.w <= 0.0 {
+                let Some((ix, iy)) = pixel_seeing(p, (clip, inv), depth_buf, size, 0.5 * texel)
+                else {
                     continue;
-                }
-                let (px, py) = (
-                    ((c.x / c.w) * 0.5 + 0.5) * w as f32,
-                    (0.5 - (c.y / c.w) * 0.5) * h as f32,
-                );
-                if px < 0.0 || py < 0.0 || px >= w as f32 || py >= h as f32 {
-                    continue;
-                }
-                let (ix, iy) = (px as u32, py as u32);
-                let i = (iy * w + ix) as usize;
-                // The pixel must see the ground at this point.
-                let dz = depth_buf.get(i).copied().unwrap_or(0.0);
-                let n = pixel_to_ndc(ix as f32 + 0.5, iy as f32 + 0.5, w, h);
-                let q = inv * Vec4::new(n.x, n.y, dz, 1.0);
-                if dz <= 0.0 || (q.truncate() / q.w).distance(p) as f64 > 0.5 * texel {
-                    continue;
-                }
+                };
                 points += 1;
                 if f.image.get_pixel(ix, iy)[0] >= 128 {
                     first_lit_after = Some(k);
@@ -256,6 +240,34 @@ pub fn contact_gaps(
         });
     }
     Ok(rows)
+}
+
+/// The pixel of a `w`×`h` frame (`clip`, its inverse, its reversed-z depths) whose centre sees
+/// the ground within `tolerance` of `p`, if one does.
+fn pixel_seeing(
+    p: Vec3,
+    (clip, inv): (Mat4, Mat4),
+    depth: &[f32],
+    (w, h): (u32, u32),
+    tolerance: f64,
+) -> Option<(u32, u32)> {
+    let c = clip * p.extend(1.0);
+    if c.w <= 0.0 {
+        return None;
+    }
+    let (px, py) = (
+        ((c.x / c.w) * 0.5 + 0.5) * w as f32,
+        (0.5 - (c.y / c.w) * 0.5) * h as f32,
+    );
+    if px < 0.0 || py < 0.0 || px >= w as f32 || py >= h as f32 {
+        return None;
+    }
+    let (ix, iy) = (px as u32, py as u32);
+    let dz = depth.get((iy * w + ix) as usize).copied().unwrap_or(0.0);
+    let n = pixel_to_ndc(ix as f32 + 0.5, iy as f32 + 0.5, w, h);
+    let q = inv * Vec4::new(n.x, n.y, dz, 1.0);
+    let far = dz <= 0.0 || (q.truncate() / q.w).distance(p) as f64 > tolerance;
+    (!far).then_some((ix, iy))
 }
 
 /// One sun direction (degrees) and bias factor classified (for tests and single checks).
