@@ -323,7 +323,6 @@ impl WindowRenderer {
         let view = &v;
         let prepared = self.core.prepare(f, view, extent.width, extent.height)?;
         self.held = Some(ShadowHold::from_plan(&prepared.plan));
-        let pixels = extent.width as usize * extent.height as usize;
         let want_copy = screenshot && self.swapchain.can_copy;
         self.ensure_readbacks(f, fit, want_copy)?;
         let (_, depth) = self.depth.as_mut().expect("depth exists with a swapchain");
@@ -352,18 +351,14 @@ impl WindowRenderer {
             shadow_views: shadow_view_summary(&prepared.plan),
         };
         if fit {
-            depth.transition(d, cmd, Access::TransferSrc);
-            copy_to_buffer(
+            record_depth_read(
                 d,
                 cmd,
-                depth.image,
-                vk::ImageAspectFlags::DEPTH,
+                depth,
+                &mut self.depth_reads[f],
+                &view.camera,
                 extent,
-                self.depth_reads[f].0.as_ref().expect("buffer").raw,
             );
-            let aspect = extent.width as f32 / extent.height.max(1) as f32;
-            self.depth_reads[f].1 =
-                Some((crate::plan::camera_projection(&view.camera, aspect), pixels));
         }
         let shot_buffer = want_copy
             .then(|| self.screenshot.as_ref().map(|b| b.raw))
@@ -545,6 +540,30 @@ impl WindowRenderer {
             .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
         Ok(rgba_from_readback(bytes, extent.width, extent.height, bgra))
     }
+}
+
+/// Records the copy of a frame's depth into its slot's readback buffer, and keeps the camera
+/// projection and pixel count to read it with.
+fn record_depth_read(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    depth: &mut Attachment,
+    read: &mut DepthRead,
+    camera: &crate::scene::Camera,
+    extent: vk::Extent2D,
+) {
+    depth.transition(d, cmd, Access::TransferSrc);
+    copy_to_buffer(
+        d,
+        cmd,
+        depth.image,
+        vk::ImageAspectFlags::DEPTH,
+        extent,
+        read.0.as_ref().expect("buffer").raw,
+    );
+    let aspect = extent.width as f32 / extent.height.max(1) as f32;
+    let pixels = extent.width as usize * extent.height as usize;
+    read.1 = Some((crate::plan::camera_projection(camera, aspect), pixels));
 }
 
 /// Each shadow view's (light, resolution, texel size in world units).

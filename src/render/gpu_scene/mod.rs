@@ -276,27 +276,13 @@ impl GpuScene {
             allocate_sets(ctx, sh::BINDINGS, 1, material_layout, scene.materials.len())?;
         let mut samplers = SamplerCache::new(ctx, anisotropy);
 
-        let mut material_buffers = Vec::new();
-        for (i, m) in scene.materials.iter().enumerate() {
-            let (orm_ref, _) = orm_slot(m, scene.textures.len());
-            let u = material_uniform(m, orm_ref);
-            let mut buf = Buffer::new(
-                ctx,
-                &format!("material {i} '{}'", m.name),
-                std::mem::size_of::<MaterialUniform>() as u64,
-                vk::BufferUsageFlags::UNIFORM_BUFFER,
-                MemoryLocation::CpuToGpu,
-            )?;
-            buf.write(0, bytemuck::bytes_of(&u))?;
-            let views = TextureViews {
-                scene_textures: scene.textures.len(),
-                textures: &textures,
-                index: &tex_index,
-                defaults,
-            };
-            write_material_set(ctx, sets[i], &buf, m, &views, &mut samplers)?;
-            material_buffers.push(buf);
-        }
+        let views = TextureViews {
+            scene_textures: scene.textures.len(),
+            textures: &textures,
+            index: &tex_index,
+            defaults,
+        };
+        let material_buffers = write_materials(ctx, scene, &sets, &views, &mut samplers)?;
         Ok(Self {
             ctx: ctx.clone(),
             positions: pos_buf,
@@ -320,6 +306,32 @@ impl GpuScene {
             _textures: textures,
         })
     }
+}
+
+/// Each material's uniform buffer, written with its descriptor set (`sets[i]` for material i).
+fn write_materials(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    sets: &[vk::DescriptorSet],
+    views: &TextureViews,
+    samplers: &mut SamplerCache,
+) -> Result<Vec<Buffer>, GpuError> {
+    let mut material_buffers = Vec::new();
+    for (i, m) in scene.materials.iter().enumerate() {
+        let (orm_ref, _) = orm_slot(m, scene.textures.len());
+        let u = material_uniform(m, orm_ref);
+        let mut buf = Buffer::new(
+            ctx,
+            &format!("material {i} '{}'", m.name),
+            std::mem::size_of::<MaterialUniform>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        buf.write(0, bytemuck::bytes_of(&u))?;
+        write_material_set(ctx, sets[i], &buf, m, views, samplers)?;
+        material_buffers.push(buf);
+    }
+    Ok(material_buffers)
 }
 
 impl Drop for GpuScene {

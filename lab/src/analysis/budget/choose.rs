@@ -176,6 +176,58 @@ pub fn next_candidate(
         })
 }
 
+/// This view's GPU (camera, shadow) milliseconds under the default configuration (the second
+/// of two frames: the first may compile pipelines or allocate the map).
+fn base_split(
+    renderer: &mut umbra::render::Renderer,
+    view: &View,
+    (w, h): (u32, u32),
+) -> Result<Option<(f64, f64)>, umbra::gpu::GpuError> {
+    let base = crate::analysis::grid::Grid::full()
+        .configs()
+        .into_iter()
+        .find(|c| c.name() == COST_BASE);
+    let mut base_ms = None;
+    if let Some(b) = base {
+        let mut v = view.clone();
+        v.shadow = b.shadow;
+        renderer.render(&v, w, h)?;
+        let st = renderer.render(&v, w, h)?.stats;
+        base_ms = st.gpu_camera_ms.zip(st.gpu_shadow_ms);
+    }
+    Ok(base_ms)
+}
+
+/// The choice among the verified candidates: the cheapest within `budget` (`ok`); failing that,
+/// the most accurate measured, or without measurements the cheapest predicted within it. With
+/// the measured error, if any, and whether the budget is met.
+fn pick(
+    ok: Option<&Verified>,
+    verified: &[Verified],
+    preds: &[Prediction],
+    budget: f64,
+) -> (Prediction, Option<f64>, bool) {
+    match ok {
+        Some(v) => (v.prediction.clone(), Some(v.measured), true),
+        None => {
+            // Not reachable within the renders: the most accurate measured (or predicted).
+            match verified
+                .iter()
+                .min_by(|a, b| a.measured.total_cmp(&b.measured))
+            {
+                Some(v) => (v.prediction.clone(), Some(v.measured), false),
+                None => {
+                    let p = cheapest_within(preds, budget)
+                        .cloned()
+                        .unwrap_or_else(|| preds[0].clone());
+                    let met = p.predicted <= budget;
+                    (p, None, met)
+                }
+            }
+        }
+    }
+}
+
 /// Chooses the cheapest configuration for `view` whose misclassification is within `budget`
 /// (module documentation: probe, predict, verify); with `current`, the running configuration is
 /// measured too (`BudgetChoice::current_measured`, for `keep_current`). `None` when no candidate
@@ -192,20 +244,7 @@ pub fn choose(
     let t0 = std::time::Instant::now();
     let planner = ScenePlanner::new(scene);
     let probe = probe_view(reference, &planner, view, w, h, PROBE_STRIDE);
-    // This view's split between the passes, from the default configuration (second of two
-    // frames: the first may compile pipelines or allocate the map).
-    let base = crate::analysis::grid::Grid::full()
-        .configs()
-        .into_iter()
-        .find(|c| c.name() == COST_BASE);
-    let mut base_ms = None;
-    if let Some(b) = base {
-        let mut v = view.clone();
-        v.shadow = b.shadow;
-        renderer.render(&v, w, h)?;
-        let st = renderer.render(&v, w, h)?.stats;
-        base_ms = st.gpu_camera_ms.zip(st.gpu_shadow_ms);
-    }
+    let base_ms = base_split(renderer, view, (w, h))?;
     let preds = predict_all(&probe, &planner, view, base_ms);
     if preds.is_empty() {
         return Ok(None);
@@ -238,25 +277,7 @@ pub fn choose(
                 .relative_cost
                 .total_cmp(&b.prediction.relative_cost)
         });
-    let (chosen, measured, met) = match ok {
-        Some(v) => (v.prediction.clone(), Some(v.measured), true),
-        None => {
-            // Not reachable within the renders: the most accurate measured (or predicted).
-            match verified
-                .iter()
-                .min_by(|a, b| a.measured.total_cmp(&b.measured))
-            {
-                Some(v) => (v.prediction.clone(), Some(v.measured), false),
-                None => {
-                    let p = cheapest_within(&preds, budget)
-                        .cloned()
-                        .unwrap_or_else(|| preds[0].clone());
-                    let met = p.predicted <= budget;
-                    (p, None, met)
-                }
-            }
-        }
-    };
+    let (chosen, measured, met) = pick(ok, &verified, &preds, budget);
     // The running configuration (the viewer's), measured with the same probe.
     let current_measured = match current {
         None => None,
