@@ -219,32 +219,7 @@ pub fn warn_msaa(a: &ViewArgs, samples: u32) {
 /// Builds the view from arguments.
 pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
     let aspect = a.size.0 as f32 / a.size.1 as f32;
-    let camera: Camera = match (a.eye, a.target, a.camera) {
-        (Some(eye), Some(target), _) => {
-            if (target - eye).length_squared() == 0.0 {
-                bail!("--eye and --target must differ");
-            }
-            let b = scene.bounds();
-            let near = if b.is_empty() {
-                0.01
-            } else {
-                (b.diagonal() * 1e-4).max(1e-4)
-            };
-            Camera::look_at(eye, target, 45f32.to_radians(), near)
-        }
-        (Some(_), None, _) | (None, Some(_), _) => bail!("--eye and --target go together"),
-        (None, None, Some(i)) => *scene.cameras.get(i).ok_or_else(|| {
-            anyhow!(
-                "--camera {i}: the scene has {} camera(s)",
-                scene.cameras.len()
-            )
-        })?,
-        (None, None, None) => scene
-            .cameras
-            .first()
-            .copied()
-            .unwrap_or_else(|| scene.default_camera(aspect)),
-    };
+    let camera = camera_of(scene, a, aspect)?;
     let mut v = View::new(camera);
     v.sun_direction = match a.sun_dir {
         Some(d) if d.length_squared() == 0.0 => bail!("--sun-dir must not be zero"),
@@ -276,6 +251,43 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         }
     }
     v.shown_light = a.shadow_light;
+    v.shadow = shadow_settings(a)?;
+    Ok(v)
+}
+
+/// The camera the arguments ask for: `--eye`/`--target`, a glTF camera, or the scene's first
+/// (its default framing without one).
+fn camera_of(scene: &Scene, a: &ViewArgs, aspect: f32) -> anyhow::Result<Camera> {
+    Ok(match (a.eye, a.target, a.camera) {
+        (Some(eye), Some(target), _) => {
+            if (target - eye).length_squared() == 0.0 {
+                bail!("--eye and --target must differ");
+            }
+            let b = scene.bounds();
+            let near = if b.is_empty() {
+                0.01
+            } else {
+                (b.diagonal() * 1e-4).max(1e-4)
+            };
+            Camera::look_at(eye, target, 45f32.to_radians(), near)
+        }
+        (Some(_), None, _) | (None, Some(_), _) => bail!("--eye and --target go together"),
+        (None, None, Some(i)) => *scene.cameras.get(i).ok_or_else(|| {
+            anyhow!(
+                "--camera {i}: the scene has {} camera(s)",
+                scene.cameras.len()
+            )
+        })?,
+        (None, None, None) => scene
+            .cameras
+            .first()
+            .copied()
+            .unwrap_or_else(|| scene.default_camera(aspect)),
+    })
+}
+
+/// The shadow settings of the arguments (`--shadow-map` checked).
+fn shadow_settings(a: &ViewArgs) -> anyhow::Result<ShadowSettings> {
     let sizes = ShadowSettings::MAP_SIZES;
     if !sizes.contains(&a.shadow_map) {
         bail!(
@@ -285,7 +297,7 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
             sizes.end()
         );
     }
-    v.shadow = ShadowSettings {
+    Ok(ShadowSettings {
         enabled: !a.no_shadows,
         method: a.shadow_method.parse().unwrap_or_default(),
         contact: a.contact_shadows,
@@ -306,6 +318,5 @@ pub fn make_view(scene: &Scene, a: &ViewArgs) -> anyhow::Result<View> {
         cube_face: a.cube_face,
         depth_fit: a.depth_fit,
         soft: true,
-    };
-    Ok(v)
+    })
 }
