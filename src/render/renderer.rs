@@ -1,6 +1,7 @@
 //! The offscreen renderer: the shared frame core into an image, read back to RGBA8.
 
 use super::core::FrameCore;
+use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::Recorder;
 use crate::gpu::{Buffer, Image};
@@ -109,6 +110,19 @@ type SeenDepths = (
     (u32, u32),
     Option<(f32, f32)>,
 );
+
+/// [`copy_to_buffer`] of an attachment's image, moved to a transfer source first.
+pub fn copy_attachment_to_buffer(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    at: &mut Attachment,
+    aspect: vk::ImageAspectFlags,
+    extent: vk::Extent2D,
+    buffer: vk::Buffer,
+) {
+    at.transition(d, cmd, Access::TransferSrc);
+    copy_to_buffer(d, cmd, at.image, aspect, extent, buffer);
+}
 
 /// Copies a whole single-level image aspect into a tightly packed buffer.
 pub fn copy_to_buffer(

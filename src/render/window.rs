@@ -4,7 +4,7 @@
 
 use super::core::{FrameCore, Targets};
 use super::renderer::{
-    copy_to_buffer, rgba_from_readback, transfer_to_host_barrier, visible_depths,
+    copy_attachment_to_buffer, rgba_from_readback, transfer_to_host_barrier, visible_depths,
 };
 use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
@@ -552,15 +552,8 @@ fn record_depth_read(
     camera: &crate::scene::Camera,
     extent: vk::Extent2D,
 ) {
-    depth.transition(d, cmd, Access::TransferSrc);
-    copy_to_buffer(
-        d,
-        cmd,
-        depth.image,
-        vk::ImageAspectFlags::DEPTH,
-        extent,
-        read.0.as_ref().expect("buffer").raw,
-    );
+    let buffer = read.0.as_ref().expect("buffer").raw;
+    copy_attachment_to_buffer(d, cmd, depth, vk::ImageAspectFlags::DEPTH, extent, buffer);
     let aspect = extent.width as f32 / extent.height.max(1) as f32;
     let pixels = extent.width as usize * extent.height as usize;
     read.1 = Some((crate::plan::camera_projection(camera, aspect), pixels));
@@ -586,15 +579,7 @@ fn record_screenshot_and_overlay(
     (capture, shot): (Capture, Option<vk::Buffer>),
 ) {
     let copy = |color: &mut Attachment, buffer| {
-        color.transition(d, cmd, Access::TransferSrc);
-        copy_to_buffer(
-            d,
-            cmd,
-            color.image,
-            vk::ImageAspectFlags::COLOR,
-            extent,
-            buffer,
-        );
+        copy_attachment_to_buffer(d, cmd, color, vk::ImageAspectFlags::COLOR, extent, buffer);
     };
     if let Some(b) = shot {
         if capture == Capture::Scene || overlay.is_none() {

@@ -4,8 +4,7 @@
 //! and alone, they come from one extra depth-tested pass (`CameraPass::record_aov`) at one
 //! sample per pixel.
 
-use super::{copy_to_buffer, transfer_to_host_barrier, RenderedFrame, Renderer};
-use crate::gpu::barrier::Access;
+use super::{copy_attachment_to_buffer, transfer_to_host_barrier, RenderedFrame, Renderer};
 use crate::gpu::context::{GpuError, VkCheck};
 use crate::gpu::{Buffer, Image};
 use crate::plan::settings::ViewMode;
@@ -106,7 +105,7 @@ impl AovTarget {
     ) {
         let extent = self.ids.0.extent;
         let color = vk::ImageAspectFlags::COLOR;
-        for (wanted, (image, at, buffers), aspect) in [
+        for (wanted, (_, at, buffers), aspect) in [
             (set.instance, &mut self.ids, color),
             (set.normal, &mut self.normals, color),
             (
@@ -116,8 +115,7 @@ impl AovTarget {
             ),
         ] {
             if wanted {
-                at.transition(d, cmd, Access::TransferSrc);
-                copy_to_buffer(d, cmd, image.raw, aspect, extent, buffers[slot].raw);
+                copy_attachment_to_buffer(d, cmd, at, aspect, extent, buffers[slot].raw);
             }
         }
     }

@@ -189,16 +189,15 @@ pub fn run(
     let quick = opts.quick;
     let t_all = std::time::Instant::now();
     let mut seconds = Vec::new();
-    let (light_angle, contact, frames, shimmer) = renderer_probes(
+    let probes = Probes {
         ctx,
         scene,
         view,
         scene_options,
         opts,
         wall,
-        &mut seconds,
-        progress,
-    )?;
+    };
+    let (light_angle, contact, frames, shimmer) = renderer_probes(&probes, &mut seconds, progress)?;
     let mut timed = |name: &str, t: std::time::Instant| {
         seconds.push((name.to_string(), t.elapsed().as_secs_f64()))
     };
@@ -262,22 +261,28 @@ fn first_azimuth(scene: &Scene, view: &View, wall: Option<Vec3>) -> f32 {
     }
 }
 
+/// What every probe of [`run`] is given.
+struct Probes<'a> {
+    ctx: &'a Arc<Context>,
+    scene: &'a Scene,
+    view: &'a View,
+    scene_options: &'a SceneOptions,
+    opts: &'a StabilityOptions,
+    wall: Option<Vec3>,
+}
+
 /// The light angle, contact and shimmer probes' results, and the camera path's frame count.
 type RendererProbes = (Vec<AngleRow>, Vec<ContactRow>, usize, Vec<ShimmerSeries>);
 
 /// The probes that share one renderer: light angle, contact gaps and shimmer along the camera
 /// path (with the path's frame count), each one's seconds pushed to `seconds`.
-#[allow(clippy::too_many_arguments)]
 fn renderer_probes(
-    ctx: &Arc<Context>,
-    scene: &Scene,
-    view: &View,
-    scene_options: &SceneOptions,
-    opts: &StabilityOptions,
-    wall: Option<Vec3>,
+    p: &Probes,
     seconds: &mut Vec<(String, f64)>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<RendererProbes, GpuError> {
+    let (ctx, scene, view, scene_options, opts, wall) =
+        (p.ctx, p.scene, p.view, p.scene_options, p.opts, p.wall);
     let (size, quick) = (opts.size, opts.quick);
     let mut timed = |name: &str, t: std::time::Instant| {
         seconds.push((name.to_string(), t.elapsed().as_secs_f64()))
