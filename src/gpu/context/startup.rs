@@ -224,6 +224,62 @@ pub(super) fn create_device(
     Ok(DeviceOwner(raw))
 }
 
+/// What device `pd` lacks of what umbra needs (Vulkan 1.3, dynamic rendering, synchronization2,
+/// depth clamp, a graphics queue, sampled D32 depth, and the swapchain extension when asked for);
+/// its graphics queue family; whether it has sampler anisotropy.
+fn requirements(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    props: &vk::PhysicalDeviceProperties,
+    swapchain: bool,
+) -> (Vec<String>, Option<usize>, bool) {
+    let mut missing = Vec::new();
+    if props.api_version < vk::API_VERSION_1_3 {
+        missing.push("Vulkan 1.3".to_string());
+    }
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    let core = f2.features;
+    if f13.dynamic_rendering == vk::FALSE {
+        missing.push("dynamicRendering".into());
+    }
+    if f13.synchronization2 == vk::FALSE {
+        missing.push("synchronization2".into());
+    }
+    if core.depth_clamp == vk::FALSE {
+        missing.push("depthClamp".into());
+    }
+    let qf = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+    let family = qf
+        .iter()
+        .position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS));
+    if family.is_none() {
+        missing.push("a graphics queue".into());
+    }
+    let d32 = unsafe { instance.get_physical_device_format_properties(pd, vk::Format::D32_SFLOAT) }
+        .optimal_tiling_features;
+    if !d32.contains(
+        vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE,
+    ) {
+        missing.push("D32_SFLOAT depth attachment + sampling".into());
+    }
+    if swapchain {
+        let exts =
+            unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+        if !exts.iter().any(|e| {
+            e.extension_name_as_c_str()
+                .is_ok_and(|n| n == ash::khr::swapchain::NAME)
+        }) {
+            missing.push("VK_KHR_swapchain".into());
+        }
+    }
+    (missing, family, core.sampler_anisotropy == vk::TRUE)
+}
+
+/// The device to use: the one `desc.device` (or `UMBRA_DEVICE`) names, else the best scored (a
+/// discrete GPU first) of those with what umbra needs; with its graphics queue family and whether
+/// it has anisotropy. The error says why each device was passed over.
 pub(super) fn pick_device(
     instance: &ash::Instance,
     desc: &ContextDesc,
@@ -253,61 +309,14 @@ pub(super) fn pick_device(
                 continue;
             }
         }
-        let mut missing = Vec::new();
-        if props.api_version < vk::API_VERSION_1_3 {
-            missing.push("Vulkan 1.3".to_string());
-        }
-        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
-        unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-        let core = f2.features;
-        if f13.dynamic_rendering == vk::FALSE {
-            missing.push("dynamicRendering".into());
-        }
-        if f13.synchronization2 == vk::FALSE {
-            missing.push("synchronization2".into());
-        }
-        if core.depth_clamp == vk::FALSE {
-            missing.push("depthClamp".into());
-        }
-        let qf = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-        let family = qf
-            .iter()
-            .position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS));
-        if family.is_none() {
-            missing.push("a graphics queue".into());
-        }
-        let d32 =
-            unsafe { instance.get_physical_device_format_properties(pd, vk::Format::D32_SFLOAT) }
-                .optimal_tiling_features;
-        if !d32.contains(
-            vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT
-                | vk::FormatFeatureFlags::SAMPLED_IMAGE,
-        ) {
-            missing.push("D32_SFLOAT depth attachment + sampling".into());
-        }
-        if desc.swapchain {
-            let exts =
-                unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
-            if !exts.iter().any(|e| {
-                e.extension_name_as_c_str()
-                    .is_ok_and(|n| n == ash::khr::swapchain::NAME)
-            }) {
-                missing.push("VK_KHR_swapchain".into());
-            }
-        }
+        let (missing, family, anisotropy) = requirements(instance, pd, &props, desc.swapchain);
         if !missing.is_empty() {
             reasons.push(format!("{name}: missing {}", missing.join(", ")));
             continue;
         }
         let s = score(props.device_type);
         if best.as_ref().is_none_or(|b| s > b.0) {
-            best = Some((
-                s,
-                pd,
-                family.unwrap_or(0) as u32,
-                core.sampler_anisotropy == vk::TRUE,
-            ));
+            best = Some((s, pd, family.unwrap_or(0) as u32, anisotropy));
         }
     }
     best.map(|(_, pd, f, a)| (pd, f, a))

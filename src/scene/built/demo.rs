@@ -83,27 +83,7 @@ pub fn demo_scene() -> Scene {
         ..Default::default()
     };
     add_object(&mut s, "ground", plane(24.0, 6.0), ground, Mat4::IDENTITY);
-    add_object(
-        &mut s,
-        "red box",
-        cuboid(Vec3::new(1.0, 1.0, 1.0)),
-        colored(Vec3::new(0.7, 0.08, 0.05), 0.4),
-        Mat4::from_rotation_translation(Quat::from_rotation_y(0.4), Vec3::new(-3.0, 1.0, 1.0)),
-    );
-    add_object(
-        &mut s,
-        "blue box",
-        cuboid(Vec3::new(0.6, 0.6, 0.6)),
-        colored(Vec3::new(0.08, 0.2, 0.7), 0.3),
-        Mat4::from_rotation_translation(Quat::from_rotation_y(-0.3), Vec3::new(2.5, 0.6, 2.5)),
-    );
-    add_object(
-        &mut s,
-        "long box",
-        cuboid(Vec3::new(1.5, 0.4, 0.5)),
-        colored(Vec3::new(0.6, 0.55, 0.3), 0.6),
-        Mat4::from_translation(Vec3::new(0.5, 0.4, 4.0)),
-    );
+    add_boxes(&mut s);
     let gold = Material {
         name: "gold".into(),
         base_color: Vec3::new(0.9, 0.65, 0.2).extend(1.0),
@@ -125,26 +105,7 @@ pub fn demo_scene() -> Scene {
         colored(Vec3::new(0.75, 0.75, 0.72), 0.5),
         Mat4::from_translation(Vec3::new(3.5, 2.5, -2.0)),
     );
-    let panel_base = add_texture(
-        &mut s,
-        checker_texture(256, 4, [230, 180, 90], [90, 140, 200]),
-    );
-    let panel_normal = add_texture(&mut s, bump_normal_map(256, 6, 1.2));
-    let panel = Material {
-        name: "panel".into(),
-        base_color_texture: Some(TextureRef::new(panel_base)),
-        normal_texture: Some(TextureRef::new(panel_normal)),
-        roughness: 0.45,
-        double_sided: true,
-        ..Default::default()
-    };
-    add_object(
-        &mut s,
-        "panel",
-        quad(3.0, 2.0),
-        panel,
-        Mat4::from_rotation_translation(Quat::from_rotation_y(0.5), Vec3::new(-2.5, 1.6, -3.0)),
-    );
+    add_panel(&mut s);
     s.lights.push(Light::sun(
         Light::sun_direction(
             DEMO_SUN_ELEVATION_DEG.to_radians(),
@@ -159,4 +120,50 @@ pub fn demo_scene() -> Scene {
         0.1,
     ));
     s
+}
+
+/// The demo's three coloured boxes (red, blue, long).
+fn add_boxes(s: &mut Scene) {
+    add_object(
+        s,
+        "red box",
+        cuboid(Vec3::new(1.0, 1.0, 1.0)),
+        colored(Vec3::new(0.7, 0.08, 0.05), 0.4),
+        Mat4::from_rotation_translation(Quat::from_rotation_y(0.4), Vec3::new(-3.0, 1.0, 1.0)),
+    );
+    add_object(
+        s,
+        "blue box",
+        cuboid(Vec3::new(0.6, 0.6, 0.6)),
+        colored(Vec3::new(0.08, 0.2, 0.7), 0.3),
+        Mat4::from_rotation_translation(Quat::from_rotation_y(-0.3), Vec3::new(2.5, 0.6, 2.5)),
+    );
+    add_object(
+        s,
+        "long box",
+        cuboid(Vec3::new(1.5, 0.4, 0.5)),
+        colored(Vec3::new(0.6, 0.55, 0.3), 0.6),
+        Mat4::from_translation(Vec3::new(0.5, 0.4, 4.0)),
+    );
+}
+
+/// The demo's double-sided, normal-mapped panel.
+fn add_panel(s: &mut Scene) {
+    let panel_base = add_texture(s, checker_texture(256, 4, [230, 180, 90], [90, 140, 200]));
+    let panel_normal = add_texture(s, bump_normal_map(256, 6, 1.2));
+    let panel = Material {
+        name: "panel".into(),
+        base_color_texture: Some(TextureRef::new(panel_base)),
+        normal_texture: Some(TextureRef::new(panel_normal)),
+        roughness: 0.45,
+        double_sided: true,
+        ..Default::default()
+    };
+    add_object(
+        s,
+        "panel",
+        quad(3.0, 2.0),
+        panel,
+        Mat4::from_rotation_translation(Quat::from_rotation_y(0.5), Vec3::new(-2.5, 1.6, -3.0)),
+    );
 }
