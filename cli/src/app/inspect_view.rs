@@ -477,11 +477,9 @@ fn findings(r: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
     out
 }
 
-/// The motion tables: animations (one row per channel), skins and morph targets; nothing for
-/// a file that does not move.
-fn motion(m: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+/// The animations table (one row per animation, its channels tallied); nothing without one.
+fn animations(anims: &[Value], md: bool, h: &dyn Fn(&str) -> String) -> String {
     let mut out = String::new();
-    let anims = arr(&m["animations"]);
     if !anims.is_empty() {
         let mut t = Table::new(&[
             "animation",
@@ -525,6 +523,14 @@ fn motion(m: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
         out += &h(&format!("Animations ({})", anims.len()));
         out += &t.render(md);
     }
+    out
+}
+
+/// The motion tables: animations (one row per channel), skins and morph targets; nothing for
+/// a file that does not move.
+fn motion(m: &Value, md: bool, h: &dyn Fn(&str) -> String) -> String {
+    let mut out = String::new();
+    out += &animations(arr(&m["animations"]), md, h);
     let skins = arr(&m["skins"]);
     if !skins.is_empty() {
         let mut t = Table::new(&[
