@@ -82,31 +82,7 @@ impl PostAaPass {
     /// Makes the pipeline and a scratch image of `extent` (every binding of its set written).
     pub fn ensure(&mut self, extent: vk::Extent2D) -> Result<(), GpuError> {
         if self.pipelines.is_none() {
-            let pipeline = |name, vertex, fragment| {
-                create_pipeline(
-                    &self.ctx,
-                    &PipelineDesc {
-                        name,
-                        layout: self.layout,
-                        vertex: (self.module, vertex),
-                        fragment: Some((self.module, fragment)),
-                        bindings: &[],
-                        attributes: &[],
-                        color_formats: &[self.format],
-                        masked_targets: 0,
-                        depth_format: MARK_FORMAT,
-                        stencil: Stencil::Off,
-                        depth_clamp: false,
-                        depth_bias: false,
-                        depth: Depth::Test,
-                        blend: ColorBlend::Off,
-                        samples: 1,
-                    },
-                )
-            };
-            let mark = pipeline("FXAA marks", sh::ENTRY_VS_MARK, sh::ENTRY_FS_MARK)?;
-            let edges = pipeline("FXAA edges", sh::ENTRY_VS_EDGES, sh::ENTRY_FS_FXAA)?;
-            self.pipelines = Some([mark, edges]);
+            self.pipelines = Some(self.make_pipelines()?);
         }
         if self
             .scratch
@@ -166,6 +142,35 @@ impl PostAaPass {
             set,
         });
         Ok(())
+    }
+
+    /// The two FXAA pipelines: the edge marks, then the filter on the marked pixels.
+    fn make_pipelines(&self) -> Result<[vk::Pipeline; 2], GpuError> {
+        let pipeline = |name, vertex, fragment| {
+            create_pipeline(
+                &self.ctx,
+                &PipelineDesc {
+                    name,
+                    layout: self.layout,
+                    vertex: (self.module, vertex),
+                    fragment: Some((self.module, fragment)),
+                    bindings: &[],
+                    attributes: &[],
+                    color_formats: &[self.format],
+                    masked_targets: 0,
+                    depth_format: MARK_FORMAT,
+                    stencil: Stencil::Off,
+                    depth_clamp: false,
+                    depth_bias: false,
+                    depth: Depth::Test,
+                    blend: ColorBlend::Off,
+                    samples: 1,
+                },
+            )
+        };
+        let mark = pipeline("FXAA marks", sh::ENTRY_VS_MARK, sh::ENTRY_FS_MARK)?;
+        let edges = pipeline("FXAA edges", sh::ENTRY_VS_EDGES, sh::ENTRY_FS_FXAA)?;
+        Ok([mark, edges])
     }
 
     /// The scratch image the camera pass draws into ([`PostAaPass::ensure`] first).

@@ -56,49 +56,56 @@ impl ExactPass {
             tiles: storage("hybrid traced tiles", TILE_WORDS * 4)?,
         };
         for (slot, &set) in self.sets.iter().enumerate() {
-            write_buffers(
-                ctx,
-                set,
-                &[
-                    (&sh::XF, &self.uniforms[slot]),
-                    (&sh::HEADS, &t.heads),
-                    (&sh::NEXT, &t.next),
-                    (&sh::SAMPLES, &t.samples),
-                    (&sh::RAYS, &t.rays),
-                    (&sh::TILES, &t.tiles),
-                    (&sh::TILES_READ, &t.tiles),
-                    (&sh::POSITIONS, &scene.positions),
-                    (&sh::INDICES, &scene.indices),
-                    (&sh::ATTRIBUTES, &scene.attributes),
-                ],
-            );
-            write_buffers(ctx, set, &self.culling.bindings());
-            let image = |view| {
-                [vk::DescriptorImageInfo {
-                    sampler: vk::Sampler::null(),
-                    image_view: view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }]
-            };
-            let images = [
-                (sh::RECEIVER_POSITION, image(t.position.view)),
-                (sh::RECEIVER_NORMAL, image(t.normal.view)),
-            ];
-            let writes: Vec<vk::WriteDescriptorSet> = images
-                .iter()
-                .map(|(b, info)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(set)
-                        .dst_binding(b.binding)
-                        .descriptor_type(b.descriptor_type())
-                        .image_info(info)
-                })
-                .collect();
-            unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+            self.write_set(scene, &t, slot, set);
         }
         // A new set of targets: every slot's map binding is written again (`bind_map`).
         self.bound_map.fill(vk::ImageView::null());
         self.targets = Some(t);
         Ok(())
+    }
+
+    /// Writes slot `slot`'s descriptor set: its uniforms, `t`'s buffers and images, the scene's
+    /// geometry and the culling's bindings.
+    fn write_set(&self, scene: &GpuScene, t: &Targets, slot: usize, set: vk::DescriptorSet) {
+        let ctx = &self.ctx;
+        write_buffers(
+            ctx,
+            set,
+            &[
+                (&sh::XF, &self.uniforms[slot]),
+                (&sh::HEADS, &t.heads),
+                (&sh::NEXT, &t.next),
+                (&sh::SAMPLES, &t.samples),
+                (&sh::RAYS, &t.rays),
+                (&sh::TILES, &t.tiles),
+                (&sh::TILES_READ, &t.tiles),
+                (&sh::POSITIONS, &scene.positions),
+                (&sh::INDICES, &scene.indices),
+                (&sh::ATTRIBUTES, &scene.attributes),
+            ],
+        );
+        write_buffers(ctx, set, &self.culling.bindings());
+        let image = |view| {
+            [vk::DescriptorImageInfo {
+                sampler: vk::Sampler::null(),
+                image_view: view,
+                image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            }]
+        };
+        let images = [
+            (sh::RECEIVER_POSITION, image(t.position.view)),
+            (sh::RECEIVER_NORMAL, image(t.normal.view)),
+        ];
+        let writes: Vec<vk::WriteDescriptorSet> = images
+            .iter()
+            .map(|(b, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(b.binding)
+                    .descriptor_type(b.descriptor_type())
+                    .image_info(info)
+            })
+            .collect();
+        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
     }
 }
