@@ -5,7 +5,7 @@ use anyhow::{bail, Context as _};
 use glam::{Mat4, Vec3};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use umbra::render::{Aovs, BatchShadows, Renderer};
+use umbra::render::{AovSet, Aovs, BatchShadows, Renderer};
 use umbra::scene::Camera;
 
 /// `render --views`: renders every pose of the file and writes its outputs.
@@ -43,13 +43,7 @@ pub fn render_views(a: &super::cli::RenderArgs, poses: &Path) -> anyhow::Result<
     let wants = |n: &str| a.outputs.iter().any(|o| o == n);
     let (mut walls, mut drawn) = (Vec::with_capacity(views.len()), 0);
     let mut gpu = Vec::with_capacity(views.len());
-    let aovs = OUTPUTS[1..].iter().filter(|n| wants(n)).collect::<Vec<_>>();
-    let set = umbra::render::AovSet {
-        instance: wants("segmentation"),
-        normal: wants("normals"),
-        depth: wants("depth"),
-    };
-    let set = (!aovs.is_empty()).then_some(set);
+    let (aovs, set) = aov_request(&a.outputs);
     if wants("color") {
         // Frames in flight: each view's files are written while the next views are drawn; its
         // camera pass draws the AOVs where it can (one sample a pixel). A view's time is the
@@ -69,14 +63,7 @@ pub fn render_views(a: &super::cli::RenderArgs, poses: &Path) -> anyhow::Result<
             return Err(e);
         }
     } else if let Some(set) = set {
-        for (v, png) in views.iter().zip(&paths) {
-            let t = std::time::Instant::now();
-            let a = renderer.render_aovs_of(v, w, h, set)?;
-            for n in &aovs {
-                write_aov(&output_path(png, n), n, &a)?;
-            }
-            walls.push(t.elapsed().as_secs_f64() * 1e3);
-        }
+        walls = render_aovs_only(&mut renderer, (&views, &paths), (w, h), set, &aovs)?;
     }
     let total = start.elapsed().as_secs_f64();
     walls.sort_by(f64::total_cmp);
@@ -93,6 +80,40 @@ pub fn render_views(a: &super::cli::RenderArgs, poses: &Path) -> anyhow::Result<
     );
     drop(renderer);
     crate::finish_context(ctx)
+}
+
+/// The AOVs among `outputs` (in `OUTPUTS` order) and the set to draw them with (`None`: none).
+fn aov_request(outputs: &[String]) -> (Vec<&'static &'static str>, Option<AovSet>) {
+    let wants = |n: &str| outputs.iter().any(|o| o == n);
+    let aovs = OUTPUTS[1..].iter().filter(|n| wants(n)).collect::<Vec<_>>();
+    let set = AovSet {
+        instance: wants("segmentation"),
+        normal: wants("normals"),
+        depth: wants("depth"),
+    };
+    let set = (!aovs.is_empty()).then_some(set);
+    (aovs, set)
+}
+
+/// Renders the AOVs `names` of every view without colour (the AOV pass) and writes them beside
+/// the view's path; returns each view's wall time (ms).
+fn render_aovs_only(
+    renderer: &mut Renderer,
+    (views, paths): (&[umbra::plan::View], &[PathBuf]),
+    (w, h): (u32, u32),
+    set: AovSet,
+    names: &[&&str],
+) -> anyhow::Result<Vec<f64>> {
+    let mut walls = Vec::with_capacity(views.len());
+    for (v, png) in views.iter().zip(paths) {
+        let t = std::time::Instant::now();
+        let a = renderer.render_aovs_of(v, w, h, set)?;
+        for n in names {
+            write_aov(&output_path(png, n), n, &a)?;
+        }
+        walls.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(walls)
 }
 
 /// Writes one view's PNG and the AOVs `names` beside it.
