@@ -46,6 +46,14 @@ pub struct ReflectedBinding {
 }
 
 impl ReflectedBinding {
+    /// A write of this binding in `set`, its descriptor type set; the caller adds the info.
+    pub fn write<'a>(&self, set: vk::DescriptorSet) -> vk::WriteDescriptorSet<'a> {
+        vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(self.binding)
+            .descriptor_type(self.descriptor_type())
+    }
+
     /// The Vulkan descriptor type.
     pub fn descriptor_type(&self) -> vk::DescriptorType {
         match self.kind {
@@ -56,6 +64,48 @@ impl ReflectedBinding {
             BindingKind::Other => vk::DescriptorType::UNIFORM_BUFFER,
         }
     }
+}
+
+/// Writes sampled-image `bindings` of `set`, each view read in `SHADER_READ_ONLY_OPTIMAL`.
+pub fn write_sampled_images(
+    device: &ash::Device,
+    set: vk::DescriptorSet,
+    bindings: &[(&ReflectedBinding, vk::ImageView)],
+) {
+    let info = |&(_, image_view): &(&ReflectedBinding, vk::ImageView)| {
+        [vk::DescriptorImageInfo {
+            sampler: vk::Sampler::null(),
+            image_view,
+            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        }]
+    };
+    let infos: Vec<_> = bindings.iter().map(info).collect();
+    let writes = bindings.iter().zip(&infos);
+    let writes: Vec<_> = writes
+        .map(|((b, _), i)| b.write(set).image_info(i))
+        .collect();
+    unsafe { device.update_descriptor_sets(&writes, &[]) };
+}
+
+/// Writes storage and uniform buffer `bindings` of `set` (the whole of each buffer).
+pub fn write_buffers(
+    device: &ash::Device,
+    set: vk::DescriptorSet,
+    bindings: &[(&ReflectedBinding, vk::Buffer)],
+) {
+    let info = |&(_, buffer): &(&ReflectedBinding, vk::Buffer)| {
+        [vk::DescriptorBufferInfo {
+            buffer,
+            offset: 0,
+            range: vk::WHOLE_SIZE,
+        }]
+    };
+    let infos: Vec<_> = bindings.iter().map(info).collect();
+    let writes = bindings.iter().zip(&infos);
+    let writes: Vec<_> = writes
+        .map(|((b, _), i)| b.write(set).buffer_info(i))
+        .collect();
+    unsafe { device.update_descriptor_sets(&writes, &[]) };
 }
 
 include!(concat!(env!("OUT_DIR"), "/shaders.rs"));

@@ -75,7 +75,8 @@ pub struct RenderedFrame {
 
 struct Target {
     color: Image,
-    depth: Image,
+    /// Owns the image `depth_at` draws into.
+    _depth: Image,
     color_at: Attachment,
     depth_at: Attachment,
     /// Per ring slot (`ring::RING`), the colour and depth readbacks.
@@ -340,7 +341,7 @@ impl Renderer {
             color_at: Attachment::of(&color),
             depth_at: Attachment::of(&depth),
             color,
-            depth,
+            _depth: depth,
             readback,
             depth_readback,
         });

@@ -216,12 +216,7 @@ pub(super) fn write_material_set(
     let s_normal = samp(m.normal_texture)?;
     let s_mr = samp(orm_ref)?;
     let s_em = samp(m.emissive_texture)?;
-    let w = |b: &crate::gpu::shaders::ReflectedBinding| {
-        vk::WriteDescriptorSet::default()
-            .dst_set(set)
-            .dst_binding(b.binding)
-            .descriptor_type(b.descriptor_type())
-    };
+    let w = |b: &crate::gpu::shaders::ReflectedBinding| b.write(set);
     let writes = [
         w(&sh::MATERIAL_BLOCK).buffer_info(&buf_info),
         w(&sh::BASE_COLOR_TEX).image_info(&i_base),

@@ -16,7 +16,7 @@
 
 use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError};
-use crate::gpu::shaders::{allocate_sets, scene as sh, ReflectedBinding};
+use crate::gpu::shaders::{allocate_sets, scene as sh, write_sampled_images, ReflectedBinding};
 use crate::gpu::Image;
 use crate::render::gpu_scene::{AlphaDraw, Draw};
 use crate::render::passes::cull::CameraCull;
@@ -244,29 +244,12 @@ impl GBuffer {
         }
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 2, set_layout, 1)?;
         let set = sets[0];
-        let infos: Vec<[vk::DescriptorImageInfo; 1]> = images
-            .iter()
-            .map(|im| {
-                [vk::DescriptorImageInfo {
-                    sampler: vk::Sampler::null(),
-                    image_view: im.view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }]
-            })
-            .collect();
         let bindings: [&ReflectedBinding; GBUFFER_TARGETS] = [&sh::GBUFFER_A, &sh::GBUFFER_B];
-        let writes: Vec<vk::WriteDescriptorSet> = bindings
-            .iter()
-            .zip(&infos)
-            .map(|(b, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(b.binding)
-                    .descriptor_type(b.descriptor_type())
-                    .image_info(info)
-            })
+        let targets: Vec<_> = bindings
+            .into_iter()
+            .zip(images.iter().map(|im| im.view))
             .collect();
-        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        write_sampled_images(&ctx.device, set, &targets);
         Ok(Self {
             states: vec![Access::Undefined; images.len()],
             images,

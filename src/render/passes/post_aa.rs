@@ -121,16 +121,8 @@ impl PostAaPass {
             image_layout: vk::ImageLayout::UNDEFINED,
         }];
         let writes = [
-            vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(sh::SOURCE.binding)
-                .descriptor_type(sh::SOURCE.descriptor_type())
-                .image_info(&image_info),
-            vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(sh::SOURCE_SAMPLER.binding)
-                .descriptor_type(sh::SOURCE_SAMPLER.descriptor_type())
-                .image_info(&sampler_info),
+            sh::SOURCE.write(set).image_info(&image_info),
+            sh::SOURCE_SAMPLER.write(set).image_info(&sampler_info),
         ];
         unsafe { self.ctx.device.update_descriptor_sets(&writes, &[]) };
         self.scratch = Some(Scratch {

@@ -4,8 +4,9 @@
 //! a batch keeps frames in flight.
 
 use super::{
-    aov, check_size, check_supersample, copy_to_buffer, rgba_from_readback,
-    transfer_to_host_barrier, AovSet, FrameStats, RenderedFrame, Renderer, Target,
+    aov, check_size, check_supersample, copy_attachment_to_buffer, copy_to_buffer,
+    rgba_from_readback, transfer_to_host_barrier, AovSet, FrameStats, RenderedFrame, Renderer,
+    Target,
 };
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{GpuError, VkCheck};
@@ -186,15 +187,8 @@ fn record_readback(
         t.readback[slot].raw,
     );
     if read_depth {
-        t.depth_at.transition(d, cmd, Access::TransferSrc);
-        copy_to_buffer(
-            d,
-            cmd,
-            t.depth.raw,
-            vk::ImageAspectFlags::DEPTH,
-            drawn,
-            t.depth_readback[slot].raw,
-        );
+        let (depth, buffer) = (vk::ImageAspectFlags::DEPTH, t.depth_readback[slot].raw);
+        copy_attachment_to_buffer(d, cmd, &mut t.depth_at, depth, drawn, buffer);
     }
     transfer_to_host_barrier(d, cmd);
 }

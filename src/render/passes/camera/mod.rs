@@ -198,12 +198,7 @@ impl CameraPass {
             image_layout: vk::ImageLayout::UNDEFINED,
         }];
         let set = s.set;
-        let w = |b: &ReflectedBinding| {
-            vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(b.binding)
-                .descriptor_type(b.descriptor_type())
-        };
+        let w = |b: &ReflectedBinding| b.write(set);
         let writes = [
             w(&sh::FRAME_BLOCK).buffer_info(&buf),
             w(&sh::SHADOW_MAP).image_info(&img),

@@ -113,12 +113,12 @@ impl Culling {
     }
 
     /// The bindings of the culling buffers, for a set write.
-    pub fn bindings(&self) -> [(&'static crate::gpu::shaders::ReflectedBinding, &Buffer); 4] {
+    pub fn bindings(&self) -> [(&'static crate::gpu::shaders::ReflectedBinding, vk::Buffer); 4] {
         [
-            (&sh::THIN, &self.thin),
-            (&sh::KEPT, &self.kept),
-            (&sh::DRAW_ARGS, &self.args),
-            (&sh::KEPT_READ, &self.kept),
+            (&sh::THIN, self.thin.raw),
+            (&sh::KEPT, self.kept.raw),
+            (&sh::DRAW_ARGS, self.args.raw),
+            (&sh::KEPT_READ, self.kept.raw),
         ]
     }
 

@@ -24,7 +24,9 @@ mod targets;
 
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::resources::Buffer;
-use crate::gpu::shaders::{allocate_sets, create_module, exact as sh, set_layout_for};
+use crate::gpu::shaders::{
+    allocate_sets, create_module, exact as sh, set_layout_for, write_buffers,
+};
 use crate::gpu::Image;
 use crate::plan::{ExactMode, ExactPlan};
 use crate::render::gpu_scene::{vertex_layout, GpuScene};
@@ -206,7 +208,7 @@ impl ExactPass {
     pub fn ensure_culling(&mut self, scene: &GpuScene, f: &ExactPlan) -> Result<(), GpuError> {
         if self.culling.ensure(scene, f)? {
             for &set in &self.sets {
-                write_buffers(&self.ctx, set, &self.culling.bindings());
+                write_buffers(&self.ctx.device, set, &self.culling.bindings());
             }
         }
         Ok(())
@@ -223,11 +225,7 @@ impl ExactPass {
             image_view: map,
             image_layout: vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
         }];
-        let write = vk::WriteDescriptorSet::default()
-            .dst_set(self.sets[slot])
-            .dst_binding(sh::SHADOW_MAP.binding)
-            .descriptor_type(sh::SHADOW_MAP.descriptor_type())
-            .image_info(&info);
+        let write = sh::SHADOW_MAP.write(self.sets[slot]).image_info(&info);
         unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
         self.bound_map[slot] = map;
     }
@@ -287,36 +285,6 @@ fn caster_column(dr: &crate::render::gpu_scene::Draw, view: usize) -> Vec4 {
         },
         view as f32,
     )
-}
-
-/// Writes storage and uniform buffer `bindings` of `set` (the whole of each buffer).
-fn write_buffers(
-    ctx: &Context,
-    set: vk::DescriptorSet,
-    bindings: &[(&crate::gpu::shaders::ReflectedBinding, &Buffer)],
-) {
-    let infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
-        .iter()
-        .map(|(_, b)| {
-            [vk::DescriptorBufferInfo {
-                buffer: b.raw,
-                offset: 0,
-                range: vk::WHOLE_SIZE,
-            }]
-        })
-        .collect();
-    let writes: Vec<vk::WriteDescriptorSet> = bindings
-        .iter()
-        .zip(&infos)
-        .map(|((b, _), info)| {
-            vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(b.binding)
-                .descriptor_type(b.descriptor_type())
-                .buffer_info(info)
-        })
-        .collect();
-    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 
 /// The receivers' pipeline (world positions and normals into two targets, depth-tested) and the

@@ -3,7 +3,7 @@
 use super::*;
 use crate::gpu::context::{GpuError, VkCheck};
 use crate::gpu::resources::Buffer;
-use crate::gpu::shaders::exact as sh;
+use crate::gpu::shaders::{exact as sh, write_buffers, write_sampled_images};
 use crate::gpu::Image;
 use crate::render::gpu_scene::GpuScene;
 use crate::render::targets::Attachment;
@@ -67,45 +67,31 @@ impl ExactPass {
     /// Writes slot `slot`'s descriptor set: its uniforms, `t`'s buffers and images, the scene's
     /// geometry and the culling's bindings.
     fn write_set(&self, scene: &GpuScene, t: &Targets, slot: usize, set: vk::DescriptorSet) {
-        let ctx = &self.ctx;
+        let d = &self.ctx.device;
         write_buffers(
-            ctx,
+            d,
             set,
             &[
-                (&sh::XF, &self.uniforms[slot]),
-                (&sh::HEADS, &t.heads),
-                (&sh::NEXT, &t.next),
-                (&sh::SAMPLES, &t.samples),
-                (&sh::RAYS, &t.rays),
-                (&sh::TILES, &t.tiles),
-                (&sh::TILES_READ, &t.tiles),
-                (&sh::POSITIONS, &scene.positions),
-                (&sh::INDICES, &scene.indices),
-                (&sh::ATTRIBUTES, &scene.attributes),
+                (&sh::XF, self.uniforms[slot].raw),
+                (&sh::HEADS, t.heads.raw),
+                (&sh::NEXT, t.next.raw),
+                (&sh::SAMPLES, t.samples.raw),
+                (&sh::RAYS, t.rays.raw),
+                (&sh::TILES, t.tiles.raw),
+                (&sh::TILES_READ, t.tiles.raw),
+                (&sh::POSITIONS, scene.positions.raw),
+                (&sh::INDICES, scene.indices.raw),
+                (&sh::ATTRIBUTES, scene.attributes.raw),
             ],
         );
-        write_buffers(ctx, set, &self.culling.bindings());
-        let image = |view| {
-            [vk::DescriptorImageInfo {
-                sampler: vk::Sampler::null(),
-                image_view: view,
-                image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            }]
-        };
-        let images = [
-            (sh::RECEIVER_POSITION, image(t.position.view)),
-            (sh::RECEIVER_NORMAL, image(t.normal.view)),
-        ];
-        let writes: Vec<vk::WriteDescriptorSet> = images
-            .iter()
-            .map(|(b, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(b.binding)
-                    .descriptor_type(b.descriptor_type())
-                    .image_info(info)
-            })
-            .collect();
-        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        write_buffers(d, set, &self.culling.bindings());
+        write_sampled_images(
+            d,
+            set,
+            &[
+                (&sh::RECEIVER_POSITION, t.position.view),
+                (&sh::RECEIVER_NORMAL, t.normal.view),
+            ],
+        );
     }
 }
