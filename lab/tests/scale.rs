@@ -206,6 +206,7 @@ fn truth_frame(scale: f64) -> ReferenceFrame {
         image: image::RgbaImage::new(W, H),
         curved: vec![false; (W * H) as usize],
         incidence: vec![1.0; (W * H) as usize],
+        coincident: vec![false; (W * H) as usize],
     }
 }
 

@@ -38,6 +38,9 @@ pub struct Metrics {
     pub edge_pixels: usize,
     /// Pixels left out because GPU and reference see different surfaces (silhouettes).
     pub coverage_mismatch: usize,
+    /// Pixels left out because two faces lie where the surface seen lies and are judged
+    /// differently: which one the GPU keeps is a depth tie ([`ReferenceFrame::coincident`]).
+    pub coincident_surfaces: usize,
 }
 
 impl Metrics {
@@ -55,6 +58,7 @@ impl Metrics {
             "judged_pixels": self.judged_pixels,
             "edge_pixels": self.edge_pixels,
             "coverage_mismatch": self.coverage_mismatch,
+            "coincident_surfaces": self.coincident_surfaces,
         })
     }
 }
@@ -115,6 +119,8 @@ pub struct Classified {
     pub edge: Vec<bool>,
     /// Pixels seen by exactly one of GPU and reference (left out).
     pub coverage_mismatch: usize,
+    /// Pixels on coincident faces judged differently (left out: a depth tie).
+    pub coincident: usize,
 }
 
 /// The pixels within [`EDGE_PIXELS`] of an exact shadow boundary (two neighbouring pixels whose
@@ -188,6 +194,7 @@ pub fn classify(
     let edge = edge_band(&reference.visibility, w, h);
     let mut class = vec![PixelClass::Unjudged; (w * h) as usize];
     let mut coverage_mismatch = 0;
+    let mut coincident = 0;
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
@@ -197,6 +204,10 @@ pub fn classify(
                 }
                 continue;
             };
+            if reference.coincident[i] {
+                coincident += 1;
+                continue;
+            }
             let gpu_lit = gpu_shadow.get_pixel(x, y)[0] >= 128;
             class[i] = match (exact, gpu_lit) {
                 (true, false) => PixelClass::FalseShadow,
@@ -211,6 +222,7 @@ pub fn classify(
         class,
         edge,
         coverage_mismatch,
+        coincident,
     }
 }
 
@@ -362,6 +374,7 @@ pub fn summarise(
         judged_pixels: n,
         edge_pixels: ne,
         coverage_mismatch: c.coverage_mismatch,
+        coincident_surfaces: c.coincident,
     };
     (m, diff)
 }

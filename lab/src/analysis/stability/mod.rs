@@ -372,6 +372,7 @@ mod tests {
             image: image::RgbaImage::new(w, h),
             curved: vec![false; n],
             incidence: vec![1.0; n],
+            coincident: vec![false; n],
         };
         let mut class = vec![PixelClass::Correct; n];
         for &(x, y) in gpu_shadow {
@@ -386,6 +387,7 @@ mod tests {
                 class,
                 edge,
                 coverage_mismatch: 0,
+                coincident: 0,
             },
             exact,
         )

@@ -68,11 +68,16 @@ pub struct ReferenceFrame {
     /// the direction to the shadowed light, the n·l that decides whether it faces the light; 1
     /// where no surface is hit or no light is shadowed.
     pub incidence: Vec<f32>,
+    /// Per pixel: another face lies where the surface seen lies (within 10⁻⁶ of its distance)
+    /// and the shadowed light judges it otherwise, as when a card is modelled twice with opposite
+    /// windings and normals. Which of the two a depth test keeps is a tie, so such pixels are
+    /// not judged (`compare`'s `coincident_surfaces`).
+    pub coincident: Vec<bool>,
 }
 
 /// One reference pixel: (centre visibility, visible fraction) of the shadowed light where a
-/// surface is hit, distance, colour, curved, incidence.
-type PixelResult = (Option<(bool, f32)>, f32, [u8; 4], bool, f32);
+/// surface is hit, distance, colour, curved, incidence, coincident.
+type PixelResult = (Option<(bool, f32)>, f32, [u8; 4], bool, f32, bool);
 
 impl ReferenceFrame {
     /// The shadowed light's visible fraction as the GPU's shadow view writes visibility: grey
@@ -214,7 +219,7 @@ impl<'a> ReferenceScene<'a> {
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
         let (ng, mut n_geo) = self.hit_normals(&h);
-        let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+        let (ng, flip) = face_viewer(ng, n_geo, self.sides(&h), ray.dir);
         if flip {
             n_geo = -n_geo;
         }
@@ -265,7 +270,7 @@ impl<'a> ReferenceScene<'a> {
                     .intersect_where(&ray, 0.0, f32::INFINITY, &|h: &Hit| self.stops(h, true))?;
                 // The same normals, flips and facing test as `shade`.
                 let (ng, mut n_geo) = self.hit_normals(&h);
-                let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+                let (ng, flip) = face_viewer(ng, n_geo, self.sides(&h), ray.dir);
                 if flip {
                     n_geo = -n_geo;
                 }
@@ -316,6 +321,7 @@ impl<'a> ReferenceScene<'a> {
                         encode(plan.background_along(ray.dir)),
                         false,
                         1.0,
+                        false,
                     ),
                     Some(h) => {
                         let (vis, cover, rgb) = self.shade(plan, &ray, &h, ambient);
@@ -326,7 +332,9 @@ impl<'a> ReferenceScene<'a> {
                             (h, vis, cover)
                         } else {
                             match self.receiver_beyond(&ray, &h) {
-                                None => return (None, f32::INFINITY, encode(rgb), false, 1.0),
+                                None => {
+                                    return (None, f32::INFINITY, encode(rgb), false, 1.0, false)
+                                }
                                 Some(r) => {
                                     let (vis, cover, _) = self.shade(plan, &ray, &r, ambient);
                                     (r, vis, cover)
@@ -335,16 +343,19 @@ impl<'a> ReferenceScene<'a> {
                         };
                         let (ng, n) = self.hit_normals(&h);
                         let incidence = plan.shadow_light.map_or(1.0, |i| {
-                            let (_, flip) = face_viewer(ng, n, ray.dir);
+                            let (_, flip) = face_viewer(ng, n, self.sides(&h), ray.dir);
                             let facing = if flip { -n } else { n };
                             facing.dot(light_at(&plan.lights[i], ray.at(h.t)).0)
                         });
+                        let coincident = plan.shadow_light.is_some()
+                            && self.coincident(plan, &ray, &h, vis, ambient);
                         (
                             Some((vis, cover)),
                             h.t,
                             encode(rgb),
                             ng.dot(n).abs() < CURVED_COS,
                             incidence,
+                            coincident,
                         )
                     }
                 }
@@ -363,6 +374,7 @@ impl<'a> ReferenceScene<'a> {
             image,
             curved: results.iter().map(|r| r.3).collect(),
             incidence: results.iter().map(|r| r.4).collect(),
+            coincident: results.iter().map(|r| r.5).collect(),
         }
     }
 
@@ -402,7 +414,7 @@ impl<'a> ReferenceScene<'a> {
             );
         }
         // Back faces (seen only on double-sided materials on the GPU) flip like the shader does.
-        let (ng, flip) = face_viewer(ng, n_geo, ray.dir);
+        let (ng, flip) = face_viewer(ng, n_geo, self.sides(h), ray.dir);
         if flip {
             n_geo = -n_geo;
             n = -n;

@@ -32,15 +32,26 @@ pub(super) fn primary_ray(
     Ray::new(eye, (at(1e-3) - eye).normalize_or(Vec3::NEG_Z))
 }
 
-/// Turns a hit's geometric normal towards the viewer along `dir`, as the shader does; the
-/// returned flag says whether the shading normals flip too (a back face whose interpolated normal
-/// also faces away).
-pub(super) fn face_viewer(ng: Vec3, n_geo: Vec3, dir: Vec3) -> (Vec3, bool) {
-    if ng.dot(dir) > 0.0 {
-        (-ng, n_geo.dot(dir) > 0.0)
+/// Turns a hit's geometric normal `ng` (the counter-clockwise one, from its world vertices)
+/// towards the viewer along `dir`; the returned flag says whether its shading normals (`n`, the
+/// interpolated one) flip. A double-sided material's back face flips them, as glTF asks and as the
+/// shader does on `front_facing`, whatever way they point; a `mirrored` instance (negative
+/// determinant) winds its front faces clockwise. A single-sided material's back face is culled
+/// on the GPU; where the reference's primary ray still grazes one at a silhouette, its normals
+/// turn to the viewer only if they face away, standing in for the front face beside it.
+pub(super) fn face_viewer(
+    ng: Vec3,
+    n: Vec3,
+    (mirrored, double_sided): (bool, bool),
+    dir: Vec3,
+) -> (Vec3, bool) {
+    let away = ng.dot(dir) > 0.0;
+    let flip = if double_sided {
+        away != mirrored
     } else {
-        (ng, false)
-    }
+        away && n.dot(dir) > 0.0
+    };
+    (if away { -ng } else { ng }, flip)
 }
 
 /// Light `l` seen from point `p`: unit direction towards it, distance (∞ for a directional

@@ -165,6 +165,38 @@ impl<'a> ReferenceScene<'a> {
         (p, umbra::math::ray::ray_offset(m, n, p))
     }
 
+    /// Whether another face that stops shadow rays lies where hit `h` of `ray` does (within
+    /// 10⁻⁶ of its distance) and the shown light judges it otherwise than `vis`
+    /// ([`ReferenceFrame::coincident`]).
+    pub(super) fn coincident(
+        &self,
+        plan: &FramePlan,
+        ray: &Ray,
+        h: &Hit,
+        vis: bool,
+        ambient: Ambient,
+    ) -> bool {
+        let (near, far) = (h.t * (1.0 - 1e-6), h.t * (1.0 + 1e-6));
+        self.bvh
+            .intersect_where(ray, near, far, &|o: &Hit| {
+                o.triangle != h.triangle && self.stops(o, true)
+            })
+            .is_some_and(|o| self.shade(plan, ray, &o, ambient).0 != vis)
+    }
+
+    /// Whether the hit's instance mirrors (a negative determinant: its front faces wind
+    /// clockwise, as the GPU draws them, `DrawRange::front_face`) and whether its material is
+    /// double-sided ([`face_viewer`](super::rays::face_viewer)).
+    pub(super) fn sides(&self, h: &Hit) -> (bool, bool) {
+        let r = self.refs[h.triangle as usize];
+        let mirrored =
+            glam::Mat3::from_mat4(self.matrices[r.instance as usize]).determinant() < 0.0;
+        (
+            mirrored,
+            self.material_of(h).is_some_and(|m| m.double_sided),
+        )
+    }
+
     /// Geometric and interpolated normals (world space, as stored: not yet turned to the viewer)
     /// at a hit.
     pub(super) fn hit_normals(&self, h: &Hit) -> (Vec3, Vec3) {
