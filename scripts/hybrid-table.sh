@@ -3,7 +3,9 @@
 # misclassified pixels against the CPU reference (`umbra compare`, 640x360), the fraction of
 # pixels hybrid traced (its cascade view: traced verdicts green), and the frame (`umbra bench`,
 # 1280x720, 2048² map, PCF 2x2, median of REPEAT), one markdown row per scene, all in the same
-# minutes. Usage: scripts/hybrid-table.sh [REPEAT] [CORPUS]   (CORPUS: ../shared/gltf)
+# minutes. Usage: scripts/hybrid-table.sh [REPEAT] [CORPUS] [OAKTREE]   (CORPUS: ../shared/gltf;
+# OAKTREE: SaschaWillems/Vulkan-Assets' models/oaktree.gltf, adding scripts/oak-grove.py's grove
+# near and far)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repeat=${1:-5}
@@ -18,6 +20,13 @@ if [ -f "$corpus/FlightHelmet/FlightHelmet.gltf" ]; then
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+if [ -n "${3:-}" ]; then
+  for at in near far; do
+    python3 scripts/oak-grove.py "$3" "$tmp/grove-$at.gltf" "$at" >/dev/null
+    scenes+=("$tmp/grove-$at.gltf")
+    names+=("oak grove, $at")
+  done
+fi
 misclassified() { # scene args..., method -> "pixels (percent)"
   local method=${*: -1}
   # shellcheck disable=SC2086

@@ -149,17 +149,24 @@ fn builtin_scene_meets_the_thresholds_at_the_defaults() {
             p.ratio_to_origin
         );
     }
-    // In motion (a box crossing the scene, then the sun's arc), exact shadows flip no still
-    // point away from edges, and at edges far fewer than the maps held across frames do.
-    for s in r.motion.iter().filter(|s| s.method == "exact") {
+    // In motion (a box crossing the scene, then the sun's arc), exact and hybrid shadows flip
+    // no still point away from edges, and at edges far fewer than the maps held across frames do.
+    let hybrid = r.motion.iter().filter(|s| s.method == "hybrid").count();
+    assert_eq!(hybrid, 2, "both probes fly hybrid shadows");
+    for s in r
+        .motion
+        .iter()
+        .filter(|s| s.method == "exact" || s.method == "hybrid")
+    {
         let maps = r
             .motion
             .iter()
             .find(|m| m.probe == s.probe && m.method == "defaults, held")
             .unwrap();
         println!(
-            "{}: exact {:e} ({:e} away from edges), maps held {:e} ({:e})",
+            "{}: {} {:e} ({:e} away from edges), maps held {:e} ({:e})",
             s.probe,
+            s.method,
             s.mean_fraction,
             s.mean_interior_fraction,
             maps.mean_fraction,
@@ -171,14 +178,16 @@ fn builtin_scene_meets_the_thresholds_at_the_defaults() {
         let flipped: usize = s.interior.iter().map(|&(_, f)| f).sum();
         assert!(
             s.interior.iter().all(|&(n, _)| n > 10_000) && flipped <= 3,
-            "{}: {:?}",
+            "{} {}: {:?}",
             s.probe,
+            s.method,
             s.interior
         );
         assert!(
             s.mean_fraction <= 0.1 * maps.mean_fraction,
-            "{}: exact {:e} against the maps' {:e}",
+            "{}: {} {:e} against the maps' {:e}",
             s.probe,
+            s.method,
             s.mean_fraction,
             maps.mean_fraction
         );

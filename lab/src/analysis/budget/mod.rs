@@ -135,7 +135,8 @@ pub fn misclassified_at_probes(
     let (mut judged, mut wrong) = (0usize, 0usize);
     for j in 0..probe.rows {
         for i in 0..probe.cols {
-            let Some(p) = probe.probes[(j * probe.cols + i) as usize] else {
+            let Some(p) = probe.probes[(j * probe.cols + i) as usize].filter(|p| !p.coincident)
+            else {
                 continue;
             };
             let (x, y) = probe.pixel(i, j);
@@ -197,7 +198,8 @@ pub fn features(probe: &ViewProbe, plan: &FramePlan, view: &View) -> Features {
         };
         (texel / pixel_at(p.distance).max(f32::MIN_POSITIVE)) as f64
     };
-    let at = |i: u32, j: u32| probe.probes[(j * probe.cols + i) as usize];
+    // A depth tie's verdict is either face's: no boundary runs through it.
+    let at = |i: u32, j: u32| probe.probes[(j * probe.cols + i) as usize].filter(|p| !p.coincident);
     let ell = std::f64::consts::FRAC_PI_4 * probe.stride as f64;
     let (mut texel_sum, mut edge_sum, mut seen) = (0.0f64, 0.0f64, 0usize);
     for j in 0..probe.rows {

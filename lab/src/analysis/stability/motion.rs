@@ -10,7 +10,7 @@
 //! their exact visibility, ray-cast for each frame, does not; also counted away from edges (points
 //! beyond `EDGE_PIXELS` of an exact shadow boundary in both frames). Flown with maps fitted
 //! afresh per frame (as stills) and held (`View::shadow_hold`, as the viewer renders), and with
-//! exact shadows.
+//! exact and hybrid shadows.
 
 use super::{fraction, shadow_frame};
 use crate::reference::{classify, edge_band, PixelClass, ReferenceScene};
@@ -31,7 +31,8 @@ pub struct MotionSeries {
     pub probe: String,
     /// What moves: the animation's name, or "added box".
     pub mover: String,
-    /// "defaults" (maps fitted afresh per frame), "defaults, held" (the viewer) or "exact".
+    /// "defaults" (maps fitted afresh per frame), "defaults, held" (the viewer), "exact" or
+    /// "hybrid".
     pub method: String,
     /// Per consecutive pair: still points whose exact visibility is the same in both frames.
     pub points: Vec<usize>,
@@ -48,11 +49,13 @@ pub struct MotionSeries {
     pub mean_interior_fraction: f64,
 }
 
-/// How a probe is flown: maps fitted afresh each frame, maps held across frames, exact shadows.
-const METHODS: [(&str, bool, ShadowMethod); 3] = [
+/// How a probe is flown: maps fitted afresh each frame, maps held across frames, exact shadows,
+/// and hybrid shadows (the map's verdict where it proves one, traced elsewhere).
+pub const METHODS: [(&str, bool, ShadowMethod); 4] = [
     ("defaults", false, ShadowMethod::Map),
     ("defaults, held", true, ShadowMethod::Map),
     ("exact", false, ShadowMethod::Exact),
+    ("hybrid", false, ShadowMethod::Hybrid),
 ];
 
 /// Frames of each probe: 2 s at 60 frames per second (`quick`: its first half second).

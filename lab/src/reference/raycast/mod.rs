@@ -120,6 +120,10 @@ pub struct Probe {
     pub distance: f32,
     /// Exact visibility of the shadowed light (facing it and unoccluded).
     pub visible: bool,
+    /// Another face lies at the same distance and the light judges it otherwise: a depth tie
+    /// (twin cards), left out of judgements as `compare` leaves it
+    /// ([`ReferenceFrame::coincident`]).
+    pub coincident: bool,
 }
 
 /// What a click on the image hits (`ReferenceScene::pick`).
@@ -218,18 +222,13 @@ impl<'a> ReferenceScene<'a> {
         let h = self.intersect(&ray)?;
         let r = self.refs[h.triangle as usize];
         let prim = &self.scene.meshes[r.mesh as usize].primitives[r.primitive as usize];
-        let (ng, mut n_geo) = self.hit_normals(&h);
-        let (ng, flip) = face_viewer(ng, n_geo, self.sides(&h), ray.dir);
-        if flip {
-            n_geo = -n_geo;
-        }
-        let (p, offset) = self.surface_point(&h);
+        let rc = self.receiver(&ray, &h);
         let lights = plan
             .lights
             .iter()
             .map(|l| {
-                let (dir, dist, _) = light_at(l, p);
-                n_geo.dot(dir) > 0.0 && !self.occluded((p, offset), ng, dir, dist)
+                let (dir, dist, _) = light_at(l, rc.p);
+                rc.n_geo.dot(dir) > 0.0 && !self.occluded((rc.p, rc.offset), rc.ng, dir, dist)
             })
             .collect();
         Some(Pick {
@@ -238,8 +237,8 @@ impl<'a> ReferenceScene<'a> {
             primitive: r.primitive as usize,
             material: prim.material,
             triangle: r.first as usize / 3,
-            position: p + self.origin,
-            normal: ng,
+            position: rc.p + self.origin,
+            normal: rc.ng,
             distance: h.t,
             lights_visible: lights,
         })
@@ -268,23 +267,18 @@ impl<'a> ReferenceScene<'a> {
                 let h = self
                     .bvh
                     .intersect_where(&ray, 0.0, f32::INFINITY, &|h: &Hit| self.stops(h, true))?;
-                // The same normals, flips and facing test as `shade`.
-                let (ng, mut n_geo) = self.hit_normals(&h);
-                let (ng, flip) = face_viewer(ng, n_geo, self.sides(&h), ray.dir);
-                if flip {
-                    n_geo = -n_geo;
-                }
-                let (p, offset) = self.surface_point(&h);
-                let visible = match plan.shadow_light {
-                    Some(i) => self.visible(plan, i, (p, offset), ng, n_geo).0,
-                    None => true,
-                };
+                // The same receiver, flips and facing test as `render`, and its tie rule.
+                let r = self.receiver(&ray, &h);
+                let visible = plan
+                    .shadow_light
+                    .is_none_or(|i| self.centre_visible(plan, i, &r));
                 Some(Probe {
-                    position: p,
-                    normal: ng,
-                    offset,
+                    position: r.p,
+                    normal: r.ng,
+                    offset: r.offset,
                     distance: h.t,
                     visible,
+                    coincident: self.coincident(plan, &ray, &h, visible),
                 })
             })
             .collect()
@@ -341,19 +335,16 @@ impl<'a> ReferenceScene<'a> {
                                 }
                             }
                         };
-                        let (ng, n) = self.hit_normals(&h);
+                        let r = self.receiver(&ray, &h);
                         let incidence = plan.shadow_light.map_or(1.0, |i| {
-                            let (_, flip) = face_viewer(ng, n, self.sides(&h), ray.dir);
-                            let facing = if flip { -n } else { n };
-                            facing.dot(light_at(&plan.lights[i], ray.at(h.t)).0)
+                            r.n_geo.dot(light_at(&plan.lights[i], ray.at(h.t)).0)
                         });
-                        let coincident = plan.shadow_light.is_some()
-                            && self.coincident(plan, &ray, &h, vis, ambient);
+                        let coincident = self.coincident(plan, &ray, &h, vis);
                         (
                             Some((vis, cover)),
                             h.t,
                             encode(rgb),
-                            ng.dot(n).abs() < CURVED_COS,
+                            r.ng.dot(r.n_geo).abs() < CURVED_COS,
                             incidence,
                             coincident,
                         )
@@ -388,9 +379,11 @@ impl<'a> ReferenceScene<'a> {
             prim.indices[r.first as usize + 2] as usize,
         ];
         let w = Vec3::new(1.0 - h.u - h.v, h.u, h.v);
-        let (p, offset) = self.surface_point(h);
         let m3 = Mat3::from_mat4(self.matrices[r.instance as usize]);
-        let (ng, mut n_geo) = self.hit_normals(h);
+        // The receiver's normals turned to the viewer; the normal map perturbs the stored one.
+        let rc = self.receiver(ray, h);
+        let (p, offset, ng) = (rc.p, rc.offset, rc.ng);
+        let n_geo = if rc.flipped { -rc.n_geo } else { rc.n_geo };
         let (uv, vertex_color) = surface_inputs(prim, r.first as usize, h);
         let mat = &self.scene.materials[prim.material.min(self.scene.materials.len() - 1)];
         let base = mat.base_color
@@ -414,9 +407,8 @@ impl<'a> ReferenceScene<'a> {
             );
         }
         // Back faces (seen only on double-sided materials on the GPU) flip like the shader does.
-        let (ng, flip) = face_viewer(ng, n_geo, self.sides(h), ray.dir);
-        if flip {
-            n_geo = -n_geo;
+        let n_geo = rc.n_geo;
+        if rc.flipped {
             n = -n;
         }
         let mr = self.sample(mat.metallic_roughness_texture, uv, false, Vec4::ONE);

@@ -1,5 +1,6 @@
 //! Rays: the primary ray of a pixel, shadow rays and what stops them, the caster search.
 
+use super::surface::Receiver;
 use super::*;
 use crate::reference::bvh::Hit;
 use glam::{Vec2, Vec3, Vec4};
@@ -130,6 +131,15 @@ impl<'a> ReferenceScene<'a> {
             })
             .count();
         (centre, open as f32 / AREA_SAMPLES as f32, dir, radiance)
+    }
+
+    /// Whether light `i`'s centre reaches receiver `r` as the frame judges it: facing it, and
+    /// unoccluded where the plan shadows that light (`visible`'s first answer, without the
+    /// emitter's samples).
+    pub(super) fn centre_visible(&self, plan: &FramePlan, i: usize, r: &Receiver) -> bool {
+        let (dir, dist, _) = light_at(&plan.lights[i], r.p);
+        r.n_geo.dot(dir) > 0.0
+            && (!plan.is_shadowed(i) || !self.occluded((r.p, r.offset), r.ng, dir, dist))
     }
 
     /// Whether anything lies between surface point `p` (geometric normal `ng`) and a light

@@ -8,6 +8,20 @@ use umbra::math::ray::Ray;
 use umbra::plan::{Ambient, FramePlan};
 use umbra::scene::{AlphaMode, Filter, Sampler, Texture, TextureRef};
 
+/// A hit as a receiver ([`ReferenceScene::receiver`]).
+pub(super) struct Receiver {
+    /// The surface point, as the GPU interpolates it.
+    pub p: Vec3,
+    /// How far its shadow rays start off it.
+    pub offset: f32,
+    /// The geometric normal, facing the viewer.
+    pub ng: Vec3,
+    /// The interpolated normal, flipped where the face is seen from behind.
+    pub n_geo: Vec3,
+    /// Whether the shading normals flipped.
+    pub flipped: bool,
+}
+
 /// The interpolated TEXCOORD_0, TEXCOORD_1 and COLOR_0 at hit `h` on the triangle whose first
 /// index is `first` (zeros without texture coordinates, white without colours).
 pub(super) fn surface_inputs(
@@ -168,20 +182,33 @@ impl<'a> ReferenceScene<'a> {
     /// Whether another face that stops shadow rays lies where hit `h` of `ray` does (within
     /// 10⁻⁶ of its distance) and the shown light judges it otherwise than `vis`
     /// ([`ReferenceFrame::coincident`]).
-    pub(super) fn coincident(
-        &self,
-        plan: &FramePlan,
-        ray: &Ray,
-        h: &Hit,
-        vis: bool,
-        ambient: Ambient,
-    ) -> bool {
+    pub(super) fn coincident(&self, plan: &FramePlan, ray: &Ray, h: &Hit, vis: bool) -> bool {
+        let Some(i) = plan.shadow_light else {
+            return false;
+        };
         let (near, far) = (h.t * (1.0 - 1e-6), h.t * (1.0 + 1e-6));
         self.bvh
             .intersect_where(ray, near, far, &|o: &Hit| {
                 o.triangle != h.triangle && self.stops(o, true)
             })
-            .is_some_and(|o| self.shade(plan, ray, &o, ambient).0 != vis)
+            .is_some_and(|o| self.centre_visible(plan, i, &self.receiver(ray, &o)) != vis)
+    }
+
+    /// Hit `h` of `ray` as a receiver, the one step every judgement of it shares (`render`,
+    /// `probe`, `pick`, the coincidence test): its surface point and shadow-ray offset, its
+    /// geometric normal turned to the viewer and its interpolated normal flipped as the GPU flips
+    /// it ([`face_viewer`](super::rays::face_viewer)).
+    pub(super) fn receiver(&self, ray: &Ray, h: &Hit) -> Receiver {
+        let (ng, n_geo) = self.hit_normals(h);
+        let (ng, flipped) = face_viewer(ng, n_geo, self.sides(h), ray.dir);
+        let (p, offset) = self.surface_point(h);
+        Receiver {
+            p,
+            offset,
+            ng,
+            n_geo: if flipped { -n_geo } else { n_geo },
+            flipped,
+        }
     }
 
     /// Whether the hit's instance mirrors (a negative determinant: its front faces wind

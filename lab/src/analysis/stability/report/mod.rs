@@ -130,7 +130,7 @@ pub fn planned_steps(quick: bool, contact: bool) -> u64 {
     let shimmer = methods(&Default::default()).len() * (path_frames(quick) - 1) * 2;
     let precision = super::precision::offsets(quick).len() + super::precision::scales(quick).len();
     let degenerate = if quick { 9 } else { 10 };
-    let moving = 4 * super::motion::frames(quick);
+    let moving = 2 * super::motion::METHODS.len() * super::motion::frames(quick);
     (light + contact + shimmer + moving + precision + degenerate) as u64
 }
 

@@ -111,12 +111,17 @@ pub(super) fn motion_verdicts(r: &StabilityReport, v: &mut Vec<Verdict>) {
     }
     // Exact shadows have no texels to flicker: away from edges, their still points flip only
     // where the exact pass and the reference disagree in one frame and not the next (isolated
-    // pixels where the light grazes a surface).
-    for s in r.motion.iter().filter(|s| s.method == "exact") {
+    // pixels where the light grazes a surface). Hybrid shadows keep the map's verdict only where
+    // it is proven, so they are held to the same bound.
+    for s in r
+        .motion
+        .iter()
+        .filter(|s| s.method == "exact" || s.method == "hybrid")
+    {
         v.push(Verdict {
             criterion: format!(
-                "exact shadows: flicker in motion away from edges ≤ {EXACT_MOTION_BOUND:.0e} ({}: {})",
-                s.probe, s.mover
+                "{} shadows: flicker in motion away from edges ≤ {EXACT_MOTION_BOUND:.0e} ({}: {})",
+                s.method, s.probe, s.mover
             ),
             measured: format!(
                 "mean {:.2e} away from edges, {:.2e} in all",
