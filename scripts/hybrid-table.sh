@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Hybrid shadows against maps and exact shadows (docs/exact-shadows.md, "Hybrid"): for each scene,
 # misclassified pixels against the CPU reference (`umbra compare`, 640x360), the fraction of
-# pixels hybrid traced (its cascade view: traced verdicts green), and the frame (`umbra bench`,
+# pixels hybrid traced (its cascade view: traced verdicts green), the caster triangles its culling
+# kept for the grid (`render`'s line, from FrameStats::grid_triangles), and the frame (`umbra bench`,
 # 1280x720, 2048² map, PCF 2x2, median of REPEAT), one markdown row per scene, all in the same
 # minutes. Usage: scripts/hybrid-table.sh [REPEAT] [CORPUS] [OAKTREE]   (CORPUS: ../shared/gltf;
 # OAKTREE: SaschaWillems/Vulkan-Assets' models/oaktree.gltf, adding scripts/oak-grove.py's grove
@@ -37,18 +38,21 @@ d = json.loads(sys.stdin.read())
 m = d["misclassified"]
 print("%d (%.3f %%)" % (round(m * d["judged_pixels"]), 100 * m))'
 }
-traced() {
+traced() { # -> "traced % | kept of all caster triangles"
   # shellcheck disable=SC2086
-  $umbra render "$@" --size 640x360 --shadow-method hybrid --view cascades -o "$tmp/v.png" >/dev/null 2>&1
-  python3 - "$tmp/v.png" <<'EOF'
-import sys
+  $umbra render "$@" --size 640x360 --shadow-method hybrid --view cascades -o "$tmp/v.png" \
+    >"$tmp/v.txt" 2>&1
+  python3 - "$tmp/v.png" "$tmp/v.txt" <<'EOF'
+import re, sys
 from PIL import Image
 im = Image.open(sys.argv[1]).convert("RGB")
 g = r = 0
 for R, G, B in im.get_flattened_data() if hasattr(im, "get_flattened_data") else im.getdata():
     g += G > R and G > B
     r += R > G and R > B
-print(f"{100 * g / max(g + r, 1):.1f} %")
+m = re.search(r"hybrid: (\d+) of (\d+) caster triangles", open(sys.argv[2]).read())
+kept = f"{int(m[1]):,} of {int(m[2]):,}" if m else "–"
+print(f"{100 * g / max(g + r, 1):.1f} % | {kept}")
 EOF
 }
 frame() { # -> median GPU ms of the frame
@@ -57,8 +61,8 @@ frame() { # -> median GPU ms of the frame
   $umbra bench ${@:1:$#-1} --size 1280x720 --maps 2048 --kernels 2x2 --repeat "$repeat" \
     --shadow-method "$method" 2>/dev/null | tail -1 | awk -F'|' '{gsub(/ /, "", $6); print $6}'
 }
-echo "| scene | misclassified: map / exact / hybrid | traced | frame, ms: map / exact / hybrid | hybrid / exact | hybrid / map |"
-echo "|---|---|---|---|---|---|"
+echo "| scene | misclassified: map / exact / hybrid | traced | casters kept (triangles) | frame, ms: map / exact / hybrid | hybrid / exact | hybrid / map |"
+echo "|---|---|---|---|---|---|---|"
 for i in "${!scenes[@]}"; do
   # shellcheck disable=SC2206
   s=(${scenes[$i]})

@@ -171,7 +171,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     };
     println!(
         "rendered {} ({} triangles, {} draws of which {} deferred and {} unshadowed beyond the casters' reach, {} casters drawn, {} shadow view(s){}) at {}x{} on {}: {what}wall {wall:.1} ms, {gpu} -> {}",
-        scene.name, s.triangles, s.draws, s.deferred_draws, s.unshadowed_draws, s.casters_drawn, if frame.plan.shadows_on { frame.plan.shadow_views.len() } else { 0 }, if frame.plan.exact_shadows() { ", exact" } else if frame.plan.contact_shadows() { ", contact shadows" } else { "" }, frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
+        scene.name, s.triangles, s.draws, s.deferred_draws, s.unshadowed_draws, s.casters_drawn, if frame.plan.shadows_on { frame.plan.shadow_views.len() } else { 0 }, grid_note(&frame), frame.image.width(), frame.image.height(), ctx.device_name, a.output.display()
     );
     let t = renderer.texture_stats();
     if t.file_mips > 0 {
@@ -186,6 +186,24 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     // Count after the renderer and the context are gone, so destroy-time and leak messages count.
     drop(renderer);
     finish_context(ctx)
+}
+
+/// The render line's note on exact and hybrid shadows: the method, and the caster triangles
+/// drawn into the grid of those the frame has.
+fn grid_note(frame: &umbra::RenderedFrame) -> String {
+    let method = if frame.plan.hybrid_shadows() {
+        "hybrid"
+    } else if frame.plan.exact_shadows() {
+        "exact"
+    } else if frame.plan.contact_shadows() {
+        return ", contact shadows".into();
+    } else {
+        return String::new();
+    };
+    match frame.stats.grid_triangles {
+        Some((drawn, all)) => format!(", {method}: {drawn} of {all} caster triangles in the grid"),
+        None => format!(", {method}"),
+    }
 }
 
 #[cfg(feature = "viewer")]

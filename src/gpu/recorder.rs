@@ -216,6 +216,11 @@ impl<'a> Recorder<'a> {
         unsafe { self.d.cmd_fill_buffer(self.cmd, buffer, offset, size, data) }
     }
 
+    /// `vkCmdCopyBuffer`.
+    pub fn copy_buffer(&self, src: vk::Buffer, dst: vk::Buffer, regions: &[vk::BufferCopy]) {
+        unsafe { self.d.cmd_copy_buffer(self.cmd, src, dst, regions) }
+    }
+
     /// `vkCmdDrawIndexed`.
     pub fn draw_indexed(
         &self,

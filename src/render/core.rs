@@ -379,6 +379,13 @@ impl FrameCore {
             .record_aov(cmd, frame.slot, &self.gpu, &targets, &frame.camera))
     }
 
+    /// The caster triangles slot `slot`'s frame (completed) drew into the exact method's grid,
+    /// and its caster triangles ([`FrameStats::grid_triangles`](crate::render::FrameStats)).
+    pub fn grid_triangles(&mut self, slot: usize, plan: &FramePlan) -> Option<(u64, u64)> {
+        let (e, pass) = (plan.exact.as_ref()?, self.exact.as_mut()?);
+        pass.grid_triangles(slot, &self.gpu, e)
+    }
+
     /// GPU milliseconds (shadow pass, camera pass) of slot `slot`'s last frame, which must have
     /// completed.
     pub fn gpu_times(&self, slot: usize) -> Option<(f64, f64)> {

@@ -58,6 +58,9 @@ pub struct FrameStats {
     /// Whether the camera pass drew the instance ids and normals too
     /// (`Renderer::render_with_aovs` at one sample per pixel).
     pub aovs_in_camera_pass: bool,
+    /// Exact and hybrid shadows: the caster triangles drawn into the grid, and the frame's
+    /// caster triangles (equal for exact shadows; hybrid ones draw those culling kept).
+    pub grid_triangles: Option<(u64, u64)>,
 }
 
 /// A rendered frame.

@@ -118,6 +118,7 @@ impl Renderer {
             triangles: self.core.gpu.triangles,
             hardware_compare: self.core.shadow.hardware_filtering(plan.shadow_format),
             aovs_in_camera_pass: p.aovs.is_some(),
+            grid_triangles: self.core.grid_triangles(p.slot, &plan),
         };
         let t = self.target.as_mut().expect("target");
         let (image, depth) = read_back(t, p.size, p.drawn, p.read_depth, p.slot)?;

@@ -35,6 +35,9 @@ pub(super) struct Culling {
     pub kept: Buffer,
     /// Indirect draw arguments, 16 bytes per caster draw.
     pub args: Buffer,
+    /// Per frame in flight, the arguments copied back to the host (the triangles kept:
+    /// [`Culling::kept_triangles`]).
+    readback: Vec<Buffer>,
     kept_capacity: u64,
     args_capacity: u64,
 }
@@ -45,6 +48,7 @@ impl Culling {
         ctx: &Arc<Context>,
         set_layout: vk::DescriptorSetLayout,
         module: vk::ShaderModule,
+        slots: usize,
     ) -> Result<Self, GpuError> {
         let ranges = [vk::PushConstantRange {
             stage_flags: vk::ShaderStageFlags::COMPUTE,
@@ -76,6 +80,7 @@ impl Culling {
             thin_capacity: 1,
             kept,
             args,
+            readback: readback_buffers(ctx, 64, slots)?,
             kept_capacity: 1024,
             args_capacity: 64,
         })
@@ -107,6 +112,9 @@ impl Culling {
         let kept_capacity = triangles.next_power_of_two().max(self.kept_capacity);
         let args_capacity = draws.next_power_of_two().max(self.args_capacity);
         (self.kept, self.args) = buffers(&self.ctx, kept_capacity, args_capacity)?;
+        if args_capacity > self.args_capacity {
+            self.readback = readback_buffers(&self.ctx, args_capacity, self.readback.len())?;
+        }
         self.kept_capacity = kept_capacity;
         self.args_capacity = args_capacity;
         Ok(true)
@@ -156,26 +164,56 @@ impl Culling {
     /// Culls each caster draw of `f` (after binning has marked the tiles), then makes the kept
     /// triangles and the arguments visible to the caster pass. Returns each draw's first kept
     /// slot, in `f.casters`' order.
+    /// Slot `slot`'s arguments are copied back for the host ([`Culling::kept_triangles`]).
     pub fn record(
         &self,
         cmd: vk::CommandBuffer,
         set: vk::DescriptorSet,
         scene: &GpuScene,
         f: &ExactPlan,
+        slot: usize,
     ) -> Vec<u32> {
         let first = self.dispatch_casters(cmd, set, scene, f, self.pipeline);
         use vk::AccessFlags2 as A;
         use vk::PipelineStageFlags2 as S;
+        // The arguments to the caster pass and to the copy; the copy also after the slot's
+        // previous one.
         memory_barrier(
             &self.ctx.device,
             cmd,
-            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
             (
-                S::DRAW_INDIRECT | S::VERTEX_SHADER,
-                A::INDIRECT_COMMAND_READ | A::SHADER_STORAGE_READ,
+                S::COMPUTE_SHADER | S::ALL_TRANSFER,
+                A::SHADER_STORAGE_WRITE | A::TRANSFER_WRITE,
+            ),
+            (
+                S::DRAW_INDIRECT | S::VERTEX_SHADER | S::ALL_TRANSFER,
+                A::INDIRECT_COMMAND_READ
+                    | A::SHADER_STORAGE_READ
+                    | A::TRANSFER_READ
+                    | A::TRANSFER_WRITE,
             ),
         );
+        let region = vk::BufferCopy::default().size(16 * f.casters.len().max(1) as u64);
+        Recorder::new(&self.ctx.device, cmd).copy_buffer(
+            self.args.raw,
+            self.readback[slot].raw,
+            &[region],
+        );
+        memory_barrier(
+            &self.ctx.device,
+            cmd,
+            (S::ALL_TRANSFER, A::TRANSFER_WRITE),
+            (S::HOST, A::HOST_READ),
+        );
         first
+    }
+
+    /// The caster triangles slot `slot`'s culling kept for `draws` caster draws (its frame
+    /// completed): six vertices each in the indirect arguments.
+    pub fn kept_triangles(&mut self, slot: usize, draws: usize) -> Option<u64> {
+        let bytes = self.readback.get_mut(slot)?.mapped()?;
+        let words: &[u32] = bytemuck::try_cast_slice(bytes.get(..16 * draws)?).ok()?;
+        Some(words.chunks_exact(4).map(|a| u64::from(a[0] / 6)).sum())
     }
 
     /// Dispatches `pipeline` over each caster draw's triangles (a thread each), the draw's
@@ -243,10 +281,25 @@ fn buffers(ctx: &Arc<Context>, triangles: u64, draws: u64) -> Result<(Buffer, Bu
         ctx,
         "hybrid caster draws",
         draws * 16,
-        usage | vk::BufferUsageFlags::INDIRECT_BUFFER,
+        usage | vk::BufferUsageFlags::INDIRECT_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
         MemoryLocation::GpuOnly,
     )?;
     Ok((kept, args))
+}
+
+/// Host-readable copies of `draws` argument records, one per frame in flight.
+fn readback_buffers(ctx: &Arc<Context>, draws: u64, slots: usize) -> Result<Vec<Buffer>, GpuError> {
+    (0..slots)
+        .map(|i| {
+            Buffer::new(
+                ctx,
+                &format!("hybrid caster draws, read back {i}"),
+                draws * 16,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )
+        })
+        .collect()
 }
 
 /// The thin-caster mask of `tiles` words.

@@ -192,8 +192,31 @@ impl ExactPass {
             targets: None,
             empty,
             bound_map: vec![vk::ImageView::null(); slots],
-            culling: cull::Culling::new(ctx, set_layout, module)?,
+            culling: cull::Culling::new(ctx, set_layout, module, slots)?,
         })
+    }
+
+    /// The caster triangles slot `slot`'s frame (completed) drew into the grid, and the frame's
+    /// caster triangles: all of them for exact shadows, those culling kept for hybrid ones; None
+    /// for contact shadows, which draw none.
+    pub fn grid_triangles(
+        &mut self,
+        slot: usize,
+        scene: &GpuScene,
+        f: &ExactPlan,
+    ) -> Option<(u64, u64)> {
+        if let ExactMode::Contact { .. } = f.mode {
+            return None;
+        }
+        let all: u64 = f
+            .casters
+            .iter()
+            .map(|&i| u64::from(scene.draws[i].shadow_caster().index_count / 3))
+            .sum();
+        if f.hybrid.is_none() {
+            return Some((all, all));
+        }
+        Some((self.culling.kept_triangles(slot, f.casters.len())?, all))
     }
 
     /// The sample buffer the camera pass reads (the empty one before the first exact frame).

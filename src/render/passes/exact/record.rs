@@ -78,7 +78,7 @@ impl ExactPass {
         let kept = f
             .hybrid
             .is_some()
-            .then(|| self.culling.record(cmd, set, scene, f));
+            .then(|| self.culling.record(cmd, set, scene, f, slot));
         self.record_casters(cmd, set, scene, f, kept.as_deref());
         self.targets = Some(t);
     }
