@@ -7,7 +7,7 @@ use crate::plan::casters::Viewpoint;
 use crate::plan::exact::{
     exact_asked, ExactMode, ExactPlan, HybridPlan, CONTACT_TEXELS, CONTACT_THICKNESS,
 };
-use crate::plan::input::PlanScene;
+use crate::plan::input::{PlanScene, PlanTarget};
 use crate::plan::reach::ShadowReach;
 use crate::plan::settings::ViewMode;
 use crate::plan::sight::Sight;
@@ -15,6 +15,17 @@ use crate::plan::view::View;
 use crate::plan::ShadowMethod;
 use crate::scene::LightKind;
 use crate::shader_consts::VariantKey;
+
+/// Finishes `plan` for `view` of `scene` into `target`: the casters of its shadow views, the
+/// exact method's choice (and its shader bit) and the camera's sight.
+pub(super) fn finish(plan: &mut FramePlan, scene: &PlanScene, view: &View, target: &PlanTarget) {
+    plan.plan_casters(scene, view.shadow.pcf, view.mode == ViewMode::ShadowMap);
+    plan.exact = choose_exact(plan, view, scene, target.aspect, target.exact_capable);
+    if plan.exact.is_some() {
+        plan.shader_variant |= VariantKey::EXACT;
+    }
+    plan.sight = sight(plan, view, target.aspect, target.receiver_split);
+}
 
 /// The exact pass of a frame planned as `plan` for `view` (relative to the plan's origin) of
 /// `scene` at `aspect`, when it applies: exact shadows need one shadowed directional or spot
@@ -42,40 +53,17 @@ pub(super) fn choose_exact(
                 .map(|first| (i, first))
         })
         .filter(|_| plan.shadows_on && bits.contains(VariantKey::SHADOWS))?;
-    // Exact: the shown light's views are the frame's, one (a sun's single map, a spot
-    // light) or a point light's six faces.
-    let only_shown = plan.shadow_views.iter().all(|v| v.light == shown);
-    let point = plan.lights[shown].kind == LightKind::Point;
-    let views = plan.shadow_views.len();
-    let mode = match contact {
-        false if only_shown && (views == 1 || (point && views == 6)) => ExactMode::Exact,
-        true if !bits.contains(VariantKey::SOFT) => {
-            let length = CONTACT_TEXELS * plan.shadow_views[first].texel_world;
-            ExactMode::Contact {
-                length,
-                thickness: CONTACT_THICKNESS * length,
-                margin: (scene.bounds.diagonal() * 2e-5).max(1e-6),
-            }
-        }
-        _ => return None,
-    };
+    let mode = exact_mode(plan, scene, shown, first, contact)?;
     let (light, positional) = match plan.light_source(shown) {
         Viewpoint::Eye(p) => (p, true),
         Viewpoint::Along(d) => (d, false),
     };
     let cam = &view.camera;
     let half = cam.half_extent_at(cam.near, aspect);
+    let views = plan.shadow_views.len();
     let hybrid =
         (mode == ExactMode::Exact && views == 1 && view.shadow.method == ShadowMethod::Hybrid)
-            .then(|| {
-                let v = &plan.shadow_views[first];
-                HybridPlan {
-                    world_from_clip: v.light_clip_from_world.as_dmat4().inverse().as_mat4(),
-                    map_size: v.casters.size,
-                    rect: v.casters.lookup.to_array(),
-                    texel_world: v.texel_world,
-                }
-            });
+            .then(|| hybrid_plan(plan, first));
     Some(ExactPlan {
         hybrid,
         mode,
@@ -106,6 +94,44 @@ pub(super) fn choose_exact(
             ExactMode::Contact { .. } => Vec::new(),
         },
     })
+}
+
+/// What the exact pass does for the shown light `shown` (its first view `first`): exact shadows
+/// when its views are the frame's, one (a sun's single map, a spot light) or a point light's
+/// six faces; contact shadows (`contact`) with hard shadows; else nothing.
+fn exact_mode(
+    plan: &FramePlan,
+    scene: &PlanScene,
+    shown: usize,
+    first: usize,
+    contact: bool,
+) -> Option<ExactMode> {
+    let only_shown = plan.shadow_views.iter().all(|v| v.light == shown);
+    let point = plan.lights[shown].kind == LightKind::Point;
+    let views = plan.shadow_views.len();
+    match contact {
+        false if only_shown && (views == 1 || (point && views == 6)) => Some(ExactMode::Exact),
+        true if !plan.shader_variant.contains(VariantKey::SOFT) => {
+            let length = CONTACT_TEXELS * plan.shadow_views[first].texel_world;
+            Some(ExactMode::Contact {
+                length,
+                thickness: CONTACT_THICKNESS * length,
+                margin: (scene.bounds.diagonal() * 2e-5).max(1e-6),
+            })
+        }
+        _ => None,
+    }
+}
+
+/// The hybrid method's inputs from the frame's one shadow view, `first`.
+fn hybrid_plan(plan: &FramePlan, first: usize) -> HybridPlan {
+    let v = &plan.shadow_views[first];
+    HybridPlan {
+        world_from_clip: v.light_clip_from_world.as_dmat4().inverse().as_mat4(),
+        map_size: v.casters.size,
+        rect: v.casters.lookup.to_array(),
+        texel_world: v.texel_world,
+    }
 }
 
 /// The sight of `view` planned as `plan` at `aspect`; with `receiver_split`, the reach of a

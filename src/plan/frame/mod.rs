@@ -6,9 +6,7 @@ use super::casters::{plan_casters, Viewpoint};
 use super::exact::{exact_asked, ExactMode, ExactPlan};
 use super::input::{PlanScene, PlanTarget};
 use super::lights::{effective_lights, light_uniforms, metering};
-use super::settings::{
-    Pcf, ShadowFit, ShadowFormat, ShadowMethod, ShadowSettings, Tonemap, ViewMode,
-};
+use super::settings::{Pcf, ShadowFit, ShadowFormat, ShadowMethod, ShadowSettings, Tonemap};
 use super::sight::Sight;
 use super::uniforms::{FrameUniform, MAX_LIGHTS};
 use super::view::{Ambient, Background, Exposure, HeldLight, ShadowHold, View};
@@ -17,7 +15,7 @@ use super::views::{far_view_depth, shadow_views, view_uniforms, ShadowView};
 use crate::math::Aabb;
 use crate::scene::{Light, LightKind};
 use crate::shader_consts::VariantKey;
-use finish::{choose_exact, sight};
+use finish::finish;
 use glam::{Mat4, Vec3, Vec4};
 
 pub use super::settings::CLEAR_COLOR;
@@ -356,9 +354,7 @@ pub fn resolve_format(settings: &ShadowSettings, views: &[ShadowView]) -> Shadow
 /// Plans a frame for `view` of `scene` rendered into `target`: pure, no GPU.
 pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FramePlan {
     let view = &settled(view, target);
-    let PlanTarget {
-        aspect, hw_compare, ..
-    } = *target;
+    let (aspect, hw_compare) = (target.aspect, target.hw_compare);
     let bounds = scene.bounds;
     let lights = effective_lights(scene.lights, view);
     let proj = camera_projection(&view.camera, aspect);
@@ -432,12 +428,7 @@ pub fn plan_frame(scene: &PlanScene, view: &View, target: &PlanTarget) -> FrameP
         unlit_scale,
         metered_lux,
     };
-    plan.plan_casters(scene, view.shadow.pcf, view.mode == ViewMode::ShadowMap);
-    plan.exact = choose_exact(&plan, view, scene, aspect, target.exact_capable);
-    if plan.exact.is_some() {
-        plan.shader_variant |= VariantKey::EXACT;
-    }
-    plan.sight = sight(&plan, view, aspect, target.receiver_split);
+    finish(&mut plan, scene, view, target);
     plan
 }
 

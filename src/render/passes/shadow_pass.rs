@@ -326,45 +326,63 @@ impl ShadowPass {
                 drawn += self.draw_layer(cmd, scene, s, &t, &casters.draws, true);
                 continue;
             }
-            let (statics, moving) = split_moving(scene, &casters.draws);
-            // With moving casters the static layer is cached over the whole square: the caster
-            // area follows the movers, the cache must not.
-            let side = casters.size.min(layer_side);
-            let square = vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent: vk::Extent2D {
-                    width: side,
-                    height: side,
-                },
-            };
-            let cached_area = if moving.is_empty() { t.area } else { square };
-            let biases = (s.slope_bias, eye_near);
-            let key = LayerKey::new(
-                light_clip_from_world,
-                casters,
-                cached_area,
-                biases,
-                statics.clone(),
-            );
-            match self.layers.plan(layer, key, !moving.is_empty()) {
-                LayerWork::Keep => {}
-                LayerWork::DrawStatic => {
-                    drawn += self.draw_layer(cmd, scene, s, &t, &casters.draws, true);
-                }
-                LayerWork::FromCache => {
-                    self.copy_layer(cmd, layer, t.area, false);
-                    drawn += self.draw_layer(cmd, scene, s, &t, &moving, false);
-                }
-                LayerWork::FillCache => {
-                    let whole = LayerTarget { area: square, ..t };
-                    drawn += self.draw_layer(cmd, scene, s, &whole, &statics, true);
-                    self.copy_layer(cmd, layer, square, true);
-                    drawn += self.draw_layer(cmd, scene, s, &t, &moving, false);
-                }
-            }
+            drawn += self.record_cached_layer(cmd, scene, s, layer, t, layer_side);
         }
         self.transition_map(cmd, Access::DepthFragmentSampled);
         self.ctx.end_label(cmd);
+        drawn
+    }
+
+    /// Records layer `layer` (target `t`, layers `layer_side` texels across) with the static
+    /// casters' cache: kept, drawn, copied from the cache or filled into it
+    /// (`ShadowCache::plan`). Returns casters drawn.
+    fn record_cached_layer(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        s: &ShadowSettings,
+        layer: usize,
+        t: LayerTarget<'_>,
+        layer_side: u32,
+    ) -> usize {
+        let (light_clip_from_world, casters) = (t.light_clip_from_world, t.casters);
+        let mut drawn = 0;
+        let (statics, moving) = split_moving(scene, &casters.draws);
+        // With moving casters the static layer is cached over the whole square: the caster
+        // area follows the movers, the cache must not.
+        let side = casters.size.min(layer_side);
+        let square = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D {
+                width: side,
+                height: side,
+            },
+        };
+        let cached_area = if moving.is_empty() { t.area } else { square };
+        let biases = (s.slope_bias, t.eye_near);
+        let key = LayerKey::new(
+            light_clip_from_world,
+            casters,
+            cached_area,
+            biases,
+            statics.clone(),
+        );
+        match self.layers.plan(layer, key, !moving.is_empty()) {
+            LayerWork::Keep => {}
+            LayerWork::DrawStatic => {
+                drawn += self.draw_layer(cmd, scene, s, &t, &casters.draws, true);
+            }
+            LayerWork::FromCache => {
+                self.copy_layer(cmd, layer, t.area, false);
+                drawn += self.draw_layer(cmd, scene, s, &t, &moving, false);
+            }
+            LayerWork::FillCache => {
+                let whole = LayerTarget { area: square, ..t };
+                drawn += self.draw_layer(cmd, scene, s, &whole, &statics, true);
+                self.copy_layer(cmd, layer, square, true);
+                drawn += self.draw_layer(cmd, scene, s, &t, &moving, false);
+            }
+        }
         drawn
     }
 

@@ -299,7 +299,6 @@ impl<'a> ReferenceScene<'a> {
         );
         let inv = plan.clip_from_world.inverse();
         let n = (width * height) as usize;
-        let encode = |c: Vec3| [srgb_encode(c.x), srgb_encode(c.y), srgb_encode(c.z), 255];
         let results: Vec<PixelResult> = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -307,49 +306,7 @@ impl<'a> ReferenceScene<'a> {
                     (i as u32 % width) as f32 + 0.5,
                     (i as u32 / width) as f32 + 0.5,
                 );
-                let ray = primary_ray(plan, &inv, x, y, width, height);
-                match self.intersect(&ray) {
-                    None => (
-                        None,
-                        f32::INFINITY,
-                        encode(plan.background_along(ray.dir)),
-                        false,
-                        1.0,
-                        false,
-                    ),
-                    Some(h) => {
-                        let (vis, cover, rgb) = self.shade(plan, &ray, &h, ambient);
-                        let rgb = plan.display_surface(rgb, self.unlit(&h));
-                        let rgb = self.blend_behind(plan, &ray, &h, rgb, ambient, 0);
-                        // The receiver judged: the first surface that would stop a shadow ray.
-                        let (h, vis, cover) = if self.stops(&h, true) {
-                            (h, vis, cover)
-                        } else {
-                            match self.receiver_beyond(&ray, &h) {
-                                None => {
-                                    return (None, f32::INFINITY, encode(rgb), false, 1.0, false)
-                                }
-                                Some(r) => {
-                                    let (vis, cover, _) = self.shade(plan, &ray, &r, ambient);
-                                    (r, vis, cover)
-                                }
-                            }
-                        };
-                        let r = self.receiver(&ray, &h);
-                        let incidence = plan.shadow_light.map_or(1.0, |i| {
-                            r.n_geo.dot(light_at(&plan.lights[i], ray.at(h.t)).0)
-                        });
-                        let coincident = self.coincident(plan, &ray, &h, vis);
-                        (
-                            Some((vis, cover)),
-                            h.t,
-                            encode(rgb),
-                            r.ng.dot(r.n_geo).abs() < CURVED_COS,
-                            incidence,
-                            coincident,
-                        )
-                    }
-                }
+                self.pixel(plan, primary_ray(plan, &inv, x, y, width, height), ambient)
             })
             .collect();
         let mut image = image::RgbaImage::new(width, height);
@@ -366,6 +323,53 @@ impl<'a> ReferenceScene<'a> {
             curved: results.iter().map(|r| r.3).collect(),
             incidence: results.iter().map(|r| r.4).collect(),
             coincident: results.iter().map(|r| r.5).collect(),
+        }
+    }
+
+    /// One pixel of [`ReferenceScene::render`] along its primary ray `ray`: the shown light's
+    /// verdict and emitter fraction at the receiver judged, its distance, the colour, whether it
+    /// is curved, its incidence and whether it is a depth tie.
+    fn pixel(&self, plan: &FramePlan, ray: Ray, ambient: Ambient) -> PixelResult {
+        let encode = |c: Vec3| [srgb_encode(c.x), srgb_encode(c.y), srgb_encode(c.z), 255];
+        match self.intersect(&ray) {
+            None => (
+                None,
+                f32::INFINITY,
+                encode(plan.background_along(ray.dir)),
+                false,
+                1.0,
+                false,
+            ),
+            Some(h) => {
+                let (vis, cover, rgb) = self.shade(plan, &ray, &h, ambient);
+                let rgb = plan.display_surface(rgb, self.unlit(&h));
+                let rgb = self.blend_behind(plan, &ray, &h, rgb, ambient, 0);
+                // The receiver judged: the first surface that would stop a shadow ray.
+                let (h, vis, cover) = if self.stops(&h, true) {
+                    (h, vis, cover)
+                } else {
+                    match self.receiver_beyond(&ray, &h) {
+                        None => return (None, f32::INFINITY, encode(rgb), false, 1.0, false),
+                        Some(r) => {
+                            let (vis, cover, _) = self.shade(plan, &ray, &r, ambient);
+                            (r, vis, cover)
+                        }
+                    }
+                };
+                let r = self.receiver(&ray, &h);
+                let incidence = plan.shadow_light.map_or(1.0, |i| {
+                    r.n_geo.dot(light_at(&plan.lights[i], ray.at(h.t)).0)
+                });
+                let coincident = self.coincident(plan, &ray, &h, vis);
+                (
+                    Some((vis, cover)),
+                    h.t,
+                    encode(rgb),
+                    r.ng.dot(r.n_geo).abs() < CURVED_COS,
+                    incidence,
+                    coincident,
+                )
+            }
         }
     }
 
