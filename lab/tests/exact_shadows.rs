@@ -252,6 +252,8 @@ fn exact_shadows_agree_with_the_reference_at_every_judged_pixel() {
     }
 }
 
+// The budget chooser is the `sweep` feature's.
+#[cfg(feature = "sweep")]
 #[test]
 fn probes_leave_out_depth_ties_as_compare_does() {
     // The budget chooser's probes judge a frame at chosen pixels with the reference's receiver
