@@ -322,83 +322,126 @@ pub(super) fn directional_views(
     max: usize,
     held: Option<&HeldLight>,
 ) -> Vec<ShadowView> {
-    let PlanScene {
-        bounds, receivers, ..
-    } = *scene;
-    let PlanTarget {
-        aspect, height_px, ..
-    } = *target;
-    let held_range = held.and_then(|h| h.depth_range);
-    let held = held.map(|h| h.extents.as_slice());
-    let size = view.shadow.map_size.max(1);
-    // The previous frame's extent of view `c` of `n`, when it had the same views.
-    let hold = |c: usize, n: usize| held.filter(|h| h.len() == n).map(|h| h[c]);
+    let bounds = scene.bounds;
     // A batch's other cameras, whose frusta its shared map covers too.
     let batch: Vec<CameraFrustum> = view
         .shadow_batch
         .iter()
         .flat_map(|b| b.iter())
-        .map(|c| fitting_frustum(c, aspect, bounds))
+        .map(|c| fitting_frustum(c, target.aspect, bounds))
         .collect();
-    let fit_sized = |camera, hold: Option<f32>, map_size: u32| {
-        fit_directional(&DirectionalFitInput {
+    let fitter = Fitter {
+        input: DirectionalFitInput {
             also: &batch,
             direction: l.direction,
             scene_bounds: *bounds,
-            camera,
-            map_size,
+            camera: None,
+            map_size: view.shadow.map_size.max(1),
             snap: view.shadow.snap,
             sphere: view.shadow.fit == ShadowFit::Sphere,
             extent_steps: view.shadow.extent_steps,
-            hold,
-        })
+            hold: None,
+        },
+        held: held.map(|h| h.extents.as_slice()),
     };
-    let fit_held = |camera, hold: Option<f32>| fit_sized(camera, hold, size);
-    let fit = |camera| fit_held(camera, None);
     match view.shadow.fit {
         ShadowFit::Camera | ShadowFit::Sphere => {
-            let frustum = depth_fitted_frustum(view, fit_cam, aspect, bounds);
-            let (near, far) = split_range(view, &frustum, (bounds, receivers), held_range);
-            // The automatic count fits one map first; when it stays at one, that is the map.
-            let mut single = None;
-            let n = match view.shadow.cascades {
-                0 => {
-                    let f = fit(Some(frustum));
-                    // A pixel's footprint at the nearest receiver (the same at every depth for
-                    // an orthographic camera).
-                    let pixel = 2.0 * fit_cam.half_extent_at(near, 1.0).y / height_px.max(1) as f32;
-                    let ratio = f.texel_world / pixel.max(f32::MIN_POSITIVE);
-                    single = Some(f);
-                    if auto_doubles_map(ratio, size) {
-                        // One map of twice the side instead of two cascades.
-                        let doubled = 2 * size;
-                        let f = fit_sized(Some(frustum), hold(0, 1), doubled);
-                        return vec![ShadowView {
-                            res: doubled,
-                            ..ShadowView::whole(f.light_clip_from_world, f.texel_world)
-                        }];
-                    }
-                    auto_cascades(ratio)
-                }
-                c => c.clamp(1, MAX_CASCADES) as usize,
-            }
-            .min(max);
-            if n == 1 {
-                let f = match hold(0, 1) {
-                    Some(h) => fit_held(Some(frustum), Some(h)),
-                    None => single.unwrap_or_else(|| fit(Some(frustum))),
-                };
-                vec![ShadowView::whole(f.light_clip_from_world, f.texel_world)]
-            } else {
-                cascade_views(&frustum, (near, far), n, |c, camera| {
-                    fit_held(camera, hold(c, n))
-                })
-            }
+            let held_range = held.and_then(|h| h.depth_range);
+            camera_fitted_views(&fitter, scene, view, fit_cam, target, max, held_range)
         }
         ShadowFit::Scene => {
-            let f = fit(None);
+            let f = fitter.fit(None, None);
             vec![ShadowView::whole(f.light_clip_from_world, f.texel_world)]
         }
+    }
+}
+
+/// A directional light's fit for one frame: the settings, the batch's frusta and the extents
+/// the light's views held the frame before.
+struct Fitter<'a> {
+    /// Everything but the camera, the hold and (for a doubled map) the size.
+    input: DirectionalFitInput<'a>,
+    held: Option<&'a [f32]>,
+}
+
+impl Fitter<'_> {
+    /// Fits `camera` (or the scene) at the settings' map size, holding extent `hold`.
+    fn fit(&self, camera: Option<CameraFrustum>, hold: Option<f32>) -> DirectionalFit {
+        self.fit_sized(camera, hold, self.input.map_size)
+    }
+
+    /// [`Self::fit`] for a map of `map_size` texels.
+    fn fit_sized(
+        &self,
+        camera: Option<CameraFrustum>,
+        hold: Option<f32>,
+        map_size: u32,
+    ) -> DirectionalFit {
+        fit_directional(&DirectionalFitInput {
+            camera,
+            hold,
+            map_size,
+            ..self.input
+        })
+    }
+
+    /// The previous frame's extent of view `c` of `n`, when it had the same views.
+    fn hold(&self, c: usize, n: usize) -> Option<f32> {
+        self.held.filter(|h| h.len() == n).map(|h| h[c])
+    }
+}
+
+/// A directional light's views fitted to the camera: one map (perhaps of twice the side) or
+/// cascades, their count from the settings or automatic, at most `max`.
+fn camera_fitted_views(
+    fitter: &Fitter,
+    scene: &PlanScene,
+    view: &View,
+    fit_cam: &Camera,
+    target: &PlanTarget,
+    max: usize,
+    held_range: Option<(f32, f32)>,
+) -> Vec<ShadowView> {
+    let PlanScene {
+        bounds, receivers, ..
+    } = *scene;
+    let size = fitter.input.map_size;
+    let frustum = depth_fitted_frustum(view, fit_cam, target.aspect, bounds);
+    let (near, far) = split_range(view, &frustum, (bounds, receivers), held_range);
+    // The automatic count fits one map first; when it stays at one, that is the map.
+    let mut single = None;
+    let n = match view.shadow.cascades {
+        0 => {
+            let f = fitter.fit(Some(frustum), None);
+            // A pixel's footprint at the nearest receiver (the same at every depth for an
+            // orthographic camera).
+            let pixel = 2.0 * fit_cam.half_extent_at(near, 1.0).y / target.height_px.max(1) as f32;
+            let ratio = f.texel_world / pixel.max(f32::MIN_POSITIVE);
+            single = Some(f);
+            if auto_doubles_map(ratio, size) {
+                // One map of twice the side instead of two cascades.
+                let doubled = 2 * size;
+                let f = fitter.fit_sized(Some(frustum), fitter.hold(0, 1), doubled);
+                return vec![ShadowView {
+                    res: doubled,
+                    ..ShadowView::whole(f.light_clip_from_world, f.texel_world)
+                }];
+            }
+            auto_cascades(ratio)
+        }
+        c => c.clamp(1, MAX_CASCADES) as usize,
+    }
+    .min(max);
+    if n == 1 {
+        let f = match fitter.hold(0, 1) {
+            Some(h) => fitter.fit(Some(frustum), Some(h)),
+            None => single.unwrap_or_else(|| fitter.fit(Some(frustum), None)),
+        };
+        vec![ShadowView::whole(f.light_clip_from_world, f.texel_world)]
+    } else {
+        cascade_views(&frustum, (near, far), n, |c, camera| {
+            fitter.fit(camera, fitter.hold(c, n))
+        })
     }
 }
 

@@ -110,28 +110,9 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
     let multisample = vk::PipelineMultisampleStateCreateInfo::default()
         .rasterization_samples(vk::SampleCountFlags::from_raw(d.samples.max(1)));
     let depth = depth_stencil_state(d);
-    let blend_attachment = blend_attachment_state(d);
-    let mut blend_attachments = vec![blend_attachment; d.color_formats.len()];
-    if ctx.independent_blend {
-        for masked in blend_attachments.iter_mut().rev().take(d.masked_targets) {
-            masked.color_write_mask = vk::ColorComponentFlags::empty();
-            // Nothing to blend (and integer targets cannot blend).
-            masked.blend_enable = vk::FALSE;
-        }
-    }
+    let blend_attachments = blend_attachments(ctx, d);
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-    let mut dyn_states = vec![
-        vk::DynamicState::VIEWPORT,
-        vk::DynamicState::SCISSOR,
-        vk::DynamicState::CULL_MODE,
-        vk::DynamicState::FRONT_FACE,
-    ];
-    if d.depth_bias {
-        dyn_states.push(vk::DynamicState::DEPTH_BIAS);
-    }
-    if d.stencil != Stencil::Off {
-        dyn_states.push(vk::DynamicState::STENCIL_REFERENCE);
-    }
+    let dyn_states = dynamic_states(d);
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dyn_states);
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(d.color_formats)
@@ -161,6 +142,42 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
     })?[0];
     ctx.set_name(p, d.name);
     Ok(p)
+}
+
+/// One blend state per colour target; with independent blending, the last `d.masked_targets`
+/// written to by nothing.
+fn blend_attachments(
+    ctx: &Context,
+    d: &PipelineDesc,
+) -> Vec<vk::PipelineColorBlendAttachmentState> {
+    let blend_attachment = blend_attachment_state(d);
+    let mut blend_attachments = vec![blend_attachment; d.color_formats.len()];
+    if ctx.independent_blend {
+        for masked in blend_attachments.iter_mut().rev().take(d.masked_targets) {
+            masked.color_write_mask = vk::ColorComponentFlags::empty();
+            // Nothing to blend (and integer targets cannot blend).
+            masked.blend_enable = vk::FALSE;
+        }
+    }
+    blend_attachments
+}
+
+/// The dynamic states: viewport, scissor, cull mode and front face; depth bias and stencil
+/// reference where `d` uses them.
+fn dynamic_states(d: &PipelineDesc) -> Vec<vk::DynamicState> {
+    let mut dyn_states = vec![
+        vk::DynamicState::VIEWPORT,
+        vk::DynamicState::SCISSOR,
+        vk::DynamicState::CULL_MODE,
+        vk::DynamicState::FRONT_FACE,
+    ];
+    if d.depth_bias {
+        dyn_states.push(vk::DynamicState::DEPTH_BIAS);
+    }
+    if d.stencil != Stencil::Off {
+        dyn_states.push(vk::DynamicState::STENCIL_REFERENCE);
+    }
+    dyn_states
 }
 
 /// Reversed-z depth (`d.depth`; no writes from blended draws) and the stencil test of

@@ -182,8 +182,35 @@ where
         .draw()
         .map_err(e)?;
     draw_points(&mut chart, rows)?;
-    // The front: a staircase through its points, each labelled.
-    let front = pareto_front(&pts);
+    let at: Vec<(i32, i32)> = pts.iter().map(|p| chart.backend_coord(p)).collect();
+    draw_front(&mut chart, rows, &pts, &at)?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// The Pareto front: a staircase through its points, each ringed, and labelled where the label
+/// does not overlap the previous one (`at`: each point's position on the drawing).
+fn draw_front<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    rows: &[Row],
+    pts: &[(f64, f64)],
+    at: &[(i32, i32)],
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let front = pareto_front(pts);
     let mut stair = Vec::new();
     for (k, &i) in front.iter().enumerate() {
         if k > 0 {
@@ -200,7 +227,7 @@ where
     // label.
     let mut labelled: Vec<(usize, (i32, i32))> = Vec::new();
     for &i in &front {
-        let at = chart.backend_coord(&pts[i]);
+        let at = at[i];
         if labelled
             .last()
             .is_none_or(|(_, p)| (p.1 - at.1).abs() >= 16 || (p.0 - at.0).abs() >= 260)
@@ -221,15 +248,6 @@ where
                 + Text::new(short_label(&rows[i]), (10, -7), ("sans-serif", 13))
         }))
         .map_err(e)?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(e)?;
-    root.present().map_err(e)?;
     Ok(())
 }
 
@@ -298,6 +316,17 @@ where
             .label(method)
             .legend(move |(x, y)| Rectangle::new([(x - 6, y - 5), (x + 6, y + 5)], fill));
     }
+    draw_shape_legend(chart)
+}
+
+/// The legend's shape entries (grey, one per filter), carried by empty series.
+fn draw_shape_legend<'a, DB, CT>(chart: &mut ChartContext<'a, DB, CT>) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     let grey = RGBColor(60, 60, 60);
     for (label, shape) in [
         ("nearest", 0),

@@ -357,6 +357,30 @@ fn sphere_square(
     )
 }
 
+/// The receivers' box in light view space (`view`): where the camera's frustum (and the batch's)
+/// meets `scene`, within the scene's light-space box `scene_l`; that box itself without a camera
+/// or where they do not meet.
+fn receiver_box(input: &DirectionalFitInput, view: &Mat4, scene: &Aabb, scene_l: &Aabb) -> Aabb {
+    let receivers_world: Vec<Vec3> = match &input.camera {
+        Some(c) => std::iter::once(c)
+            .chain(input.also)
+            .flat_map(|c| frustum_box_intersection(c, scene))
+            .collect(),
+        None => Vec::new(),
+    };
+    let recv = if receivers_world.is_empty() {
+        *scene_l
+    } else {
+        Aabb::from_points(receivers_world.iter().map(|p| view.transform_point3(*p)))
+            .intersection(scene_l)
+    };
+    if recv.is_empty() {
+        *scene_l
+    } else {
+        recv
+    }
+}
+
 /// Fits an orthographic light projection (see the module documentation).
 pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
     let view = light_view_rotation(input.direction);
@@ -366,22 +390,7 @@ pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
         input.scene_bounds
     };
     let scene_l = scene.transformed(&view);
-    let receivers_world: Vec<Vec3> = match &input.camera {
-        Some(c) => std::iter::once(c)
-            .chain(input.also)
-            .flat_map(|c| frustum_box_intersection(c, &scene))
-            .collect(),
-        None => Vec::new(),
-    };
-    let mut recv = if receivers_world.is_empty() {
-        scene_l
-    } else {
-        Aabb::from_points(receivers_world.iter().map(|p| view.transform_point3(*p)))
-            .intersection(&scene_l)
-    };
-    if recv.is_empty() {
-        recv = scene_l;
-    }
+    let recv = receiver_box(input, &view, &scene, &scene_l);
     let size = input.map_size.max(1) as f32;
     // Guard against a degenerate (flat or point) receiver set.
     let min_extent = (scene.diagonal() * 1e-4).max(1e-4);

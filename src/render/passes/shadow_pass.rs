@@ -484,13 +484,6 @@ impl ShadowPass {
         let Some(map) = &self.map else { return 0 };
         let d = &self.ctx.device;
         let casters = t.casters;
-        let from = casters.light;
-        // A point or spot light's eye and its projection's near distance (clusters wholly
-        // nearer are not drawn); none for a directional light (outside everything).
-        let eye = match from {
-            Viewpoint::Eye(p) => Some((p, t.eye_near)),
-            Viewpoint::Along(_) => None,
-        };
         let mut depth_attachment = depth_clear_attachment(t.view, false);
         if !clear {
             depth_attachment = depth_attachment.load_op(vk::AttachmentLoadOp::LOAD);
@@ -515,44 +508,67 @@ impl ShadowPass {
             );
             Recorder::new(d, cmd).set_scissor(0, &[area]);
             Recorder::new(d, cmd).bind_index_buffer(scene.indices.raw, 0, vk::IndexType::UINT32);
-            for masked in [false, true] {
-                let (pipeline, layout) = match (&self.masked, masked) {
-                    (_, false) => (self.pipeline, self.layout),
-                    (Some(m), true) => (m.pipeline, m.layout),
-                    // No masked pipeline: no masked draws (`ensure_masked`).
-                    (None, true) => break,
-                };
-                let mut bound = false;
-                for dr in draws.iter().map(|&i| scene.draws[i].shadow_caster()) {
-                    if dr.alpha.tests_alpha_in_shadow() != masked {
-                        continue;
-                    }
-                    if !bound {
-                        Recorder::new(d, cmd)
-                            .bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
-                        // Reversed-z: "away from the light" is towards smaller depth, so
-                        // the factor is negated. The constant bias is applied on the
-                        // receiver side, in texels.
-                        Recorder::new(d, cmd).set_depth_bias(0.0, 0.0, -s.slope_bias);
-                        let buffers = [scene.positions.raw, scene.attributes.raw];
-                        let n = if masked { 2 } else { 1 };
-                        Recorder::new(d, cmd).bind_vertex_buffers(0, &buffers[..n], &[0, 0][..n]);
-                        bound = true;
-                    }
-                    if masked {
-                        scene.bind_material(d, cmd, layout, 0, dr.material);
-                    }
-                    let pc = ShadowImmediates {
-                        light_clip_from_world: *t.light_clip_from_world,
-                        world_from_model: dr.world_from_model,
-                    };
-                    let pc = bytemuck::bytes_of(&pc);
-                    scene.record_draw(cmd, layout, &dr, eye, from, pc);
-                    drawn += 1;
-                }
-            }
+            drawn = self.draw_casters(cmd, scene, s, t, draws);
         }
         Recorder::new(d, cmd).end_rendering();
+        drawn
+    }
+
+    /// Records `draws` into the layer's rendering begun by [`Self::draw_layer`]: opaque casters
+    /// with the depth-only pipeline, then the alpha-masked and blended ones. Returns the draws
+    /// recorded.
+    fn draw_casters(
+        &self,
+        cmd: vk::CommandBuffer,
+        scene: &GpuScene,
+        s: &ShadowSettings,
+        t: &LayerTarget,
+        draws: &[usize],
+    ) -> usize {
+        let d = &self.ctx.device;
+        let from = t.casters.light;
+        // A point or spot light's eye and its projection's near distance (clusters wholly
+        // nearer are not drawn); none for a directional light (outside everything).
+        let eye = match from {
+            Viewpoint::Eye(p) => Some((p, t.eye_near)),
+            Viewpoint::Along(_) => None,
+        };
+        let mut drawn = 0;
+        for masked in [false, true] {
+            let (pipeline, layout) = match (&self.masked, masked) {
+                (_, false) => (self.pipeline, self.layout),
+                (Some(m), true) => (m.pipeline, m.layout),
+                // No masked pipeline: no masked draws (`ensure_masked`).
+                (None, true) => break,
+            };
+            let mut bound = false;
+            for dr in draws.iter().map(|&i| scene.draws[i].shadow_caster()) {
+                if dr.alpha.tests_alpha_in_shadow() != masked {
+                    continue;
+                }
+                if !bound {
+                    Recorder::new(d, cmd).bind_pipeline(vk::PipelineBindPoint::GRAPHICS, pipeline);
+                    // Reversed-z: "away from the light" is towards smaller depth, so
+                    // the factor is negated. The constant bias is applied on the
+                    // receiver side, in texels.
+                    Recorder::new(d, cmd).set_depth_bias(0.0, 0.0, -s.slope_bias);
+                    let buffers = [scene.positions.raw, scene.attributes.raw];
+                    let n = if masked { 2 } else { 1 };
+                    Recorder::new(d, cmd).bind_vertex_buffers(0, &buffers[..n], &[0, 0][..n]);
+                    bound = true;
+                }
+                if masked {
+                    scene.bind_material(d, cmd, layout, 0, dr.material);
+                }
+                let pc = ShadowImmediates {
+                    light_clip_from_world: *t.light_clip_from_world,
+                    world_from_model: dr.world_from_model,
+                };
+                let pc = bytemuck::bytes_of(&pc);
+                scene.record_draw(cmd, layout, &dr, eye, from, pc);
+                drawn += 1;
+            }
+        }
         drawn
     }
 }

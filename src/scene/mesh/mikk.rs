@@ -40,6 +40,33 @@ impl mikktspace::Geometry for Unwelded {
     }
 }
 
+/// The bits that must match for corner `k` of `g` (with tangent `t`) to share a vertex with
+/// another: position, normal, uvs, tangent, colour and `source` (0, or the source vertex where
+/// only corners of one source may weld).
+fn weld_key(g: &Unwelded, k: usize, t: Vec4, source: u32) -> [u32; 19] {
+    [
+        g.positions[k].x.to_bits(),
+        g.positions[k].y.to_bits(),
+        g.positions[k].z.to_bits(),
+        g.normals[k].x.to_bits(),
+        g.normals[k].y.to_bits(),
+        g.normals[k].z.to_bits(),
+        g.uvs[k].x.to_bits(),
+        g.uvs[k].y.to_bits(),
+        t.x.to_bits(),
+        t.y.to_bits(),
+        t.z.to_bits(),
+        t.w.to_bits(),
+        g.colors[k].x.to_bits(),
+        g.colors[k].y.to_bits(),
+        g.colors[k].z.to_bits(),
+        g.colors[k].w.to_bits(),
+        g.uvs1[k].x.to_bits(),
+        g.uvs1[k].y.to_bits(),
+        source,
+    ]
+}
+
 /// Generates MikkTSpace tangents (the glTF-specified algorithm) for `p`, with w such that
 /// w·(n × t) points up the image (glTF's convention, as in its sample models); splitting vertices where
 /// the tangent frame differs (UV seams, mirrored halves) and merging identical ones again.
@@ -83,27 +110,7 @@ pub fn generate_mikktspace(p: &mut Primitive) -> bool {
         if !t.is_finite() || t.truncate().length_squared() < 1e-12 {
             t = fallback_tangent(g.normals[k]);
         }
-        let key = [
-            g.positions[k].x.to_bits(),
-            g.positions[k].y.to_bits(),
-            g.positions[k].z.to_bits(),
-            g.normals[k].x.to_bits(),
-            g.normals[k].y.to_bits(),
-            g.normals[k].z.to_bits(),
-            g.uvs[k].x.to_bits(),
-            g.uvs[k].y.to_bits(),
-            t.x.to_bits(),
-            t.y.to_bits(),
-            t.z.to_bits(),
-            t.w.to_bits(),
-            g.colors[k].x.to_bits(),
-            g.colors[k].y.to_bits(),
-            g.colors[k].z.to_bits(),
-            g.colors[k].w.to_bits(),
-            g.uvs1[k].x.to_bits(),
-            g.uvs1[k].y.to_bits(),
-            if keep_sources { p.indices[k] } else { 0 },
-        ];
+        let key = weld_key(&g, k, t, if keep_sources { p.indices[k] } else { 0 });
         let id = *map.entry(key).or_insert_with(|| {
             sources.push(p.indices[k]);
             pos.push(g.positions[k]);

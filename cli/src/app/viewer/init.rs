@@ -32,28 +32,14 @@ impl App {
         let view = self.opts.view.clone();
         let bounds = framing_bounds(&self.opts.scene);
         let controller = Controller::from_camera(&view.camera, &bounds);
-        let lights = effective_lights(&self.opts.scene.lights, &view);
-        let sun_dir = lights
-            .iter()
-            .find(|l| l.kind == LightKind::Directional)
-            .map(|l| l.direction)
-            .unwrap_or(glam::Vec3::NEG_Y);
+        let sun = self.first_sun(&view);
         println!(
             "viewer: {} on {} ({} triangles); press Esc to quit, F1 for the panel",
             self.opts.scene.name,
             ctx.device_name,
             renderer.triangles()
         );
-        let watch = self.opts.path.as_deref().and_then(|p| {
-            crate::app::reload::Watch::new(p)
-                .map_err(|e| eprintln!("warning: {}: not watched for changes: {e}", p.display()))
-                .ok()
-        });
-        let tree = self
-            .opts
-            .path
-            .as_deref()
-            .and_then(|p| files::tree_of(p, &self.opts.scene));
+        let (watch, tree) = self.watch_and_tree();
         let triangles = renderer.triangles();
         Ok(State {
             overlay,
@@ -67,7 +53,7 @@ impl App {
             controller,
             bounds,
             view,
-            sun: SunAngles::from_direction(sun_dir),
+            sun,
             camera_index: None,
             drawn: 0,
             rss_warm: None,
@@ -102,6 +88,39 @@ impl App {
             budget_value: self.opts.shadow_budget,
             worker_problems: 0,
         })
+    }
+
+    /// The sun the panel starts from: the first directional light of `view` (straight down
+    /// without one).
+    fn first_sun(&self, view: &umbra::plan::View) -> SunAngles {
+        let lights = effective_lights(&self.opts.scene.lights, view);
+        let sun_dir = lights
+            .iter()
+            .find(|l| l.kind == LightKind::Directional)
+            .map(|l| l.direction)
+            .unwrap_or(glam::Vec3::NEG_Y);
+        SunAngles::from_direction(sun_dir)
+    }
+
+    /// The model file watched for changes (a warning where it cannot be), and its files' tree
+    /// for the panel.
+    fn watch_and_tree(
+        &self,
+    ) -> (
+        Option<crate::app::reload::Watch>,
+        Option<crate::app::scene_tree::SceneTree>,
+    ) {
+        let watch = self.opts.path.as_deref().and_then(|p| {
+            crate::app::reload::Watch::new(p)
+                .map_err(|e| eprintln!("warning: {}: not watched for changes: {e}", p.display()))
+                .ok()
+        });
+        let tree = self
+            .opts
+            .path
+            .as_deref()
+            .and_then(|p| files::tree_of(p, &self.opts.scene));
+        (watch, tree)
     }
 
     /// The window, a context that can present to it, and the window renderer of the scene.

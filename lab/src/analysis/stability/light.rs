@@ -174,21 +174,9 @@ pub fn contact_gaps(
     for &e in elevations {
         let mut v = sun_view(view, e, 0.0, 1.0);
         v.shadow_fit_camera = Some(view.camera);
-        // The texel at the base, from the plan of the user's view.
-        let plan = planner.plan(&v, size.0, size.1);
-        let base = Vec3::new(0.0, 0.0, -half.z);
-        let eye = view.camera.position();
-        let fwd = view
-            .camera
-            .world_from_view
-            .transform_vector3(Vec3::NEG_Z)
-            .normalize();
-        let depth = (base - eye).dot(fwd);
-        let views = plan.primary_views();
-        let Some(sv) = views.iter().find(|s| depth <= s.far).or(views.last()) else {
+        let Some(texel) = base_texel(planner, &v, half, size) else {
             continue;
         };
-        let texel = sv.texel_world as f64;
         let light = -v.sun_direction.unwrap_or(Vec3::NEG_Y);
         // Observer: straight down over the band behind the base, a quarter texel per pixel.
         let fov = 40f32.to_radians();
@@ -240,6 +228,24 @@ pub fn contact_gaps(
         });
     }
     Ok(rows)
+}
+
+/// The world size of a texel at the wall's base (`half`: the wall's half extents), from the
+/// plan of `v` (the user's camera, the sun set): the shadow view whose range holds the base's
+/// view depth.
+fn base_texel(planner: &ScenePlanner, v: &View, half: Vec3, size: (u32, u32)) -> Option<f64> {
+    let plan = planner.plan(v, size.0, size.1);
+    let base = Vec3::new(0.0, 0.0, -half.z);
+    let eye = v.camera.position();
+    let fwd = v
+        .camera
+        .world_from_view
+        .transform_vector3(Vec3::NEG_Z)
+        .normalize();
+    let depth = (base - eye).dot(fwd);
+    let views = plan.primary_views();
+    let sv = views.iter().find(|s| depth <= s.far).or(views.last())?;
+    Some(sv.texel_world as f64)
 }
 
 /// The pixel of a `w`×`h` frame (`clip`, its inverse, its reversed-z depths) whose centre sees

@@ -200,29 +200,8 @@ fn scene_pipeline(
         &PipelineDesc {
             name: &name,
             layout,
-            vertex: match entry {
-                Entry::Resolve | Entry::ResolveAov => (module, sh::ENTRY_VS_FULLSCREEN_FLAT),
-                Entry::OpaqueFlat | Entry::OpaqueFlatAov => (module, sh::ENTRY_VS_MAIN_FLAT),
-                _ => (module, sh::ENTRY_VS_MAIN),
-            },
-            fragment: Some((
-                module,
-                match entry {
-                    Entry::Opaque => sh::ENTRY_FS_MAIN,
-                    Entry::OpaqueFlat => sh::ENTRY_FS_MAIN_FLAT,
-                    Entry::Masked => sh::ENTRY_FS_MASKED,
-                    Entry::Blended | Entry::BlendedAov => sh::ENTRY_FS_BLEND,
-                    Entry::Debug | Entry::Overdraw => sh::ENTRY_FS_DEBUG,
-                    Entry::Resolve | Entry::ResolveAov => sh::ENTRY_FS_RESOLVE,
-                    Entry::GBuffer => sh::ENTRY_FS_GBUFFER,
-                    Entry::OpaqueAov => sh::ENTRY_FS_MAIN_AOV,
-                    Entry::OpaqueFlatAov => sh::ENTRY_FS_MAIN_FLAT_AOV,
-                    Entry::MaskedAov => sh::ENTRY_FS_MASKED_AOV,
-                    Entry::GBufferAov => sh::ENTRY_FS_GBUFFER_AOV,
-                    Entry::Aov => sh::ENTRY_FS_AOV,
-                    Entry::AovMasked => sh::ENTRY_FS_AOV_MASKED,
-                },
-            )),
+            vertex: (module, vertex_entry(entry)),
+            fragment: Some((module, fragment_entry(entry))),
             bindings: if resolve { &[] } else { &bindings },
             attributes: if resolve { &[] } else { &attributes },
             color_formats: match entry {
@@ -264,4 +243,32 @@ fn scene_pipeline(
             samples: if aov { 1 } else { formats.samples },
         },
     )
+}
+
+/// The vertex shader entry point of camera pipeline `entry`.
+fn vertex_entry(entry: Entry) -> &'static std::ffi::CStr {
+    match entry {
+        Entry::Resolve | Entry::ResolveAov => sh::ENTRY_VS_FULLSCREEN_FLAT,
+        Entry::OpaqueFlat | Entry::OpaqueFlatAov => sh::ENTRY_VS_MAIN_FLAT,
+        _ => sh::ENTRY_VS_MAIN,
+    }
+}
+
+/// The fragment shader entry point of camera pipeline `entry`.
+fn fragment_entry(entry: Entry) -> &'static std::ffi::CStr {
+    match entry {
+        Entry::Opaque => sh::ENTRY_FS_MAIN,
+        Entry::OpaqueFlat => sh::ENTRY_FS_MAIN_FLAT,
+        Entry::Masked => sh::ENTRY_FS_MASKED,
+        Entry::Blended | Entry::BlendedAov => sh::ENTRY_FS_BLEND,
+        Entry::Debug | Entry::Overdraw => sh::ENTRY_FS_DEBUG,
+        Entry::Resolve | Entry::ResolveAov => sh::ENTRY_FS_RESOLVE,
+        Entry::GBuffer => sh::ENTRY_FS_GBUFFER,
+        Entry::OpaqueAov => sh::ENTRY_FS_MAIN_AOV,
+        Entry::OpaqueFlatAov => sh::ENTRY_FS_MAIN_FLAT_AOV,
+        Entry::MaskedAov => sh::ENTRY_FS_MASKED_AOV,
+        Entry::GBufferAov => sh::ENTRY_FS_GBUFFER_AOV,
+        Entry::Aov => sh::ENTRY_FS_AOV,
+        Entry::AovMasked => sh::ENTRY_FS_AOV_MASKED,
+    }
 }

@@ -426,24 +426,7 @@ fn clip_to_alpha(cut: &AlphaCut, poly: &[Point]) -> Clip {
             continue;
         }
         changed = true;
-        let n = out.len();
-        let mut next = Vec::with_capacity(n + 1);
-        for k in 0..n {
-            let (p0, p1) = (out[k], out[(k + 1) % n]);
-            let (f0, f1) = (p0.uv.dot(d) - e, p1.uv.dot(d) - e);
-            if f0 <= 0.0 {
-                next.push(p0);
-            }
-            if (f0 <= 0.0) != (f1 <= 0.0) {
-                let s = f0 / (f0 - f1);
-                next.push(Point {
-                    uv: p0.uv.lerp(p1.uv, s),
-                    w: p0.w.lerp(p1.w, s),
-                    vertex: None,
-                });
-            }
-        }
-        out = next;
+        out = clip_half_plane(&out, d, e);
         if out.len() < 3 {
             return Clip::Empty;
         }
@@ -452,6 +435,29 @@ fn clip_to_alpha(cut: &AlphaCut, poly: &[Point]) -> Clip {
         return Clip::Unchanged;
     }
     Clip::Cut(out)
+}
+
+/// Convex `poly` clipped to the half-plane uv · d ≤ e (Sutherland–Hodgman; new points
+/// interpolated along the edges they cut).
+fn clip_half_plane(poly: &[Point], d: Vec2, e: f32) -> Vec<Point> {
+    let n = poly.len();
+    let mut next = Vec::with_capacity(n + 1);
+    for k in 0..n {
+        let (p0, p1) = (poly[k], poly[(k + 1) % n]);
+        let (f0, f1) = (p0.uv.dot(d) - e, p1.uv.dot(d) - e);
+        if f0 <= 0.0 {
+            next.push(p0);
+        }
+        if (f0 <= 0.0) != (f1 <= 0.0) {
+            let s = f0 / (f0 - f1);
+            next.push(Point {
+                uv: p0.uv.lerp(p1.uv, s),
+                w: p0.w.lerp(p1.w, s),
+                vertex: None,
+            });
+        }
+    }
+    next
 }
 
 /// Appends polygon `poly` (weights over triangle `t` of `src`) to `dst` as a fan of triangles,

@@ -2,13 +2,12 @@
 //! (per frame: command buffer, fence, acquire semaphore, uniform slot; per image: render-finished
 //! semaphore).
 
+mod record;
+
 use super::core::{FrameCore, Targets};
-use super::renderer::{
-    copy_attachment_to_buffer, rgba_from_readback, transfer_to_host_barrier, visible_depths,
-};
+use super::renderer::{rgba_from_readback, transfer_to_host_barrier, visible_depths};
 use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::gpu::Recorder;
 use crate::gpu::{Buffer, Image};
 use crate::plan::settings::SceneOptions;
 use crate::plan::view::{ShadowHold, View};
@@ -18,6 +17,7 @@ use crate::scene::Scene;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use raw_window_handle::{RawDisplayHandle, RawWindowHandle};
+use record::{record_depth_read, record_screenshot_and_overlay, shadow_view_summary};
 use std::ffi::{CStr, CString};
 use std::sync::Arc;
 
@@ -105,7 +105,7 @@ pub enum DrawResult {
 
 /// A frame slot's depth readback buffer and, while a copy is in flight, the camera projection
 /// and pixel count it holds.
-type DepthRead = (Option<Buffer>, Option<(glam::Mat4, usize)>);
+pub(super) type DepthRead = (Option<Buffer>, Option<(glam::Mat4, usize)>);
 
 /// Draws views of a scene into a window's swapchain.
 pub struct WindowRenderer {
@@ -369,10 +369,28 @@ impl WindowRenderer {
         }
         color.transition(d, cmd, Access::Present);
         self.submit(cmd, acquired, fence, index)?;
+        let shot = self.present(f, fence, index, extent, screenshot)?;
+        Ok(DrawResult::Drawn {
+            summary,
+            screenshot: shot,
+        })
+    }
+
+    /// Presents image `index` and moves on from frame slot `f`: with `screenshot`, the copy read
+    /// back (once `fence` signals) where the swapchain can be copied from; a stale swapchain
+    /// recreated.
+    fn present(
+        &mut self,
+        f: usize,
+        fence: vk::Fence,
+        index: u32,
+        extent: vk::Extent2D,
+        screenshot: bool,
+    ) -> Result<Option<image::RgbaImage>, GpuError> {
         let stale = self.swapchain.present(index)?;
         self.frame = (f + 1) % FRAMES_IN_FLIGHT;
         let mut shot = None;
-        if want_copy {
+        if screenshot && self.swapchain.can_copy {
             shot = Some(self.read_screenshot(fence, extent)?);
         } else if screenshot {
             log::warn!(
@@ -383,10 +401,7 @@ impl WindowRenderer {
             let (w, h) = self.wanted;
             self.resize(w, h)?;
         }
-        Ok(DrawResult::Drawn {
-            summary,
-            screenshot: shot,
-        })
+        Ok(shot)
     }
 
     /// The start of a frame: waits for its slot's fence, picks the view it draws
@@ -540,84 +555,6 @@ impl WindowRenderer {
             .ok_or_else(|| GpuError::Unsupported("readback not mapped".into()))?;
         Ok(rgba_from_readback(bytes, extent.width, extent.height, bgra))
     }
-}
-
-/// Records the copy of a frame's depth into its slot's readback buffer, and keeps the camera
-/// projection and pixel count to read it with.
-fn record_depth_read(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    depth: &mut Attachment,
-    read: &mut DepthRead,
-    camera: &crate::scene::Camera,
-    extent: vk::Extent2D,
-) {
-    let buffer = read.0.as_ref().expect("buffer").raw;
-    copy_attachment_to_buffer(d, cmd, depth, vk::ImageAspectFlags::DEPTH, extent, buffer);
-    let aspect = extent.width as f32 / extent.height.max(1) as f32;
-    let pixels = extent.width as usize * extent.height as usize;
-    read.1 = Some((crate::plan::camera_projection(camera, aspect), pixels));
-}
-
-/// Each shadow view's (light, resolution, texel size in world units).
-fn shadow_view_summary(plan: &crate::plan::FramePlan) -> Vec<(usize, u32, f32)> {
-    plan.shadow_views
-        .iter()
-        .map(|v| (v.light, v.res, v.texel_world))
-        .collect()
-}
-
-/// Records the overlay over `color`, and with a screenshot buffer (`shot`: what to capture, where)
-/// the copy of `color` into it: before the overlay for `Capture::Scene` (or with no overlay),
-/// after it for `Capture::Screen`.
-fn record_screenshot_and_overlay(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    color: &mut Attachment,
-    extent: vk::Extent2D,
-    overlay: Option<&mut dyn Overlay>,
-    (capture, shot): (Capture, Option<vk::Buffer>),
-) {
-    let copy = |color: &mut Attachment, buffer| {
-        copy_attachment_to_buffer(d, cmd, color, vk::ImageAspectFlags::COLOR, extent, buffer);
-    };
-    if let Some(b) = shot {
-        if capture == Capture::Scene || overlay.is_none() {
-            copy(color, b);
-        }
-    }
-    if let Some(o) = overlay {
-        record_overlay(d, cmd, color, extent, o);
-        if let (Some(b), Capture::Screen) = (shot, capture) {
-            copy(color, b);
-        }
-    }
-}
-
-/// Records `overlay` into a rendering of `color` (loaded and stored, after the scene's writes).
-fn record_overlay(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    color: &mut Attachment,
-    extent: vk::Extent2D,
-    overlay: &mut dyn Overlay,
-) {
-    color.transition(d, cmd, Access::ColorAttachment);
-    let attachments = [vk::RenderingAttachmentInfo::default()
-        .image_view(color.view)
-        .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-        .load_op(vk::AttachmentLoadOp::LOAD)
-        .store_op(vk::AttachmentStoreOp::STORE)];
-    let rendering = vk::RenderingInfo::default()
-        .render_area(vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent,
-        })
-        .layer_count(1)
-        .color_attachments(&attachments);
-    Recorder::new(d, cmd).begin_rendering(&rendering);
-    overlay.record(cmd, extent);
-    Recorder::new(d, cmd).end_rendering();
 }
 
 impl Drop for WindowRenderer {
