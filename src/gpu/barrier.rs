@@ -34,6 +34,31 @@ pub enum Access {
     Present,
 }
 
+impl Access {
+    /// Whether the access writes the image (a pass's output).
+    pub fn writes(self) -> bool {
+        matches!(
+            self,
+            Access::TransferDst
+                | Access::ColorAttachment
+                | Access::DepthAttachment
+                | Access::DepthResolve
+        )
+    }
+
+    /// Whether the access only reads the image (a pass's input); presentation counts as one.
+    pub fn reads(self) -> bool {
+        matches!(
+            self,
+            Access::TransferSrc
+                | Access::FragmentSampled
+                | Access::DepthFragmentSampled
+                | Access::ComputeSampled
+                | Access::Present
+        )
+    }
+}
+
 /// (stage, access, layout) for an access.
 pub fn access_info(a: Access) -> (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout) {
     use vk::AccessFlags2 as A;
@@ -113,6 +138,22 @@ pub fn image_barrier(
     from: Access,
     to: Access,
 ) {
+    record_dependency(
+        device,
+        cmd,
+        &[],
+        &[barrier_info(image, aspect, mips, from, to)],
+    );
+}
+
+/// The barrier taking mip levels `mips` of `image` from access `from` to `to` (every layer).
+pub fn barrier_info(
+    image: vk::Image,
+    aspect: vk::ImageAspectFlags,
+    mips: std::ops::Range<u32>,
+    from: Access,
+    to: Access,
+) -> vk::ImageMemoryBarrier2<'static> {
     let (src_stage, src_access, old_layout) = access_info(from);
     let (dst_stage, dst_access, new_layout) = access_info(to);
     // A depth-stencil image moves both aspects together, in the combined layouts.
@@ -126,7 +167,7 @@ pub fn image_barrier(
         & (vk::AccessFlags2::TRANSFER_WRITE
             | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
             | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE);
-    let barrier = vk::ImageMemoryBarrier2::default()
+    vk::ImageMemoryBarrier2::default()
         .src_stage_mask(src_stage)
         .src_access_mask(src_access)
         .dst_stage_mask(dst_stage)
@@ -142,26 +183,23 @@ pub fn image_barrier(
             level_count: mips.end - mips.start,
             base_array_layer: 0,
             layer_count: vk::REMAINING_ARRAY_LAYERS,
-        });
-    let barriers = [barrier];
-    let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
-    unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
+        })
 }
 
-/// Records a global memory barrier: writes (and reads) of `src` stages before, accesses of
-/// `dst` after (storage buffers shared by passes, which have no layouts to track).
-pub fn memory_barrier(
+/// Records global memory barriers and image barriers as one dependency (nothing when there are
+/// none).
+pub fn record_dependency(
     device: &ash::Device,
     cmd: vk::CommandBuffer,
-    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    memory: &[vk::MemoryBarrier2<'_>],
+    images: &[vk::ImageMemoryBarrier2<'_>],
 ) {
-    let barrier = [vk::MemoryBarrier2::default()
-        .src_stage_mask(src.0)
-        .src_access_mask(src.1)
-        .dst_stage_mask(dst.0)
-        .dst_access_mask(dst.1)];
-    let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
+    if memory.is_empty() && images.is_empty() {
+        return;
+    }
+    let dep = vk::DependencyInfo::default()
+        .memory_barriers(memory)
+        .image_memory_barriers(images);
     unsafe { device.cmd_pipeline_barrier2(cmd, &dep) };
 }
 

@@ -4,6 +4,7 @@
 
 pub(crate) mod barrier;
 pub(crate) mod context;
+pub(crate) mod graph;
 mod heap;
 pub mod pipeline_cache;
 pub(crate) mod recorder;
@@ -11,5 +12,6 @@ pub(crate) mod resources;
 pub(crate) mod shaders;
 
 pub use context::{Context, ContextDesc, GpuError, RawVulkan, Validation, ValidationLog};
+pub(crate) use graph::{Attachment, BufferAccess, SharedBuffer, Uses};
 pub(crate) use recorder::Recorder;
 pub(crate) use resources::{Buffer, Image};

@@ -6,7 +6,7 @@ use super::device::device_facts;
 use super::gpu_scene::GpuScene;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::gpu::Recorder;
+use crate::gpu::{Recorder, Uses};
 use crate::math::shadow_fit::spot_near;
 use crate::plan::settings::{PostAa, SceneOptions, ShadowFormat, ShadowSettings, ViewMode};
 use crate::plan::view::{Background, View};
@@ -321,17 +321,15 @@ impl FrameCore {
             (ViewMode::Lit, Background::Color(c)) => c.extend(1.0).to_array(),
             _ => CLEAR_COLOR,
         };
-        let mut targets = camera_targets(
+        let targets = camera_targets(
             d,
             cmd,
             (color_target, depth, msaa),
+            aovs.filter(|_| camera.aovs),
             resolve_depth,
             extent,
             clear,
         );
-        if let Some((ids, normals)) = aovs.filter(|_| camera.aovs) {
-            targets.aovs = Some([ids, normals].map(|a| aov_view(d, cmd, a)));
-        }
         let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
         if frame.post_aa {
             self.post.record(cmd, color);
@@ -364,10 +362,11 @@ impl FrameCore {
         (ids, normals, depth): (&mut Attachment, &mut Attachment, &mut Attachment),
     ) -> Result<usize, GpuError> {
         self.camera.ensure_aov_pipelines(&self.gpu, &frame.camera)?;
-        let d = &self.ctx.device;
-        ids.transition(d, cmd, Access::ColorAttachment);
-        normals.transition(d, cmd, Access::ColorAttachment);
-        depth.transition(d, cmd, Access::DepthAttachment);
+        Uses::new()
+            .writes(ids, Access::ColorAttachment)
+            .writes(normals, Access::ColorAttachment)
+            .writes(depth, Access::DepthAttachment)
+            .enter(&self.ctx.device, cmd);
         let targets = AovTargets {
             ids: ids.view,
             normals: normals.view,
@@ -412,43 +411,60 @@ impl FrameCore {
     }
 }
 
-/// Moves the camera pass's attachments into their attachment layouts and names them: the colour
-/// target (or with MSAA the multisampled colour and depth, resolving into the colour target and,
-/// with `resolve_depth`, into `depth`) and the depth.
+/// The camera pass's outputs, declared and named: the colour target (or with MSAA the
+/// multisampled colour and depth, resolving into the colour target and, with `resolve_depth`,
+/// into `depth`), the depth, and the instance ids and normals asked for (`aovs`). An AOV target
+/// not asked for is left unbound (a null view): the draws' writes to it are discarded, which
+/// spares llvmpipe a 16-byte normal per pixel when only ids are read.
 fn camera_targets(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
     (color_target, depth, msaa): (&mut Attachment, &mut Attachment, Option<&mut MsaaTargets>),
+    aovs: Option<(Option<&mut Attachment>, Option<&mut Attachment>)>,
     resolve_depth: bool,
     extent: vk::Extent2D,
     clear: [f32; 4],
 ) -> CameraTargets {
-    color_target.transition(d, cmd, Access::ColorAttachment);
-    let (draw_color, draw_depth, resolve) = match msaa {
+    let (color_view, depth_view) = (color_target.view, depth.view);
+    let uses = Uses::new().writes(color_target, Access::ColorAttachment);
+    let (draw_color, draw_depth, resolve, uses) = match msaa {
         Some(m) => {
-            m.color.transition(d, cmd, Access::ColorAttachment);
-            m.depth.transition(d, cmd, Access::DepthAttachment);
-            if resolve_depth {
-                depth.transition(d, cmd, Access::DepthResolve);
-            }
+            let drawn = (m.color.view, m.depth.view);
+            let uses = uses
+                .writes(&mut m.color, Access::ColorAttachment)
+                .writes(&mut m.depth, Access::DepthAttachment);
             let resolve = Resolve {
-                color: Some(color_target.view),
-                depth: resolve_depth.then_some(depth.view),
+                color: Some(color_view),
+                depth: resolve_depth.then_some(depth_view),
             };
-            (m.color.view, m.depth.view, resolve)
+            let uses = match resolve_depth {
+                true => uses.writes(depth, Access::DepthResolve),
+                false => uses,
+            };
+            (drawn.0, drawn.1, resolve, uses)
         }
         None => {
-            depth.transition(d, cmd, Access::DepthAttachment);
-            (color_target.view, depth.view, Resolve::default())
+            let uses = uses.writes(depth, Access::DepthAttachment);
+            (color_view, depth_view, Resolve::default(), uses)
         }
     };
+    let view = |a: &Option<&mut Attachment>| a.as_ref().map_or(vk::ImageView::null(), |a| a.view);
+    let (aov_views, uses) = match aovs {
+        Some((ids, normals)) => (
+            Some([view(&ids), view(&normals)]),
+            uses.writes_some(ids, Access::ColorAttachment)
+                .writes_some(normals, Access::ColorAttachment),
+        ),
+        None => (None, uses),
+    };
+    uses.enter(d, cmd);
     CameraTargets {
         color: draw_color,
         depth: draw_depth,
         resolve,
         extent,
         clear,
-        aovs: None,
+        aovs: aov_views,
     }
 }
 
@@ -519,16 +535,6 @@ pub struct Targets<'a> {
     /// them (`FrameCore::prepare_with`); left alone by a frame that does not draw them.
     /// Each `None` is an output not asked for: its writes are discarded.
     pub aovs: Option<(Option<&'a mut Attachment>, Option<&'a mut Attachment>)>,
-}
-
-/// An AOV target's view for the camera pass, in attachment layout. A target not asked for is
-/// left unbound (a null view): the draws' writes to it are discarded, which spares llvmpipe a
-/// 16-byte normal per pixel when only ids are read.
-fn aov_view(d: &ash::Device, cmd: vk::CommandBuffer, a: Option<&mut Attachment>) -> vk::ImageView {
-    a.map_or(vk::ImageView::null(), |a| {
-        a.transition(d, cmd, Access::ColorAttachment);
-        a.view
-    })
 }
 
 /// Draws recorded in one frame, after culling.

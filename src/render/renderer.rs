@@ -3,8 +3,8 @@
 use super::core::FrameCore;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::gpu::Recorder;
 use crate::gpu::{Buffer, Image};
+use crate::gpu::{Recorder, Uses};
 use crate::plan::settings::SceneOptions;
 use crate::plan::view::{View, SUPERSAMPLE_FACTORS};
 use crate::plan::FramePlan;
@@ -124,7 +124,7 @@ pub fn copy_attachment_to_buffer(
     extent: vk::Extent2D,
     buffer: vk::Buffer,
 ) {
-    at.transition(d, cmd, Access::TransferSrc);
+    Uses::new().reads(at, Access::TransferSrc).enter(d, cmd);
     copy_to_buffer(d, cmd, at.image, aspect, extent, buffer);
 }
 

@@ -14,10 +14,9 @@
 //! On by default on CPU devices at one sample per pixel (`SceneOptions::deferred`); GPUs shade
 //! 2×2 quads in hardware and keep the forward pass.
 
-use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{allocate_sets, scene as sh, write_sampled_images, ReflectedBinding};
-use crate::gpu::Image;
+use crate::gpu::{Attachment, Image};
 use crate::render::gpu_scene::{AlphaDraw, Draw};
 use crate::render::passes::cull::CameraCull;
 use crate::render::passes::screen::{pixels_per_triangle, screen_rect, PixelRect};
@@ -211,11 +210,11 @@ pub fn plan(
     p
 }
 
-/// The G-buffer targets of one size, their descriptor set (set 2 of the camera layout), and the
-/// access each was last used with.
+/// The G-buffer targets of one size, and their descriptor set (set 2 of the camera layout).
 pub struct GBuffer {
-    images: Vec<Image>,
-    states: Vec<Access>,
+    _images: Vec<Image>,
+    /// The targets, in location order, each with its last access.
+    pub targets: Vec<Attachment>,
     /// Their size.
     pub extent: vk::Extent2D,
     pool: vk::DescriptorPool,
@@ -251,8 +250,8 @@ impl GBuffer {
             .collect();
         write_sampled_images(&ctx.device, set, &targets);
         Ok(Self {
-            states: vec![Access::Undefined; images.len()],
-            images,
+            targets: images.iter().map(Attachment::of).collect(),
+            _images: images,
             extent,
             pool,
             set,
@@ -262,24 +261,7 @@ impl GBuffer {
 
     /// The targets' views, in location order.
     pub fn views(&self) -> Vec<vk::ImageView> {
-        self.images.iter().map(|i| i.view).collect()
-    }
-
-    /// Records barriers taking every target to `to` (after whatever the last frame did with it).
-    pub fn transition(&mut self, cmd: vk::CommandBuffer, to: Access) {
-        for (im, state) in self.images.iter().zip(&mut self.states) {
-            // From the last access: a later frame's writes wait for this one's reads.
-            image_barrier(
-                &self.ctx.device,
-                cmd,
-                im.raw,
-                vk::ImageAspectFlags::COLOR,
-                0..1,
-                *state,
-                to,
-            );
-            *state = to;
-        }
+        self.targets.iter().map(|t| t.view).collect()
     }
 }
 

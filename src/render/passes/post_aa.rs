@@ -11,7 +11,7 @@ use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{allocate_sets, create_module, post as sh, set_layout};
 use crate::gpu::Image;
-use crate::gpu::Recorder;
+use crate::gpu::{Recorder, Uses};
 use crate::render::pipeline::{
     create_layout, create_pipeline, depth_clear_attachment, set_viewport, ColorBlend, Depth,
     PipelineDesc, Stencil,
@@ -180,15 +180,16 @@ impl PostAaPass {
         let d = &ctx.device;
         let extent = scratch.image.extent;
         ctx.begin_label(cmd, "FXAA");
-        scratch
-            .attachment
-            .transition(d, cmd, Access::FragmentSampled);
         let rcp = [1.0 / extent.width as f32, 1.0 / extent.height as f32];
         let bytes: &[u8] = bytemuck::cast_slice(&rcp);
         // Pass 1 copies and marks (marks cleared to 0, so every pixel passes); pass 2 loads both.
         for (pipeline, first) in [(mark, true), (edges, false)] {
-            target.transition(d, cmd, Access::ColorAttachment);
-            scratch.marks.transition(d, cmd, Access::DepthAttachment);
+            // The scene's colour is the input; the target and the marks the outputs.
+            Uses::new()
+                .reads(&mut scratch.attachment, Access::FragmentSampled)
+                .writes(target, Access::ColorAttachment)
+                .writes(&mut scratch.marks, Access::DepthAttachment)
+                .enter(d, cmd);
             let color = [vk::RenderingAttachmentInfo::default()
                 .image_view(target.view)
                 .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)

@@ -5,7 +5,7 @@ use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError};
 use crate::gpu::shaders::{create_module, shadow as sh};
 use crate::gpu::Image;
-use crate::gpu::Recorder;
+use crate::gpu::{Recorder, Uses};
 use crate::plan::settings::{ShadowFormat, ShadowSettings};
 use crate::plan::uniforms::ShadowImmediates;
 use crate::plan::{CasterPlan, Viewpoint};
@@ -305,7 +305,7 @@ impl ShadowPass {
         };
         let layer_side = self.map.as_ref().map_or(1, |m| m.extent.width);
         self.ctx.begin_label(cmd, "shadow depth pass");
-        self.transition_map(cmd, Access::DepthAttachment);
+        self.declare_map(cmd, true);
         let mut drawn = 0;
         for (layer, (light_clip_from_world, casters)) in views.iter().enumerate() {
             let Some(view) = self
@@ -328,7 +328,7 @@ impl ShadowPass {
             }
             drawn += self.record_cached_layer(cmd, scene, s, layer, t, layer_side);
         }
-        self.transition_map(cmd, Access::DepthFragmentSampled);
+        self.declare_map(cmd, false);
         self.ctx.end_label(cmd);
         drawn
     }
@@ -386,10 +386,17 @@ impl ShadowPass {
         drawn
     }
 
-    fn transition_map(&mut self, cmd: vk::CommandBuffer, to: Access) {
-        if let Some(at) = self.map_at.as_mut() {
-            at.transition(&self.ctx.device, cmd, to);
+    /// The map as the pass's output (`drawn`, before the pass draws into it), or handed on as
+    /// the input of the passes that sample it (camera, exact).
+    fn declare_map(&mut self, cmd: vk::CommandBuffer, drawn: bool) {
+        let Some(at) = self.map_at.as_mut() else {
+            return;
+        };
+        match drawn {
+            true => Uses::new().writes(at, Access::DepthAttachment),
+            false => Uses::new().reads(at, Access::DepthFragmentSampled),
         }
+        .enter(&self.ctx.device, cmd);
     }
 
     /// Makes the static-caster cache (same size, format and layers as the map).
@@ -429,12 +436,16 @@ impl ShadowPass {
         };
         let d = &self.ctx.device;
         let (src, dst) = if to_cache {
-            map_at.transition(d, cmd, Access::TransferSrc);
-            cache_at.transition(d, cmd, Access::TransferDst);
+            Uses::new()
+                .reads(map_at, Access::TransferSrc)
+                .writes(cache_at, Access::TransferDst)
+                .enter(d, cmd);
             (map.raw, cache.raw)
         } else {
-            cache_at.transition(d, cmd, Access::TransferSrc);
-            map_at.transition(d, cmd, Access::TransferDst);
+            Uses::new()
+                .reads(cache_at, Access::TransferSrc)
+                .writes(map_at, Access::TransferDst)
+                .enter(d, cmd);
             (cache.raw, map.raw)
         };
         let sub = vk::ImageSubresourceLayers {
@@ -466,7 +477,9 @@ impl ShadowPass {
             vk::ImageLayout::TRANSFER_DST_OPTIMAL,
             &region,
         );
-        map_at.transition(d, cmd, Access::DepthAttachment);
+        Uses::new()
+            .writes(map_at, Access::DepthAttachment)
+            .enter(d, cmd);
     }
 
     /// Draws `draws` of one layer into the map within the casters' area (cleared first when

@@ -11,6 +11,7 @@ use super::{
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{GpuError, VkCheck};
 use crate::gpu::resources::blit_linear;
+use crate::gpu::Uses;
 use crate::plan::view::View;
 use crate::plan::FramePlan;
 use crate::render::core::Targets;
@@ -167,17 +168,24 @@ fn record_readback(
     slot: usize,
 ) {
     let (dw, dh, width, height) = (drawn.width, drawn.height, extent.width, extent.height);
-    t.color_at.transition(d, cmd, Access::TransferSrc);
     let shown = match t.filtered.as_mut() {
         Some((image, at)) => {
-            at.transition(d, cmd, Access::TransferDst);
+            Uses::new()
+                .reads(&mut t.color_at, Access::TransferSrc)
+                .writes(at, Access::TransferDst)
+                .enter(d, cmd);
             // 2:1: each pixel the mean of its 2×2 samples, in linear light.
             let (dw, dh, w, h) = (dw as i32, dh as i32, width as i32, height as i32);
             blit_linear(d, cmd, (t.color.raw, 0, dw, dh), (image.raw, 0, w, h));
-            at.transition(d, cmd, Access::TransferSrc);
+            Uses::new().reads(at, Access::TransferSrc).enter(d, cmd);
             image.raw
         }
-        None => t.color.raw,
+        None => {
+            Uses::new()
+                .reads(&mut t.color_at, Access::TransferSrc)
+                .enter(d, cmd);
+            t.color.raw
+        }
     };
     copy_to_buffer(
         d,

@@ -1,46 +1,15 @@
-//! The images a pass renders into: an attachment that remembers its last access, the
-//! multisampled targets of a camera pass, and the window's swapchain.
+//! The images a pass renders into: the multisampled targets of a camera pass and the window's
+//! swapchain (an `Attachment`, the image and its last access, is `gpu::graph`'s).
 
 #[cfg(feature = "viewer")]
 pub(crate) mod swapchain;
 
-use crate::gpu::barrier::{image_barrier, Access};
 use crate::gpu::context::{Context, GpuError};
+pub(crate) use crate::gpu::Attachment;
 use crate::gpu::Image;
 use crate::render::passes::camera::DEPTH_FORMAT;
 use ash::vk;
 use std::sync::Arc;
-
-/// An image rendered into, with the access it was last used with; `transition` records the
-/// barrier to the next access and remembers it, so no caller tracks layouts by hand.
-pub struct Attachment {
-    /// Image.
-    pub image: vk::Image,
-    /// View.
-    pub view: vk::ImageView,
-    /// Colour or depth.
-    pub aspect: vk::ImageAspectFlags,
-    /// Last access.
-    pub state: Access,
-}
-
-impl Attachment {
-    /// An attachment for a not yet used `Image`.
-    pub fn of(image: &Image) -> Self {
-        Self {
-            image: image.raw,
-            view: image.view,
-            aspect: image.aspect,
-            state: Access::Undefined,
-        }
-    }
-
-    /// Records a barrier from the last access to `to`, and remembers `to`.
-    pub fn transition(&mut self, device: &ash::Device, cmd: vk::CommandBuffer, to: Access) {
-        image_barrier(device, cmd, self.image, self.aspect, 0..1, self.state, to);
-        self.state = to;
-    }
-}
 
 /// The multisampled colour and depth images a camera pass renders into when MSAA is on; it
 /// resolves them into the target's single-sample images.

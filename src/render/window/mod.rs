@@ -8,7 +8,7 @@ use super::core::{FrameCore, Targets};
 use super::renderer::{rgba_from_readback, transfer_to_host_barrier, visible_depths};
 use crate::gpu::barrier::{access_info, Access};
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::gpu::{Buffer, Image};
+use crate::gpu::{Buffer, Image, Uses};
 use crate::plan::settings::SceneOptions;
 use crate::plan::view::{ShadowHold, View};
 use crate::render::targets::swapchain::Swapchain;
@@ -367,7 +367,7 @@ impl WindowRenderer {
         if fit || want_copy {
             transfer_to_host_barrier(d, cmd);
         }
-        color.transition(d, cmd, Access::Present);
+        Uses::new().reads(&mut color, Access::Present).enter(d, cmd);
         self.submit(cmd, acquired, fence, index)?;
         let shot = self.present(f, fence, index, extent, screenshot)?;
         Ok(DrawResult::Drawn {

@@ -3,7 +3,7 @@
 
 use super::{Capture, DepthRead, Overlay};
 use crate::gpu::barrier::Access;
-use crate::gpu::Recorder;
+use crate::gpu::{Recorder, Uses};
 use crate::render::renderer::copy_attachment_to_buffer;
 use crate::render::targets::Attachment;
 use ash::vk;
@@ -68,7 +68,9 @@ fn record_overlay(
     extent: vk::Extent2D,
     overlay: &mut dyn Overlay,
 ) {
-    color.transition(d, cmd, Access::ColorAttachment);
+    Uses::new()
+        .writes(color, Access::ColorAttachment)
+        .enter(d, cmd);
     let attachments = [vk::RenderingAttachmentInfo::default()
         .image_view(color.view)
         .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)

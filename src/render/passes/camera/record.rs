@@ -4,7 +4,7 @@
 use super::*;
 use crate::gpu::barrier::Access;
 use crate::gpu::resources::has_stencil;
-use crate::gpu::Recorder;
+use crate::gpu::{Recorder, Uses};
 use crate::render::gpu_scene::GpuScene;
 use crate::render::passes::cull::{CameraCull, Entry};
 use crate::render::passes::deferred::{self, DeferPlan};
@@ -181,7 +181,9 @@ impl CameraPass {
             return 0;
         };
         ctx.begin_label(cmd, "G-buffer");
-        gbuffer.transition(cmd, Access::ColorAttachment);
+        Uses::new()
+            .writes_each(&mut gbuffer.targets, Access::ColorAttachment)
+            .enter(d, cmd);
         let views = gbuffer.views();
         // With the ids and normals, those first (cleared; the forward pass keeps them).
         let aovs = targets.aovs;
@@ -234,7 +236,10 @@ impl CameraPass {
         }
         Recorder::new(d, cmd).end_rendering();
         if let Some(g) = self.gbuffer.as_mut() {
-            g.transition(cmd, Access::FragmentSampled);
+            // Handed on to the resolve draws, which read them with `textureLoad`.
+            Uses::new()
+                .reads_each(&mut g.targets, Access::FragmentSampled)
+                .enter(d, cmd);
         }
         gbuffer_written(d, cmd, aovs.is_some());
         ctx.end_label(cmd);

@@ -5,11 +5,10 @@
 //! the triangles never pulled are the saving.
 
 use super::{caster_column, compute_pipeline, record::bind, ExactImmediates};
-use crate::gpu::barrier::memory_barrier;
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::resources::Buffer;
 use crate::gpu::shaders::exact as sh;
-use crate::gpu::Recorder;
+use crate::gpu::{BufferAccess, Recorder, SharedBuffer, Uses};
 use crate::plan::ExactPlan;
 use crate::render::gpu_scene::GpuScene;
 use ash::vk;
@@ -29,15 +28,15 @@ pub(super) struct Culling {
     /// `cs_thin`: the thin-caster mask, before binning.
     thin_pipeline: vk::Pipeline,
     /// The thin-caster mask: a bit per map texel.
-    pub thin: Buffer,
+    pub thin: SharedBuffer,
     thin_capacity: u64,
     /// Kept triangle indices, a slot per caster triangle of the frame.
-    pub kept: Buffer,
+    pub kept: SharedBuffer,
     /// Indirect draw arguments, 16 bytes per caster draw.
-    pub args: Buffer,
+    pub args: SharedBuffer,
     /// Per frame in flight, the arguments copied back to the host (the triangles kept:
     /// [`Culling::kept_triangles`]).
-    readback: Vec<Buffer>,
+    readback: Vec<SharedBuffer>,
     kept_capacity: u64,
     args_capacity: u64,
 }
@@ -123,95 +122,84 @@ impl Culling {
     /// The bindings of the culling buffers, for a set write.
     pub fn bindings(&self) -> [(&'static crate::gpu::shaders::ReflectedBinding, vk::Buffer); 4] {
         [
-            (&sh::THIN, self.thin.raw),
-            (&sh::KEPT, self.kept.raw),
-            (&sh::DRAW_ARGS, self.args.raw),
-            (&sh::KEPT_READ, self.kept.raw),
+            (&sh::THIN, self.thin.raw()),
+            (&sh::KEPT, self.kept.raw()),
+            (&sh::DRAW_ARGS, self.args.raw()),
+            (&sh::KEPT_READ, self.kept.raw()),
         ]
     }
 
-    /// Zeroes the indirect arguments and the thin-caster mask (before the frame's first compute
-    /// step).
+    /// The fills' uses: the indirect arguments and the thin-caster mask, zeroed by
+    /// [`Culling::clear`] before the frame's first compute step.
+    pub fn fills<'a>(&'a mut self, uses: Uses<'a>) -> Uses<'a> {
+        uses.writes_buffer(&mut self.args, BufferAccess::TransferWrite)
+            .writes_buffer(&mut self.thin, BufferAccess::TransferWrite)
+    }
+
+    /// Zeroes the indirect arguments and the thin-caster mask (after [`Culling::fills`]).
     pub fn clear(&self, cmd: vk::CommandBuffer) {
         let r = Recorder::new(&self.ctx.device, cmd);
-        r.fill_buffer(self.args.raw, 0, vk::WHOLE_SIZE, 0);
-        r.fill_buffer(self.thin.raw, 0, vk::WHOLE_SIZE, 0);
+        r.fill_buffer(self.args.raw(), 0, vk::WHOLE_SIZE, 0);
+        r.fill_buffer(self.thin.raw(), 0, vk::WHOLE_SIZE, 0);
     }
 
     /// Marks the thin-caster mask under `f`'s thin and alpha-tested caster triangles (after the
     /// mask is cleared, before binning reads it).
     pub fn record_thin(
-        &self,
+        &mut self,
         cmd: vk::CommandBuffer,
         set: vk::DescriptorSet,
         scene: &GpuScene,
         f: &ExactPlan,
     ) {
+        Uses::new()
+            .writes_buffer(&mut self.thin, BufferAccess::ComputeWrite)
+            .enter(&self.ctx.device, cmd);
         self.dispatch_casters(cmd, set, scene, f, self.thin_pipeline);
-        use vk::AccessFlags2 as A;
-        use vk::PipelineStageFlags2 as S;
-        memory_barrier(
-            &self.ctx.device,
-            cmd,
-            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
-            (
-                S::COMPUTE_SHADER,
-                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-            ),
-        );
     }
 
-    /// Culls each caster draw of `f` (after binning has marked the tiles), then makes the kept
-    /// triangles and the arguments visible to the caster pass. Returns each draw's first kept
-    /// slot, in `f.casters`' order.
-    /// Slot `slot`'s arguments are copied back for the host ([`Culling::kept_triangles`]).
+    /// Culls each caster draw of `f` against the `tiles` binning marked, then copies the
+    /// arguments back for the host (slot `slot`: [`Culling::kept_triangles`]). Returns each
+    /// draw's first kept slot, in `f.casters`' order.
     pub fn record(
-        &self,
+        &mut self,
         cmd: vk::CommandBuffer,
         set: vk::DescriptorSet,
         scene: &GpuScene,
-        f: &ExactPlan,
+        (f, tiles): (&ExactPlan, &mut SharedBuffer),
         slot: usize,
     ) -> Vec<u32> {
+        let d = &self.ctx.device;
+        Uses::new()
+            .reads_buffer(tiles, BufferAccess::ComputeRead)
+            .writes_buffer(&mut self.args, BufferAccess::ComputeWrite)
+            .writes_buffer(&mut self.kept, BufferAccess::ComputeWrite)
+            .enter(d, cmd);
         let first = self.dispatch_casters(cmd, set, scene, f, self.pipeline);
-        use vk::AccessFlags2 as A;
-        use vk::PipelineStageFlags2 as S;
-        // The arguments to the caster pass and to the copy; the copy also after the slot's
-        // previous one.
-        memory_barrier(
-            &self.ctx.device,
-            cmd,
-            (
-                S::COMPUTE_SHADER | S::ALL_TRANSFER,
-                A::SHADER_STORAGE_WRITE | A::TRANSFER_WRITE,
-            ),
-            (
-                S::DRAW_INDIRECT | S::VERTEX_SHADER | S::ALL_TRANSFER,
-                A::INDIRECT_COMMAND_READ
-                    | A::SHADER_STORAGE_READ
-                    | A::TRANSFER_READ
-                    | A::TRANSFER_WRITE,
-            ),
-        );
+        let back = &mut self.readback[slot];
+        Uses::new()
+            .reads_buffer(&mut self.args, BufferAccess::TransferRead)
+            .writes_buffer(back, BufferAccess::TransferWrite)
+            .enter(d, cmd);
         let region = vk::BufferCopy::default().size(16 * f.casters.len().max(1) as u64);
-        Recorder::new(&self.ctx.device, cmd).copy_buffer(
-            self.args.raw,
-            self.readback[slot].raw,
-            &[region],
-        );
-        memory_barrier(
-            &self.ctx.device,
-            cmd,
-            (S::ALL_TRANSFER, A::TRANSFER_WRITE),
-            (S::HOST, A::HOST_READ),
-        );
+        Recorder::new(d, cmd).copy_buffer(self.args.raw(), back.raw(), &[region]);
+        Uses::new()
+            .reads_buffer(back, BufferAccess::HostRead)
+            .enter(d, cmd);
         first
+    }
+
+    /// The caster pass's uses: the arguments of its indirect draws and the kept triangles its
+    /// vertex shader reads.
+    pub fn caster_inputs<'a>(&'a mut self, uses: Uses<'a>) -> Uses<'a> {
+        uses.reads_buffer(&mut self.args, BufferAccess::Indirect)
+            .reads_buffer(&mut self.kept, BufferAccess::VertexRead)
     }
 
     /// The caster triangles slot `slot`'s culling kept for `draws` caster draws (its frame
     /// completed): six vertices each in the indirect arguments.
     pub fn kept_triangles(&mut self, slot: usize, draws: usize) -> Option<u64> {
-        let bytes = self.readback.get_mut(slot)?.mapped()?;
+        let bytes = self.readback.get_mut(slot)?.buffer.mapped()?;
         let words: &[u32] = bytemuck::try_cast_slice(bytes.get(..16 * draws)?).ok()?;
         Some(words.chunks_exact(4).map(|a| u64::from(a[0] / 6)).sum())
     }
@@ -268,7 +256,11 @@ impl Culling {
 }
 
 /// Buffers for `triangles` kept slots and `draws` argument records.
-fn buffers(ctx: &Arc<Context>, triangles: u64, draws: u64) -> Result<(Buffer, Buffer), GpuError> {
+fn buffers(
+    ctx: &Arc<Context>,
+    triangles: u64,
+    draws: u64,
+) -> Result<(SharedBuffer, SharedBuffer), GpuError> {
     let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
     let kept = Buffer::new(
         ctx,
@@ -284,11 +276,15 @@ fn buffers(ctx: &Arc<Context>, triangles: u64, draws: u64) -> Result<(Buffer, Bu
         usage | vk::BufferUsageFlags::INDIRECT_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
         MemoryLocation::GpuOnly,
     )?;
-    Ok((kept, args))
+    Ok((SharedBuffer::new(kept), SharedBuffer::new(args)))
 }
 
 /// Host-readable copies of `draws` argument records, one per frame in flight.
-fn readback_buffers(ctx: &Arc<Context>, draws: u64, slots: usize) -> Result<Vec<Buffer>, GpuError> {
+fn readback_buffers(
+    ctx: &Arc<Context>,
+    draws: u64,
+    slots: usize,
+) -> Result<Vec<SharedBuffer>, GpuError> {
     (0..slots)
         .map(|i| {
             Buffer::new(
@@ -298,12 +294,13 @@ fn readback_buffers(ctx: &Arc<Context>, draws: u64, slots: usize) -> Result<Vec<
                 vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuToCpu,
             )
+            .map(SharedBuffer::new)
         })
         .collect()
 }
 
 /// The thin-caster mask of `tiles` words.
-fn thin_buffer(ctx: &Arc<Context>, tiles: u64) -> Result<Buffer, GpuError> {
+fn thin_buffer(ctx: &Arc<Context>, tiles: u64) -> Result<SharedBuffer, GpuError> {
     Buffer::new(
         ctx,
         "hybrid thin casters",
@@ -311,6 +308,7 @@ fn thin_buffer(ctx: &Arc<Context>, tiles: u64) -> Result<Buffer, GpuError> {
         vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
         MemoryLocation::GpuOnly,
     )
+    .map(SharedBuffer::new)
 }
 
 impl Drop for Culling {

@@ -27,7 +27,7 @@ use crate::gpu::resources::Buffer;
 use crate::gpu::shaders::{
     allocate_sets, create_module, exact as sh, set_layout_for, write_buffers,
 };
-use crate::gpu::Image;
+use crate::gpu::{Image, SharedBuffer};
 use crate::plan::{ExactMode, ExactPlan};
 use crate::render::gpu_scene::{vertex_layout, GpuScene};
 use crate::render::pipeline::{
@@ -108,12 +108,12 @@ struct Targets {
     position: Attachment,
     normal: Attachment,
     depth: Attachment,
-    heads: Buffer,
-    next: Buffer,
-    samples: Buffer,
-    rays: Buffer,
+    heads: SharedBuffer,
+    next: SharedBuffer,
+    samples: SharedBuffer,
+    rays: SharedBuffer,
     /// Hybrid shadows: a bit per tile of cells holding a traced sample.
-    tiles: Buffer,
+    tiles: SharedBuffer,
 }
 
 /// The exact shadow pass.
@@ -223,7 +223,7 @@ impl ExactPass {
     pub fn samples(&self) -> vk::Buffer {
         self.targets
             .as_ref()
-            .map_or(self.empty.raw, |t| t.samples.raw)
+            .map_or(self.empty.raw, |t| t.samples.raw())
     }
 
     /// Grows the hybrid method's culling buffers to `f`'s casters (rewriting every slot's

@@ -2,8 +2,8 @@
 //! the grid of light views, the casters drawn into the grid.
 
 use super::*;
-use crate::gpu::barrier::{memory_barrier, Access};
-use crate::gpu::Recorder;
+use crate::gpu::barrier::Access;
+use crate::gpu::{BufferAccess, Recorder, Uses};
 use crate::math::ray::RAY_OFFSET_RELATIVE;
 use crate::plan::Viewpoint;
 use crate::plan::{ExactMode, ExactPlan};
@@ -21,29 +21,28 @@ impl ExactPass {
         let d = &ctx.device;
         let set = self.sets[slot];
         let mut t = self.targets.take().expect("exact targets made by ensure");
-        use vk::AccessFlags2 as A;
-        use vk::PipelineStageFlags2 as S;
-        // The previous frame's reads and writes of the lists and samples come first.
-        memory_barrier(
-            d,
-            cmd,
-            (
-                S::DRAW_INDIRECT | S::VERTEX_SHADER | S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
-                A::INDIRECT_COMMAND_READ | A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-            ),
-            (
-                S::ALL_TRANSFER | S::COMPUTE_SHADER,
-                A::TRANSFER_WRITE | A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-            ),
-        );
-        Recorder::new(d, cmd).fill_buffer(t.heads.raw, 0, vk::WHOLE_SIZE, 0);
-        if f.hybrid.is_some() {
-            Recorder::new(d, cmd).fill_buffer(t.tiles.raw, 0, vk::WHOLE_SIZE, 0);
+        let hybrid = f.hybrid.is_some();
+        // The fills come after the previous frame's uses of the grid, the tiles, the arguments
+        // and the mask.
+        let fills = Uses::new().writes_buffer(&mut t.heads, BufferAccess::TransferWrite);
+        match hybrid {
+            true => self
+                .culling
+                .fills(fills.writes_buffer(&mut t.tiles, BufferAccess::TransferWrite)),
+            false => fills,
+        }
+        .enter(d, cmd);
+        Recorder::new(d, cmd).fill_buffer(t.heads.raw(), 0, vk::WHOLE_SIZE, 0);
+        if hybrid {
+            Recorder::new(d, cmd).fill_buffer(t.tiles.raw(), 0, vk::WHOLE_SIZE, 0);
             self.culling.clear(cmd);
         }
         self.record_receivers(cmd, set, scene, f, &mut t);
         let groups = (t.extent.width.div_ceil(8), t.extent.height.div_ceil(8));
         if let ExactMode::Contact { .. } = f.mode {
+            Uses::new()
+                .writes_buffer(&mut t.samples, BufferAccess::ComputeWrite)
+                .enter(d, cmd);
             bind(
                 d,
                 self.layout,
@@ -52,34 +51,19 @@ impl ExactPass {
                 set,
             );
             Recorder::new(d, cmd).dispatch(groups.0, groups.1, 1);
-            memory_barrier(
-                d,
-                cmd,
-                (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
-                (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
-            );
+            hand_on_samples(d, cmd, &mut t);
             self.targets = Some(t);
             return;
         }
-        if f.hybrid.is_some() {
-            // After the fills (the binning barrier's first half orders them first).
-            memory_barrier(
-                d,
-                cmd,
-                (S::ALL_TRANSFER, A::TRANSFER_WRITE),
-                (
-                    S::COMPUTE_SHADER,
-                    A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-                ),
-            );
+        if hybrid {
             self.culling.record_thin(cmd, set, scene, f);
         }
-        self.record_binning(cmd, set, groups);
-        let kept = f
-            .hybrid
-            .is_some()
-            .then(|| self.culling.record(cmd, set, scene, f, slot));
-        self.record_casters(cmd, set, scene, f, kept.as_deref());
+        self.record_binning(cmd, set, groups, (&mut t, hybrid));
+        let kept = hybrid.then(|| {
+            self.culling
+                .record(cmd, set, scene, (f, &mut t.tiles), slot)
+        });
+        self.record_casters(cmd, set, scene, f, (kept.as_deref(), &mut t));
         self.targets = Some(t);
     }
 
@@ -94,9 +78,11 @@ impl ExactPass {
     ) {
         let ctx = &self.ctx;
         let d = &ctx.device;
-        t.position.transition(d, cmd, Access::ColorAttachment);
-        t.normal.transition(d, cmd, Access::ColorAttachment);
-        t.depth.transition(d, cmd, Access::DepthAttachment);
+        Uses::new()
+            .writes(&mut t.position, Access::ColorAttachment)
+            .writes(&mut t.normal, Access::ColorAttachment)
+            .writes(&mut t.depth, Access::DepthAttachment)
+            .enter(d, cmd);
         let clear = |view| {
             vk::RenderingAttachmentInfo::default()
                 .image_view(view)
@@ -148,24 +134,35 @@ impl ExactPass {
             );
         }
         Recorder::new(d, cmd).end_rendering();
-        t.position.transition(d, cmd, Access::ComputeSampled);
-        t.normal.transition(d, cmd, Access::ComputeSampled);
+        // Inputs of the binning step.
+        Uses::new()
+            .reads(&mut t.position, Access::ComputeSampled)
+            .reads(&mut t.normal, Access::ComputeSampled)
+            .enter(d, cmd);
     }
 
-    /// Step 2: each pixel's shadow ray binned into the grid of light views (`groups` of 8×8).
-    fn record_binning(&self, cmd: vk::CommandBuffer, set: vk::DescriptorSet, groups: (u32, u32)) {
+    /// Step 2: each pixel's shadow ray binned into the grid of light views (`groups` of 8×8);
+    /// with hybrid shadows, the tiles holding a traced sample marked, after the thin-caster mask.
+    fn record_binning(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        set: vk::DescriptorSet,
+        groups: (u32, u32),
+        (t, hybrid): (&mut Targets, bool),
+    ) {
         let d = &self.ctx.device;
-        use vk::AccessFlags2 as A;
-        use vk::PipelineStageFlags2 as S;
-        memory_barrier(
-            d,
-            cmd,
-            (S::ALL_TRANSFER, A::TRANSFER_WRITE),
-            (
-                S::COMPUTE_SHADER,
-                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-            ),
-        );
+        let uses = Uses::new()
+            .writes_buffer(&mut t.heads, BufferAccess::ComputeWrite)
+            .writes_buffer(&mut t.next, BufferAccess::ComputeWrite)
+            .writes_buffer(&mut t.samples, BufferAccess::ComputeWrite)
+            .writes_buffer(&mut t.rays, BufferAccess::ComputeWrite);
+        match hybrid {
+            true => uses
+                .writes_buffer(&mut t.tiles, BufferAccess::ComputeWrite)
+                .reads_buffer(&mut self.culling.thin, BufferAccess::ComputeRead),
+            false => uses,
+        }
+        .enter(d, cmd);
         bind(
             d,
             self.layout,
@@ -174,32 +171,31 @@ impl ExactPass {
             set,
         );
         Recorder::new(d, cmd).dispatch(groups.0, groups.1, 1);
-        memory_barrier(
-            d,
-            cmd,
-            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
-            (
-                S::VERTEX_SHADER | S::FRAGMENT_SHADER,
-                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-            ),
-        );
     }
 
     /// Step 3: the casters drawn into the grid (no attachments: the fragments only test and mark
     /// the rays they hit), then made visible to the camera pass's fragments. With `kept` (hybrid
     /// shadows: each draw's first kept triangle), only the triangles culling kept, indirectly.
     fn record_casters(
-        &self,
+        &mut self,
         cmd: vk::CommandBuffer,
         set: vk::DescriptorSet,
         scene: &GpuScene,
         f: &ExactPlan,
-        kept: Option<&[u32]>,
+        (kept, t): (Option<&[u32]>, &mut Targets),
     ) {
-        let ctx = &self.ctx;
+        let ctx = self.ctx.clone();
         let d = &ctx.device;
-        use vk::AccessFlags2 as A;
-        use vk::PipelineStageFlags2 as S;
+        let uses = Uses::new()
+            .reads_buffer(&mut t.heads, BufferAccess::FragmentRead)
+            .reads_buffer(&mut t.next, BufferAccess::FragmentRead)
+            .reads_buffer(&mut t.rays, BufferAccess::FragmentRead)
+            .writes_buffer(&mut t.samples, BufferAccess::FragmentWrite);
+        match kept {
+            Some(_) => self.culling.caster_inputs(uses),
+            None => uses,
+        }
+        .enter(d, cmd);
         let side = grid_side(f.views.len());
         let grid = vk::Extent2D {
             width: side,
@@ -219,7 +215,7 @@ impl ExactPass {
             (vk::PipelineBindPoint::GRAPHICS, self.caster),
             set,
         );
-        set_viewport(ctx, cmd, grid);
+        set_viewport(&ctx, cmd, grid);
         Recorder::new(d, cmd).set_cull_mode(vk::CullModeFlags::NONE);
         Recorder::new(d, cmd).set_front_face(vk::FrontFace::COUNTER_CLOCKWISE);
         for (slot, &i) in f.casters.iter().enumerate() {
@@ -244,7 +240,7 @@ impl ExactPass {
                 // Six vertices a triangle: the triangle grown (or its box's two halves).
                 match kept {
                     Some(_) => Recorder::new(d, cmd).draw_indirect(
-                        self.culling.args.raw,
+                        self.culling.args.raw(),
                         16 * slot as u64,
                         1,
                         16,
@@ -254,14 +250,15 @@ impl ExactPass {
             }
         }
         Recorder::new(d, cmd).end_rendering();
-        // The verdicts, for the camera pass's fragments.
-        memory_barrier(
-            d,
-            cmd,
-            (S::FRAGMENT_SHADER, A::SHADER_STORAGE_WRITE),
-            (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
-        );
+        hand_on_samples(d, cmd, t);
     }
+}
+
+/// The verdicts handed on to their reader, the camera pass's fragments.
+fn hand_on_samples(d: &ash::Device, cmd: vk::CommandBuffer, t: &mut Targets) {
+    Uses::new()
+        .reads_buffer(&mut t.samples, BufferAccess::FragmentRead)
+        .enter(d, cmd);
 }
 
 /// Binds `pipeline` at `point` with the frame's set `set` (set 0 of `layout`).

@@ -4,7 +4,7 @@ use super::*;
 use crate::gpu::context::{GpuError, VkCheck};
 use crate::gpu::resources::Buffer;
 use crate::gpu::shaders::{exact as sh, write_buffers, write_sampled_images};
-use crate::gpu::Image;
+use crate::gpu::{Image, SharedBuffer};
 use crate::render::gpu_scene::GpuScene;
 use crate::render::targets::Attachment;
 use ash::vk;
@@ -40,6 +40,7 @@ impl ExactPass {
                 vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             )
+            .map(SharedBuffer::new)
         };
         let t = Targets {
             extent,
@@ -73,12 +74,12 @@ impl ExactPass {
             set,
             &[
                 (&sh::XF, self.uniforms[slot].raw),
-                (&sh::HEADS, t.heads.raw),
-                (&sh::NEXT, t.next.raw),
-                (&sh::SAMPLES, t.samples.raw),
-                (&sh::RAYS, t.rays.raw),
-                (&sh::TILES, t.tiles.raw),
-                (&sh::TILES_READ, t.tiles.raw),
+                (&sh::HEADS, t.heads.raw()),
+                (&sh::NEXT, t.next.raw()),
+                (&sh::SAMPLES, t.samples.raw()),
+                (&sh::RAYS, t.rays.raw()),
+                (&sh::TILES, t.tiles.raw()),
+                (&sh::TILES_READ, t.tiles.raw()),
                 (&sh::POSITIONS, scene.positions.raw),
                 (&sh::INDICES, scene.indices.raw),
                 (&sh::ATTRIBUTES, scene.attributes.raw),
