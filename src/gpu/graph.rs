@@ -194,6 +194,14 @@ impl<'a> Uses<'a> {
         self
     }
 
+    /// An input that may be absent (a map not made yet, a pass not run this frame).
+    pub fn reads_some(self, image: Option<&'a mut Attachment>, access: Access) -> Self {
+        match image {
+            Some(image) => self.reads(image, access),
+            None => self,
+        }
+    }
+
     /// An output: `image` written with `access`.
     pub fn writes(mut self, image: &'a mut Attachment, access: Access) -> Self {
         debug_assert!(access.writes(), "{access:?} is not a write");
@@ -232,6 +240,18 @@ impl<'a> Uses<'a> {
         debug_assert!(!access.info().2, "{access:?} is not a read");
         self.buffers.push((&mut buffer.state, access));
         self
+    }
+
+    /// A shared buffer read that may be absent.
+    pub fn reads_buffer_some(
+        self,
+        buffer: Option<&'a mut SharedBuffer>,
+        access: BufferAccess,
+    ) -> Self {
+        match buffer {
+            Some(buffer) => self.reads_buffer(buffer, access),
+            None => self,
+        }
     }
 
     /// A shared buffer written (`access` a write).

@@ -6,14 +6,16 @@ use super::device::device_facts;
 use super::gpu_scene::GpuScene;
 use crate::gpu::barrier::Access;
 use crate::gpu::context::{Context, GpuError, VkCheck};
-use crate::gpu::{Recorder, Uses};
+use crate::gpu::{BufferAccess, Recorder, Uses};
 use crate::math::shadow_fit::spot_near;
 use crate::plan::settings::{PostAa, SceneOptions, ShadowFormat, ShadowSettings, ViewMode};
 use crate::plan::view::{Background, View};
 use crate::plan::ExactPlan;
 use crate::plan::CLEAR_COLOR;
 use crate::plan::{plan_frame, FramePlan, PlanScene, PlanTarget};
-use crate::render::passes::camera::{AovTargets, CameraFrame, CameraPass, CameraTargets, Resolve};
+use crate::render::passes::camera::{
+    AovTargets, CameraFrame, CameraPass, CameraTargets, Redrawn, Resolve,
+};
 use crate::render::passes::cull::CameraCull;
 use crate::render::passes::exact::ExactPass;
 use crate::render::passes::post_aa::PostAaPass;
@@ -264,8 +266,7 @@ impl FrameCore {
     /// Records the shadow pass and the camera pass of a prepared frame with timestamps (the
     /// camera pass's time includes post-process anti-aliasing, which draws the camera pass's
     /// image into `targets.color` when the frame has it); leaves `targets.color` as a colour
-    /// attachment and `targets.depth` as a depth attachment. Returns
-    /// what was drawn.
+    /// attachment and `targets.depth` as a depth attachment. Returns what was drawn.
     pub fn record(
         &mut self,
         cmd: vk::CommandBuffer,
@@ -295,20 +296,7 @@ impl FrameCore {
             Recorder::new(d, cmd).reset_query_pool(self.query_pool, q, 3);
         }
         self.timestamp(cmd, vk::PipelineStageFlags2::TOP_OF_PIPE, q);
-        let views: Vec<_> = plan
-            .shadow_views
-            .iter()
-            .map(|v| (v.light_clip_from_world, &v.casters))
-            .collect();
-        // How far from a point or spot light its projection's near plane reaches (near
-        // distance × √(1 + 2·tan²) for the widest point face, tan ≤ 4/3).
-        let near = 2.2 * spot_near(&self.gpu.bounds);
-        let casters = self
-            .shadow
-            .record(cmd, &self.gpu, &frame.shadow, &views, near);
-        if let (Some(inputs), Some(pass)) = (&plan.exact, self.exact.as_mut()) {
-            pass.record(cmd, slot, &self.gpu, inputs);
-        }
+        let casters = self.record_shadows(cmd, frame);
         self.timestamp(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, q + 1);
         // With post-process AA the camera pass draws into the pass's source image.
         let color_target: &mut Attachment = if frame.post_aa {
@@ -316,21 +304,26 @@ impl FrameCore {
         } else {
             &mut *color
         };
-        let clear = match (frame.mode, plan.background) {
-            (ViewMode::Overdraw, _) => [0.0, 0.0, 0.0, 1.0],
-            (ViewMode::Lit, Background::Color(c)) => c.extend(1.0).to_array(),
-            _ => CLEAR_COLOR,
+        let clear = clear_color(frame.mode, plan.background);
+        // The camera pass reads the map and, on an exact or hybrid frame, the verdicts.
+        let verdicts = match plan.exact {
+            Some(_) => self.exact.as_mut().and_then(ExactPass::verdicts),
+            None => None,
         };
-        let targets = camera_targets(
-            d,
-            cmd,
+        let inputs = Uses::new()
+            .reads_some(self.shadow.map_input(), Access::DepthFragmentSampled)
+            .reads_buffer_some(verdicts, BufferAccess::FragmentRead);
+        let (targets, redrawn) = camera_targets(
+            (d, cmd),
+            inputs,
             (color_target, depth, msaa),
             aovs.filter(|_| camera.aovs),
             resolve_depth,
-            extent,
-            clear,
+            (extent, clear),
         );
-        let counts = self.camera.record(cmd, slot, &self.gpu, &targets, camera);
+        let counts = self
+            .camera
+            .record(cmd, (slot, &self.gpu), (&targets, redrawn), camera);
         if frame.post_aa {
             self.post.record(cmd, color);
         }
@@ -343,6 +336,36 @@ impl FrameCore {
             unshadowed_draws: counts.unshadowed,
             flat_draws: counts.flat,
         }
+    }
+
+    /// Records the shadow pass and, on an exact or hybrid frame, the exact pass; casters drawn.
+    fn record_shadows(&mut self, cmd: vk::CommandBuffer, frame: &Prepared) -> usize {
+        let plan = &frame.plan;
+        let views: Vec<_> = plan
+            .shadow_views
+            .iter()
+            .map(|v| (v.light_clip_from_world, &v.casters))
+            .collect();
+        // How far from a point or spot light its projection's near plane reaches (near
+        // distance × √(1 + 2·tan²) for the widest point face, tan ≤ 4/3).
+        let near = 2.2 * spot_near(&self.gpu.bounds);
+        let casters = self
+            .shadow
+            .record(cmd, &self.gpu, &frame.shadow, &views, near);
+        // The map handed on to its samplers once drawn, in a dependency of its own (0.7–1.1 ms
+        // a 1280×720 demo frame cheaper on lavapipe than in the camera pass's dependency).
+        Uses::new()
+            .reads_some(self.shadow.map_input(), Access::DepthFragmentSampled)
+            .enter(&self.ctx.device, cmd);
+        if let (Some(inputs), Some(pass)) = (&plan.exact, self.exact.as_mut()) {
+            pass.record(
+                cmd,
+                (frame.slot, &self.gpu),
+                inputs,
+                self.shadow.map_input(),
+            );
+        }
+        casters
     }
 
     /// Writes timestamp `query` after `stage`, where the device has timestamps.
@@ -411,60 +434,76 @@ impl FrameCore {
     }
 }
 
-/// The camera pass's outputs, declared and named: the colour target (or with MSAA the
+/// The camera pass's inputs (`inputs`, from the passes before it) and outputs, declared as one
+/// step, and its targets named: the colour target (or with MSAA the
 /// multisampled colour and depth, resolving into the colour target and, with `resolve_depth`,
 /// into `depth`), the depth, and the instance ids and normals asked for (`aovs`). An AOV target
 /// not asked for is left unbound (a null view): the draws' writes to it are discarded, which
 /// spares llvmpipe a 16-byte normal per pixel when only ids are read.
-fn camera_targets(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    (color_target, depth, msaa): (&mut Attachment, &mut Attachment, Option<&mut MsaaTargets>),
-    aovs: Option<(Option<&mut Attachment>, Option<&mut Attachment>)>,
+fn camera_targets<'a>(
+    (d, cmd): (&ash::Device, vk::CommandBuffer),
+    inputs: Uses<'a>,
+    (color_target, depth, msaa): (
+        &'a mut Attachment,
+        &'a mut Attachment,
+        Option<&'a mut MsaaTargets>,
+    ),
+    aovs: Option<(Option<&'a mut Attachment>, Option<&'a mut Attachment>)>,
     resolve_depth: bool,
-    extent: vk::Extent2D,
-    clear: [f32; 4],
-) -> CameraTargets {
+    (extent, clear): (vk::Extent2D, [f32; 4]),
+) -> (CameraTargets, Redrawn<'a>) {
     let (color_view, depth_view) = (color_target.view, depth.view);
-    let uses = Uses::new().writes(color_target, Access::ColorAttachment);
-    let (draw_color, draw_depth, resolve, uses) = match msaa {
-        Some(m) => {
-            let drawn = (m.color.view, m.depth.view);
-            let uses = uses
-                .writes(&mut m.color, Access::ColorAttachment)
-                .writes(&mut m.depth, Access::DepthAttachment);
+    let (msaa_color, drawn_depth, resolved_depth, resolve) = match msaa {
+        Some(MsaaTargets {
+            color,
+            depth: drawn,
+            ..
+        }) => {
             let resolve = Resolve {
                 color: Some(color_view),
                 depth: resolve_depth.then_some(depth_view),
             };
-            let uses = match resolve_depth {
-                true => uses.writes(depth, Access::DepthResolve),
-                false => uses,
-            };
-            (drawn.0, drawn.1, resolve, uses)
+            (Some(color), drawn, resolve_depth.then_some(depth), resolve)
         }
-        None => {
-            let uses = uses.writes(depth, Access::DepthAttachment);
-            (color_view, depth_view, Resolve::default(), uses)
-        }
+        None => (None, depth, None, Resolve::default()),
     };
+    let draw_color = msaa_color.as_ref().map_or(color_view, |c| c.view);
     let view = |a: &Option<&mut Attachment>| a.as_ref().map_or(vk::ImageView::null(), |a| a.view);
-    let (aov_views, uses) = match aovs {
-        Some((ids, normals)) => (
-            Some([view(&ids), view(&normals)]),
-            uses.writes_some(ids, Access::ColorAttachment)
-                .writes_some(normals, Access::ColorAttachment),
-        ),
-        None => (None, uses),
+    let (aov_views, mut aovs) = match aovs {
+        Some((ids, normals)) => (Some([view(&ids), view(&normals)]), vec![ids, normals]),
+        None => (None, vec![]),
     };
-    uses.enter(d, cmd);
-    CameraTargets {
+    inputs
+        .writes(color_target, Access::ColorAttachment)
+        .writes_some(msaa_color, Access::ColorAttachment)
+        .writes(&mut *drawn_depth, Access::DepthAttachment)
+        .writes_some(resolved_depth, Access::DepthResolve)
+        .writes_each(
+            aovs.iter_mut().flatten().map(|a| &mut **a),
+            Access::ColorAttachment,
+        )
+        .enter(d, cmd);
+    let targets = CameraTargets {
         color: draw_color,
-        depth: draw_depth,
+        depth: drawn_depth.view,
         resolve,
         extent,
         clear,
         aovs: aov_views,
+    };
+    let redrawn = Redrawn {
+        depth: drawn_depth,
+        aovs: aovs.into_iter().flatten().collect(),
+    };
+    (targets, redrawn)
+}
+
+/// The camera pass's clear colour in view mode `mode` against `background`.
+fn clear_color(mode: ViewMode, background: Background) -> [f32; 4] {
+    match (mode, background) {
+        (ViewMode::Overdraw, _) => [0.0, 0.0, 0.0, 1.0],
+        (ViewMode::Lit, Background::Color(c)) => c.extend(1.0).to_array(),
+        _ => CLEAR_COLOR,
     }
 }
 
@@ -481,8 +520,7 @@ fn camera_cull(view: &View, plan: &FramePlan) -> CameraCull {
     }
 }
 
-/// The debug entry `mode` draws the scene with (`None`: the lit image, or the shadow map drawn
-/// full-screen).
+/// The debug entry `mode` draws with (`None`: the lit image, or the shadow map full-screen).
 fn is_debug_view(mode: ViewMode) -> Option<crate::render::passes::cull::Entry> {
     use crate::render::passes::cull::Entry;
     match mode {

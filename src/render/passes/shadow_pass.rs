@@ -305,7 +305,7 @@ impl ShadowPass {
         };
         let layer_side = self.map.as_ref().map_or(1, |m| m.extent.width);
         self.ctx.begin_label(cmd, "shadow depth pass");
-        self.declare_map(cmd, true);
+        self.declare_drawn(cmd);
         let mut drawn = 0;
         for (layer, (light_clip_from_world, casters)) in views.iter().enumerate() {
             let Some(view) = self
@@ -328,7 +328,6 @@ impl ShadowPass {
             }
             drawn += self.record_cached_layer(cmd, scene, s, layer, t, layer_side);
         }
-        self.declare_map(cmd, false);
         self.ctx.end_label(cmd);
         drawn
     }
@@ -386,17 +385,18 @@ impl ShadowPass {
         drawn
     }
 
-    /// The map as the pass's output (`drawn`, before the pass draws into it), or handed on as
-    /// the input of the passes that sample it (camera, exact).
-    fn declare_map(&mut self, cmd: vk::CommandBuffer, drawn: bool) {
-        let Some(at) = self.map_at.as_mut() else {
-            return;
-        };
-        match drawn {
-            true => Uses::new().writes(at, Access::DepthAttachment),
-            false => Uses::new().reads(at, Access::DepthFragmentSampled),
+    /// The map as the pass's output, before it draws; its samplers declare their reads.
+    fn declare_drawn(&mut self, cmd: vk::CommandBuffer) {
+        if let Some(at) = self.map_at.as_mut() {
+            Uses::new()
+                .writes(at, Access::DepthAttachment)
+                .enter(&self.ctx.device, cmd);
         }
-        .enter(&self.ctx.device, cmd);
+    }
+
+    /// The map, an input of the passes that sample it (exact, camera); `None` before one exists.
+    pub fn map_input(&mut self) -> Option<&mut Attachment> {
+        self.map_at.as_mut()
     }
 
     /// Makes the static-caster cache (same size, format and layers as the map).

@@ -168,12 +168,11 @@ fn record_readback(
     slot: usize,
 ) {
     let (dw, dh, width, height) = (drawn.width, drawn.height, extent.width, extent.height);
+    // The colour is copied from, whether into the filtered image or straight to the buffer.
+    let colour = Uses::new().reads(&mut t.color_at, Access::TransferSrc);
     let shown = match t.filtered.as_mut() {
         Some((image, at)) => {
-            Uses::new()
-                .reads(&mut t.color_at, Access::TransferSrc)
-                .writes(at, Access::TransferDst)
-                .enter(d, cmd);
+            colour.writes(at, Access::TransferDst).enter(d, cmd);
             // 2:1: each pixel the mean of its 2×2 samples, in linear light.
             let (dw, dh, w, h) = (dw as i32, dh as i32, width as i32, height as i32);
             blit_linear(d, cmd, (t.color.raw, 0, dw, dh), (image.raw, 0, w, h));
@@ -181,9 +180,7 @@ fn record_readback(
             image.raw
         }
         None => {
-            Uses::new()
-                .reads(&mut t.color_at, Access::TransferSrc)
-                .enter(d, cmd);
+            colour.enter(d, cmd);
             t.color.raw
         }
     };

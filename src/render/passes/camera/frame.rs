@@ -9,6 +9,7 @@ use crate::render::passes::cull::{CameraCull, Entry};
 use crate::render::passes::deferred::{self, DeferPlan};
 use crate::render::passes::receivers::{self, Split};
 use crate::render::passes::screen::pixels_per_triangle;
+use crate::render::targets::Attachment;
 use ash::vk;
 
 /// The draws the camera can see (unless culling is off), opaque ones first and front to back
@@ -193,6 +194,16 @@ pub struct CameraTargets {
     /// The instance-id and normal targets (`AOV_FORMATS`, one sample, in attachment layouts)
     /// of a frame that draws them (`CameraFrame::aovs`).
     pub aovs: Option<[vk::ImageView; 2]>,
+}
+
+/// The attachments the G-buffer rendering writes and the forward rendering after it draws on
+/// (same layouts): the depth and stencil drawn into (multisampled with MSAA), and the ids and
+/// normals asked for. The camera pass declares them written again between the two renderings.
+pub struct Redrawn<'a> {
+    /// The depth (and stencil) attachment.
+    pub depth: &'a mut Attachment,
+    /// The instance-id and normal targets asked for.
+    pub aovs: Vec<&'a mut Attachment>,
 }
 
 /// Where a multisampled camera pass resolves to (both None without MSAA).

@@ -17,7 +17,7 @@ use pipelines::Formats;
 use record::full_rect;
 
 pub use aov::{AovTargets, AOV_FORMATS};
-pub use frame::{CameraCounts, CameraFrame, CameraTargets, Resolve, FLAT_LOCATIONS};
+pub use frame::{CameraCounts, CameraFrame, CameraTargets, Redrawn, Resolve, FLAT_LOCATIONS};
 
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::shaders::{

@@ -23,9 +23,8 @@ impl CameraPass {
     pub fn record(
         &mut self,
         cmd: vk::CommandBuffer,
-        slot: usize,
-        scene: &GpuScene,
-        targets: &CameraTargets,
+        (slot, scene): (usize, &GpuScene),
+        (targets, redrawn): (&CameraTargets, Redrawn<'_>),
         frame: &CameraFrame,
     ) -> CameraCounts {
         let (cull, shadow_map_view, plan) = (&frame.cull, frame.shadow_map_view, &frame.defer);
@@ -42,7 +41,8 @@ impl CameraPass {
         let mut unshadowed = 0;
         let mut deferred_draws = 0;
         if deferring {
-            deferred_draws = self.record_gbuffer(cmd, scene, targets, frame_set, plan, cull);
+            deferred_draws =
+                self.record_gbuffer(cmd, scene, (targets, redrawn), frame_set, (plan, cull));
         }
         let (color_att, depth_att) = main_attachments(targets, stencil, deferring);
         let mut rendering = vk::RenderingInfo::default()
@@ -163,16 +163,16 @@ impl CameraPass {
     }
 
     /// Records the G-buffer pass of `plan`'s deferred draws (clearing depth and stencil, each
-    /// draw marking its material), then makes the targets readable and the depth and stencil
-    /// visible to the next rendering. Returns the number of draws.
+    /// draw marking its material), then hands the targets on to the resolves and the depth,
+    /// stencil, ids and normals (`redrawn`) on to the rendering that draws on over them.
+    /// Returns the number of draws.
     fn record_gbuffer(
         &mut self,
         cmd: vk::CommandBuffer,
         scene: &GpuScene,
-        targets: &CameraTargets,
+        (targets, redrawn): (&CameraTargets, Redrawn<'_>),
         frame_set: vk::DescriptorSet,
-        plan: &DeferPlan,
-        cull: &CameraCull,
+        (plan, cull): (&DeferPlan, &CameraCull),
     ) -> usize {
         let (depth, extent) = (targets.depth, targets.extent);
         let ctx = self.ctx.clone();
@@ -235,13 +235,14 @@ impl CameraPass {
             );
         }
         Recorder::new(d, cmd).end_rendering();
-        if let Some(g) = self.gbuffer.as_mut() {
-            // Handed on to the resolve draws, which read them with `textureLoad`.
-            Uses::new()
-                .reads_each(&mut g.targets, Access::FragmentSampled)
-                .enter(d, cmd);
-        }
-        gbuffer_written(d, cmd, aovs.is_some());
+        // The targets handed on to the resolves (`textureLoad`); the depth and stencil (stencil
+        // and depth tests), ids and normals (loaded, drawn over) written again after.
+        let read = self.gbuffer.as_mut().map(|g| &mut g.targets);
+        Uses::new()
+            .reads_each(read.into_iter().flatten(), Access::FragmentSampled)
+            .writes(redrawn.depth, Access::DepthAttachment)
+            .writes_each(redrawn.aovs, Access::ColorAttachment)
+            .enter(d, cmd);
         ctx.end_label(cmd);
         plan.deferred.len()
     }
@@ -327,42 +328,6 @@ fn pieces(bits: VariantKey, split: Split) -> Vec<(VariantKey, Option<vk::Rect2D>
             )
             .collect(),
     }
-}
-
-/// Makes what the G-buffer pass wrote visible to the rendering after it (same layouts: memory
-/// dependencies only): its depth and stencil to the resolve's stencil test and the forward draws'
-/// depth test, and with `aovs` the ids and normals to the forward pass, which loads them and
-/// draws over them.
-fn gbuffer_written(d: &ash::Device, cmd: vk::CommandBuffer, aovs: bool) {
-    let tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
-        | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
-    let out = vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT;
-    let rw = |r, w| (w, r | w);
-    let mb = [
-        (
-            tests,
-            rw(
-                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
-                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
-            ),
-        ),
-        (
-            out,
-            rw(
-                vk::AccessFlags2::COLOR_ATTACHMENT_READ,
-                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-            ),
-        ),
-    ]
-    .map(|(stage, (src, dst))| {
-        vk::MemoryBarrier2::default()
-            .src_stage_mask(stage)
-            .src_access_mask(src)
-            .dst_stage_mask(stage)
-            .dst_access_mask(dst)
-    });
-    let mb = if aovs { &mb[..] } else { &mb[..1] };
-    Recorder::new(d, cmd).pipeline_barrier2(&vk::DependencyInfo::default().memory_barriers(mb));
 }
 
 /// The camera pass's attachments after the G-buffer pass (`deferring`: its depth, stencil marks,

@@ -226,6 +226,12 @@ impl ExactPass {
             .map_or(self.empty.raw, |t| t.samples.raw())
     }
 
+    /// The samples as an input of the camera pass's fragments (`None` before the first exact
+    /// frame).
+    pub fn verdicts(&mut self) -> Option<&mut SharedBuffer> {
+        self.targets.as_mut().map(|t| &mut t.samples)
+    }
+
     /// Grows the hybrid method's culling buffers to `f`'s casters (rewriting every slot's
     /// bindings when they are made anew).
     pub fn ensure_culling(&mut self, scene: &GpuScene, f: &ExactPlan) -> Result<(), GpuError> {

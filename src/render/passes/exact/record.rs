@@ -14,17 +14,26 @@ use glam::{Mat4, Vec4};
 
 impl ExactPass {
     /// Records the three steps for slot `slot` (after [`ExactPass::ensure`] and
-    /// [`ExactPass::write_frame`]); the samples are then ready for the camera pass's fragment
-    /// shaders.
-    pub fn record(&mut self, cmd: vk::CommandBuffer, slot: usize, scene: &GpuScene, f: &ExactPlan) {
+    /// [`ExactPass::write_frame`]); binning reads the shadow map `map`. The camera
+    /// pass's fragments then read the samples ([`ExactPass::verdicts`]).
+    pub fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        (slot, scene): (usize, &GpuScene),
+        f: &ExactPlan,
+        map: Option<&mut Attachment>,
+    ) {
         let ctx = self.ctx.clone();
         let d = &ctx.device;
         let set = self.sets[slot];
         let mut t = self.targets.take().expect("exact targets made by ensure");
         let hybrid = f.hybrid.is_some();
         // The fills come after the previous frame's uses of the grid, the tiles, the arguments
-        // and the mask.
-        let fills = Uses::new().writes_buffer(&mut t.heads, BufferAccess::TransferWrite);
+        // and the mask. Binning reads the shadow map (the hybrid method's lit test; one binning
+        // pipeline serves both methods, so its binding is in use either way).
+        let fills = Uses::new()
+            .writes_buffer(&mut t.heads, BufferAccess::TransferWrite)
+            .reads_some(map, Access::DepthFragmentSampled);
         match hybrid {
             true => self
                 .culling
@@ -51,7 +60,6 @@ impl ExactPass {
                 set,
             );
             Recorder::new(d, cmd).dispatch(groups.0, groups.1, 1);
-            hand_on_samples(d, cmd, &mut t);
             self.targets = Some(t);
             return;
         }
@@ -250,15 +258,7 @@ impl ExactPass {
             }
         }
         Recorder::new(d, cmd).end_rendering();
-        hand_on_samples(d, cmd, t);
     }
-}
-
-/// The verdicts handed on to their reader, the camera pass's fragments.
-fn hand_on_samples(d: &ash::Device, cmd: vk::CommandBuffer, t: &mut Targets) {
-    Uses::new()
-        .reads_buffer(&mut t.samples, BufferAccess::FragmentRead)
-        .enter(d, cmd);
 }
 
 /// Binds `pipeline` at `point` with the frame's set `set` (set 0 of `layout`).
