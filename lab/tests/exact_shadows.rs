@@ -14,7 +14,7 @@ use umbra::render::Renderer;
 use umbra::scene::{
     built::demo::demo_scene, built::shapes::add_ground, built::synthetic, gltf::load_gltf, Scene,
 };
-use umbra_lab::reference::{compare, Metrics, ReferenceScene};
+use umbra_lab::reference::{compare, Metrics, ReferenceFrame, ReferenceScene};
 
 const W: u32 = 640;
 const H: u32 = 360;
@@ -22,11 +22,20 @@ const H: u32 = 360;
 /// Shadow metrics of `scene` from its first camera with `method` (and whether the frame ran the
 /// exact pass).
 fn measure(scene: &Scene, method: ShadowMethod) -> (Metrics, bool) {
-    measure_with(scene, method, false)
+    measure_with(scene, method, false, &mut None)
 }
 
-/// [`measure`], with contact shadows over the maps when `contact` (and whether they ran).
-fn measure_with(scene: &Scene, method: ShadowMethod, contact: bool) -> (Metrics, bool) {
+/// [`measure`], with contact shadows over the maps when `contact` (and whether they ran), judged
+/// against `reference`: rendered on the first call for a scene and kept for its other methods.
+/// The reference reads the plan's camera, lights and display settings, which the shadow method
+/// does not change (rendered afresh for each method, the references of every scene in
+/// `exact_shadows_agree_with_the_reference_at_every_judged_pixel` were identical).
+fn measure_with(
+    scene: &Scene,
+    method: ShadowMethod,
+    contact: bool,
+    reference: &mut Option<ReferenceFrame>,
+) -> (Metrics, bool) {
     let ctx = context();
     let mut r = Renderer::new(&ctx, scene).unwrap();
     r.set_read_depth(true);
@@ -39,13 +48,14 @@ fn measure_with(scene: &Scene, method: ShadowMethod, contact: bool) -> (Metrics,
     let shadow = r.render(&view, W, H).unwrap();
     drop(r);
     assert_validation_clean(&ctx);
-    let reference = ReferenceScene::new(scene).render(&lit.plan, W, H, lit.plan.ambient);
+    let render = || ReferenceScene::new(scene).render(&lit.plan, W, H, lit.plan.ambient);
+    let reference = reference.get_or_insert_with(render);
     let (m, _) = compare(
         &lit.image,
         &shadow.image,
         shadow.depth.as_deref().unwrap(),
         &shadow.plan,
-        &reference,
+        reference,
     );
     let ran = if contact {
         shadow.plan.contact_shadows()
@@ -59,8 +69,11 @@ fn measure_with(scene: &Scene, method: ShadowMethod, contact: bool) -> (Metrics,
 /// hybrid (a point light's cube is traced whole), and the fraction of covered pixels traced
 /// (the cascade view's green: traced verdicts show as view 1, the map's as view 0), and the
 /// caster triangles drawn into the grid of those the frame has (`FrameStats::grid_triangles`).
-fn measure_hybrid(scene: &Scene) -> (Metrics, bool, f64, Option<(u64, u64)>) {
-    let (m, _) = measure(scene, ShadowMethod::Hybrid);
+fn measure_hybrid(
+    scene: &Scene,
+    reference: &mut Option<ReferenceFrame>,
+) -> (Metrics, bool, f64, Option<(u64, u64)>) {
+    let (m, _) = measure_with(scene, ShadowMethod::Hybrid, false, reference);
     let ctx = context();
     let mut r = Renderer::new(&ctx, scene).unwrap();
     let camera = scene.cameras.first().copied();
@@ -157,9 +170,10 @@ fn exact_shadows_agree_with_the_reference_at_every_judged_pixel() {
         scenes.push(helmet);
     }
     for scene in &scenes {
-        let (map, _) = measure(scene, ShadowMethod::Map);
-        let (exact, ran) = measure(scene, ShadowMethod::Exact);
-        let (hybrid, hybrid_ran, traced, grid) = measure_hybrid(scene);
+        let mut reference = None;
+        let (map, _) = measure_with(scene, ShadowMethod::Map, false, &mut reference);
+        let (exact, ran) = measure_with(scene, ShadowMethod::Exact, false, &mut reference);
+        let (hybrid, hybrid_ran, traced, grid) = measure_hybrid(scene, &mut reference);
         let pixels = |m: &Metrics| (m.misclassified * m.judged_pixels as f64).round() as usize;
         eprintln!(
             "{}: hybrid {} px ({:.4} %, interior {:.4} %), {:.1} % of pixels traced",
@@ -330,7 +344,7 @@ fn contact_shadows_darken_creases_the_maps_leave_lit() {
         (demo_scene(), 0.0010),
     ] {
         let (map, _) = measure(&scene, ShadowMethod::Map);
-        let (contact, ran) = measure_with(&scene, ShadowMethod::Map, true);
+        let (contact, ran) = measure_with(&scene, ShadowMethod::Map, true, &mut None);
         assert!(ran, "{}: contact shadows did not run", scene.name);
         eprintln!(
             "{}: map {:.4} % (false light {:.4} %, false shadow {:.4} %), with contact shadows \
