@@ -3,12 +3,61 @@
 
 use crate::common::*;
 use glam::{Mat4, Quat, Vec3};
-use umbra::plan::{View, ViewMode};
+use umbra::plan::{SceneOptions, ShadowMethod, View, ViewMode};
 use umbra::render::Renderer;
 use umbra::scene::built::shapes::{add_object, colored, plane, quad};
 use umbra::scene::{
     blinn_phong_params, built::demo::demo_scene, shade_blinn_phong, Camera, Light, Material, Scene,
 };
+
+/// A renderer made after another on the same context takes the pipelines the first one made
+/// (`gpu::pipeline_store`) and draws the bytes a renderer alone on a fresh context draws;
+/// renderers that need other pipelines (MSAA, exact shadows) get their own.
+#[test]
+fn renderers_share_their_contexts_pipelines() {
+    let scene = demo_scene();
+    let size = (160, 90);
+    let plain = SceneOptions::default();
+    let msaa = SceneOptions {
+        msaa: Some(4),
+        ..plain
+    };
+    let view = View::new(scene.cameras[0]);
+    let mut exact = view.clone();
+    exact.shadow.method = ShadowMethod::Exact;
+    let runs = [(&plain, &view), (&msaa, &view), (&plain, &exact)];
+    // Each renderer alone on a context of its own.
+    let alone: Vec<_> = runs
+        .iter()
+        .map(|&(o, v)| {
+            let ctx = context();
+            render_with(&ctx, &scene, o, v, size).image
+        })
+        .collect();
+    let ctx = context();
+    let first = render_with(&ctx, &scene, &plain, &view, size).image;
+    let made = ctx.stored_pipelines();
+    let second = render_with(&ctx, &scene, &plain, &view, size).image;
+    // Measured: 10 pipelines for the demo's map frame, none more for its second renderer; 31
+    // with MSAA and exact shadows.
+    assert_eq!(
+        ctx.stored_pipelines(),
+        made,
+        "the second renderer made pipelines"
+    );
+    assert!(first == alone[0] && second == alone[0]);
+    for (i, &(o, v)) in runs.iter().enumerate().skip(1) {
+        let before = ctx.stored_pipelines();
+        let image = render_with(&ctx, &scene, o, v, size).image;
+        assert!(ctx.stored_pipelines() > before, "run {i} made no pipeline");
+        assert!(image == alone[i], "run {i} differs from its renderer alone");
+    }
+    eprintln!(
+        "pipelines: {made} for the map frame, {} in all",
+        ctx.stored_pipelines()
+    );
+    assert_validation_clean(&ctx);
+}
 
 #[test]
 fn demo_scene_renders_with_shadows() {

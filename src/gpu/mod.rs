@@ -7,6 +7,7 @@ pub(crate) mod context;
 pub(crate) mod graph;
 mod heap;
 pub mod pipeline_cache;
+pub(crate) mod pipeline_store;
 pub(crate) mod recorder;
 pub(crate) mod resources;
 pub(crate) mod shaders;

@@ -2,7 +2,9 @@
 //! binding numbers and uniform sizes used here cannot drift from the shaders).
 
 use super::context::{Context, GpuError, VkCheck};
+use super::pipeline_store::hasher;
 use ash::vk;
+use std::hash::{Hash, Hasher};
 
 /// Kind of a shader resource binding (every kind build.rs can emit, used by these shaders or not).
 #[allow(dead_code)]
@@ -162,7 +164,35 @@ pub fn create_module(
     let info = vk::ShaderModuleCreateInfo::default().code(&words);
     let m = unsafe { ctx.device.create_shader_module(&info, None) }.vk("vkCreateShaderModule")?;
     ctx.set_name(m, name);
+    let mut h = hasher();
+    spirv.hash(&mut h);
+    ctx.pipelines.note(m, h.finish());
     Ok(m)
+}
+
+/// Creates a pipeline layout of `sets` and push-constant `ranges`, noted in the context's
+/// pipeline store by what it is made of.
+pub fn create_pipeline_layout(
+    ctx: &Context,
+    sets: &[vk::DescriptorSetLayout],
+    ranges: &[vk::PushConstantRange],
+    name: &str,
+) -> Result<vk::PipelineLayout, GpuError> {
+    let info = vk::PipelineLayoutCreateInfo::default()
+        .set_layouts(sets)
+        .push_constant_ranges(ranges);
+    let l =
+        unsafe { ctx.device.create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")?;
+    ctx.set_name(l, name);
+    let mut h = hasher();
+    for &set in sets {
+        ctx.pipelines.hash_made_of(set, &mut h);
+    }
+    for r in ranges {
+        (r.stage_flags.as_raw(), r.offset, r.size).hash(&mut h);
+    }
+    ctx.pipelines.note(l, h.finish());
+    Ok(l)
 }
 
 /// Creates the descriptor set layout of `group` from reflected bindings (all stages that use them;
@@ -200,6 +230,12 @@ pub fn set_layout_for(
     let l = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
         .vk("vkCreateDescriptorSetLayout")?;
     ctx.set_name(l, name);
+    let mut h = hasher();
+    for b in &vk_bindings {
+        let kind = (b.binding, b.descriptor_type.as_raw(), b.descriptor_count);
+        (kind, b.stage_flags.as_raw()).hash(&mut h);
+    }
+    ctx.pipelines.note(l, h.finish());
     Ok(l)
 }
 

@@ -1,12 +1,15 @@
 //! Graphics pipeline creation shared by the passes (dynamic rendering, no render pass objects).
 
-use crate::gpu::context::{Context, GpuError, VkCheck};
+use crate::gpu::context::{Context, GpuError};
+use crate::gpu::pipeline_store::PipelineStore;
 use crate::gpu::resources::has_stencil;
 use crate::gpu::Recorder;
 use ash::vk;
 use std::ffi::CStr;
+use std::hash::{Hash, Hasher};
 
 /// What differs between the passes' pipelines.
+#[derive(Clone, Copy)]
 pub struct PipelineDesc<'a> {
     /// Debug name.
     pub name: &'a str,
@@ -43,7 +46,7 @@ pub struct PipelineDesc<'a> {
 }
 
 /// What a pipeline does with the stencil aspect (reference value: dynamic state).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Stencil {
     /// No stencil test or write.
     Off,
@@ -54,7 +57,7 @@ pub enum Stencil {
 }
 
 /// What a pipeline does with the depth aspect (reversed-z: larger is nearer, cleared to 0).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Depth {
     /// No test, no write (full-screen passes, the overdraw view).
     Off,
@@ -66,7 +69,7 @@ pub enum Depth {
 }
 
 /// How a pipeline's colour output combines with the attachment.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ColorBlend {
     /// Replace.
     Off,
@@ -77,9 +80,48 @@ pub enum ColorBlend {
     Over,
 }
 
-/// Creates a graphics pipeline: triangle lists, reversed-z depth test (GREATER, writes on),
+/// The graphics pipeline of `d`: triangle lists, reversed-z depth test (GREATER, writes on),
 /// counter-clockwise front faces, dynamic viewport, scissor and cull mode (and depth bias).
+/// Made once per context and kept by it (`gpu::pipeline_store`): the caller never destroys it.
 pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, GpuError> {
+    ctx.pipelines
+        .get_or_create(definition(&ctx.pipelines, d), || make_pipeline(ctx, d))
+}
+
+/// What `d` makes, hashed: everything but its name, its modules and layout by what they are
+/// made of.
+fn definition(store: &PipelineStore, d: &PipelineDesc) -> u64 {
+    let mut h = crate::gpu::pipeline_store::hasher();
+    "graphics".hash(&mut h);
+    let counts = (d.bindings.len(), d.attributes.len(), d.color_formats.len());
+    (counts, d.fragment.is_some()).hash(&mut h);
+    store.hash_made_of(d.layout, &mut h);
+    for (module, entry) in std::iter::once(d.vertex).chain(d.fragment) {
+        store.hash_made_of(module, &mut h);
+        entry.hash(&mut h);
+    }
+    for b in d.bindings {
+        (b.binding, b.stride, b.input_rate.as_raw()).hash(&mut h);
+    }
+    for a in d.attributes {
+        (a.location, a.binding, a.format.as_raw(), a.offset).hash(&mut h);
+    }
+    for f in d.color_formats {
+        f.as_raw().hash(&mut h);
+    }
+    (
+        d.masked_targets,
+        d.depth_format.as_raw(),
+        d.depth_clamp,
+        d.depth_bias,
+    )
+        .hash(&mut h);
+    (d.stencil, d.depth, d.blend, d.samples).hash(&mut h);
+    h.finish()
+}
+
+/// Creates the pipeline of `d` ([`create_pipeline`]'s first time).
+fn make_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, GpuError> {
     let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
         .stage(vk::ShaderStageFlags::VERTEX)
         .module(d.vertex.0)
@@ -258,13 +300,8 @@ pub fn create_layout(
         offset: 0,
         size: immediate_size,
     }];
-    let info = vk::PipelineLayoutCreateInfo::default()
-        .set_layouts(sets)
-        .push_constant_ranges(if immediate_size > 0 { &ranges } else { &[] });
-    let l =
-        unsafe { ctx.device.create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")?;
-    ctx.set_name(l, name);
-    Ok(l)
+    let ranges = if immediate_size > 0 { &ranges[..] } else { &[] };
+    crate::gpu::shaders::create_pipeline_layout(ctx, sets, ranges, name)
 }
 
 /// Full-extent viewport and scissor.
@@ -339,3 +376,95 @@ const _: () = assert!(
     std::mem::size_of::<crate::plan::uniforms::ShadowImmediates>()
         == crate::gpu::shaders::shadow::IMMEDIATE_SIZE as usize
 );
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ash::vk::Handle;
+
+    const MOVED: [vk::VertexInputAttributeDescription; 1] = [vk::VertexInputAttributeDescription {
+        location: 0,
+        binding: 0,
+        format: vk::Format::UNDEFINED,
+        offset: 12,
+    }];
+    const TWO: [vk::Format; 2] = [vk::Format::R8G8B8A8_SRGB, vk::Format::R32_UINT];
+
+    /// Every field but the name changes what a pipeline is known by; modules and layouts count
+    /// by what they are made of.
+    #[test]
+    fn a_pipeline_is_known_by_all_it_is_made_of() {
+        let store = PipelineStore::default();
+        let module = |raw, made_of| {
+            let m = vk::ShaderModule::from_raw(raw);
+            store.note(m, made_of);
+            m
+        };
+        let (vs, fs, fs_twin, other) = (module(1, 10), module(2, 20), module(3, 20), module(4, 30));
+        let layout = vk::PipelineLayout::from_raw(5);
+        store.note(layout, 50);
+        let layout_twin = vk::PipelineLayout::from_raw(6);
+        store.note(layout_twin, 50);
+        let other_layout = vk::PipelineLayout::from_raw(7);
+        store.note(other_layout, 70);
+        let binding = [vk::VertexInputBindingDescription::default().stride(32)];
+        let attributes = [vk::VertexInputAttributeDescription::default()];
+        let colour = [vk::Format::R8G8B8A8_SRGB];
+        let base = PipelineDesc {
+            name: "a",
+            layout,
+            vertex: (vs, c"vs_main"),
+            fragment: Some((fs, c"fs_main")),
+            bindings: &binding,
+            attributes: &attributes,
+            color_formats: &colour,
+            masked_targets: 0,
+            depth_format: vk::Format::D32_SFLOAT,
+            stencil: Stencil::Off,
+            depth_clamp: false,
+            depth_bias: false,
+            depth: Depth::Test,
+            blend: ColorBlend::Off,
+            samples: 1,
+        };
+        let key = |change: &dyn Fn(&mut PipelineDesc)| {
+            let mut d = base;
+            change(&mut d);
+            definition(&store, &d)
+        };
+        let same: [&dyn Fn(&mut PipelineDesc); 3] = [
+            &|d| d.name = "b",
+            &|d| d.fragment = Some((fs_twin, c"fs_main")),
+            &|d| d.layout = layout_twin,
+        ];
+        for change in same {
+            assert_eq!(key(change), key(&|_| ()));
+        }
+        let differ: [&dyn Fn(&mut PipelineDesc); 18] = [
+            &|d| d.layout = other_layout,
+            &|d| d.vertex = (other, c"vs_main"),
+            &|d| d.vertex = (vs, c"vs_flat"),
+            &|d| d.fragment = Some((other, c"fs_main")),
+            &|d| d.fragment = Some((fs, c"fs_flat")),
+            &|d| d.fragment = None,
+            &|d| d.bindings = &[],
+            &|d| d.attributes = &MOVED,
+            &|d| d.color_formats = &TWO,
+            &|d| d.color_formats = &[],
+            &|d| d.masked_targets = 1,
+            &|d| d.depth_format = vk::Format::D32_SFLOAT_S8_UINT,
+            &|d| d.stencil = Stencil::Mark,
+            &|d| d.depth_clamp = true,
+            &|d| d.depth_bias = true,
+            &|d| d.depth = Depth::Off,
+            &|d| d.blend = ColorBlend::Over,
+            &|d| d.samples = 4,
+        ];
+        let mut keys: Vec<u64> = differ.iter().map(|&change| key(change)).collect();
+        keys.push(key(&|_| ()));
+        let n = keys.len();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), n, "two different pipelines share a key");
+    }
+}

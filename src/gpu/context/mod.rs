@@ -1,5 +1,5 @@
-//! The Vulkan context. Drop order, written down: wait idle → allocator → command pool → device →
-//! debug messenger → instance.
+//! The Vulkan context. Drop order, written down: wait idle → stored pipelines → allocator →
+//! command pool → device → debug messenger → instance.
 //!
 //! `error` holds the error type, `validation` the validation layer's log, `startup` the creation
 //! of the instance and the device.
@@ -88,6 +88,8 @@ pub struct Context {
     /// The pipeline cache every pipeline is created with.
     pub(crate) pipeline_cache: vk::PipelineCache,
     pipeline_cache_path: Option<std::path::PathBuf>,
+    /// Every pipeline made on this context, by what it is made from (destroyed with it).
+    pub(crate) pipelines: super::pipeline_store::PipelineStore,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     command_pool: Mutex<vk::CommandPool>,
     debug_device: Option<ash::ext::debug_utils::Device>,
@@ -228,6 +230,7 @@ impl Context {
             validation_enabled: enable_validation,
             pipeline_cache,
             pipeline_cache_path: desc.pipeline_cache.clone(),
+            pipelines: Default::default(),
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             command_pool: Mutex::new(command_pool),
             debug_device,
@@ -247,6 +250,12 @@ impl Context {
             queue: self.queue,
             queue_family: self.queue_family,
         }
+    }
+
+    /// How many pipelines this context holds: every distinct one its renderers have asked for,
+    /// made once and kept until the context is dropped (`gpu::pipeline_store`).
+    pub fn stored_pipelines(&self) -> usize {
+        self.pipelines.len()
     }
 
     /// The memory allocator.
@@ -417,6 +426,7 @@ impl Drop for Context {
     fn drop(&mut self) {
         unsafe {
             let _ = self.device.device_wait_idle();
+            self.pipelines.destroy(&self.device);
             ManuallyDrop::drop(&mut self.allocator);
             let pool = *self.command_pool.lock().unwrap_or_else(|e| e.into_inner());
             self.device.destroy_command_pool(pool, None);

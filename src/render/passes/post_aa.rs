@@ -253,9 +253,6 @@ impl Drop for PostAaPass {
         unsafe {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
-            for p in self.pipelines.into_iter().flatten() {
-                d.destroy_pipeline(p, None);
-            }
             d.destroy_sampler(self.sampler, None);
             d.destroy_shader_module(self.module, None);
             d.destroy_pipeline_layout(self.layout, None);

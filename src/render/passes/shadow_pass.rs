@@ -174,8 +174,6 @@ impl ShadowPass {
     ) -> Result<bool, GpuError> {
         let fmt = vk_format(format);
         if self.pipeline_format != fmt {
-            unsafe { self.ctx.device.destroy_pipeline(self.pipeline, None) };
-            self.pipeline = vk::Pipeline::null();
             self.pipeline = depth_pipeline(&self.ctx, self.layout, self.module, false, fmt)?;
             self.pipeline_format = fmt;
         }
@@ -265,7 +263,6 @@ impl ShadowPass {
             unsafe {
                 let d = &self.ctx.device;
                 let _ = d.device_wait_idle();
-                d.destroy_pipeline(m.pipeline, None);
                 d.destroy_pipeline_layout(m.layout, None);
             }
         }
@@ -592,7 +589,6 @@ impl Drop for ShadowPass {
         unsafe {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
-            d.destroy_pipeline(self.pipeline, None);
             d.destroy_shader_module(self.module, None);
             d.destroy_pipeline_layout(self.layout, None);
         }

@@ -356,16 +356,8 @@ impl Drop for CameraPass {
         unsafe {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
-            for (_, p) in self.pipelines.drain() {
-                d.destroy_pipeline(p, None);
-            }
             for (_, m) in self.variant_modules.drain() {
                 d.destroy_shader_module(m, None);
-            }
-            d.destroy_pipeline(self.map_pipeline, None);
-            d.destroy_pipeline(self.sky_pipeline, None);
-            if let Some(p) = self.sky_aovs.take() {
-                d.destroy_pipeline(p, None);
             }
             self.gbuffer = None;
             d.destroy_descriptor_set_layout(self.gbuffer_layout, None);

@@ -55,12 +55,8 @@ impl Culling {
             size: sh::IMMEDIATE_SIZE,
         }];
         let sets = [set_layout];
-        let info = vk::PipelineLayoutCreateInfo::default()
-            .set_layouts(&sets)
-            .push_constant_ranges(&ranges);
-        let layout = unsafe { ctx.device.create_pipeline_layout(&info, None) }
-            .vk("vkCreatePipelineLayout")?;
-        ctx.set_name(layout, "hybrid cull layout");
+        let layout =
+            crate::gpu::shaders::create_pipeline_layout(ctx, &sets, &ranges, "hybrid cull layout")?;
         let pipeline = compute_pipeline(ctx, layout, module, sh::ENTRY_CS_CULL, "hybrid cull")?;
         let thin_pipeline = compute_pipeline(
             ctx,
@@ -316,8 +312,6 @@ impl Drop for Culling {
         unsafe {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
-            d.destroy_pipeline(self.pipeline, None);
-            d.destroy_pipeline(self.thin_pipeline, None);
             d.destroy_pipeline_layout(self.layout, None);
         }
     }

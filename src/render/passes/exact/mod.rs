@@ -368,12 +368,31 @@ fn graphics_pipelines(
     Ok((receiver, caster))
 }
 
-/// A compute pipeline of `module`'s entry point `entry`, named `name`.
+/// The compute pipeline of `module`'s entry point `entry`, named `name` (made once per context
+/// and kept by it: the caller never destroys it).
 fn compute_pipeline(
     ctx: &Context,
     layout: vk::PipelineLayout,
     module: vk::ShaderModule,
     entry: &std::ffi::CStr,
+    name: &str,
+) -> Result<vk::Pipeline, GpuError> {
+    use std::hash::{Hash, Hasher};
+    let mut h = crate::gpu::pipeline_store::hasher();
+    "compute".hash(&mut h);
+    ctx.pipelines.hash_made_of(layout, &mut h);
+    ctx.pipelines.hash_made_of(module, &mut h);
+    entry.hash(&mut h);
+    ctx.pipelines.get_or_create(h.finish(), || {
+        make_compute(ctx, layout, (module, entry), name)
+    })
+}
+
+/// Creates [`compute_pipeline`]'s pipeline the first time.
+fn make_compute(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    (module, entry): (vk::ShaderModule, &std::ffi::CStr),
     name: &str,
 ) -> Result<vk::Pipeline, GpuError> {
     let stage = vk::PipelineShaderStageCreateInfo::default()
@@ -401,10 +420,6 @@ impl Drop for ExactPass {
             let d = &self.ctx.device;
             let _ = d.device_wait_idle();
             self.targets = None;
-            d.destroy_pipeline(self.receiver, None);
-            d.destroy_pipeline(self.build, None);
-            d.destroy_pipeline(self.contact, None);
-            d.destroy_pipeline(self.caster, None);
             d.destroy_shader_module(self.module, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_pool(self.pool, None);
