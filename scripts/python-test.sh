@@ -17,6 +17,6 @@ fi
 . "$venv/bin/activate"
 python -m pip install -q --disable-pip-version-check \
   "maturin>=1.5,<2" numpy pytest pillow trimesh "ray>=2.9"
-maturin develop -q -m python/Cargo.toml --profile dev
+maturin develop -q -m python/Cargo.toml --profile dev --features suite
 export UMBRA_DEVICE="${UMBRA_DEVICE:-llvmpipe}" UMBRA_BIN="${UMBRA_BIN:-target/debug/umbra}"
 python -m pytest -q python/tests

@@ -59,12 +59,20 @@ impl PipelineStore {
         self.lock().made_of.get(&handle.as_raw()).copied()
     }
 
-    /// Hashes what a module or layout is made of into `state`: its noted definition, or (never
-    /// expected) its handle, which still keys it correctly while it lives.
-    pub(crate) fn hash_made_of<H: vk::Handle + Copy, S: Hasher>(&self, handle: H, state: &mut S) {
+    /// Hashes what a module or layout is made of into `state`: its noted definition, or its handle
+    /// (which keys it correctly while it lives) for one made outside `gpu::shaders`: none is, and
+    /// a debug build (the tests') says so if one ever is.
+    pub(crate) fn hash_made_of<H: vk::Handle + Copy + std::fmt::Debug, S: Hasher>(
+        &self,
+        handle: H,
+        state: &mut S,
+    ) {
         match self.made_of(handle) {
             Some(d) => (0u8, d).hash(state),
-            None => (1u8, handle.as_raw()).hash(state),
+            None => {
+                debug_assert!(false, "{handle:?} was not made by gpu::shaders");
+                (1u8, handle.as_raw()).hash(state)
+            }
         }
     }
 
@@ -171,7 +179,12 @@ mod tests {
         // The driver hands handle 1 out again for other SPIR-V.
         store.note(vk::ShaderModule::from_raw(1), 43);
         assert_ne!(key(1), key(2));
-        // A handle nobody noted is keyed by itself.
-        assert_ne!(key(3), key(4));
+    }
+
+    #[test]
+    #[cfg(debug_assertions)]
+    #[should_panic(expected = "was not made by gpu::shaders")]
+    fn a_module_made_elsewhere_is_caught() {
+        PipelineStore::default().hash_made_of(vk::ShaderModule::from_raw(3), &mut hasher());
     }
 }

@@ -88,6 +88,52 @@ pub fn create_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, 
         .get_or_create(definition(&ctx.pipelines, d), || make_pipeline(ctx, d))
 }
 
+/// The compute pipeline of `module`'s entry point `entry`, named `name`: made once per context and
+/// kept by it (`gpu::pipeline_store`), known by its layout's and module's definitions and the
+/// entry point, like [`create_pipeline`]'s. The caller never destroys it.
+pub fn create_compute_pipeline(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    module: vk::ShaderModule,
+    entry: &CStr,
+    name: &str,
+) -> Result<vk::Pipeline, GpuError> {
+    let mut h = crate::gpu::pipeline_store::hasher();
+    "compute".hash(&mut h);
+    ctx.pipelines.hash_made_of(layout, &mut h);
+    ctx.pipelines.hash_made_of(module, &mut h);
+    entry.hash(&mut h);
+    ctx.pipelines.get_or_create(h.finish(), || {
+        make_compute(ctx, layout, (module, entry), name)
+    })
+}
+
+/// Creates [`create_compute_pipeline`]'s pipeline the first time.
+fn make_compute(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    (module, entry): (vk::ShaderModule, &CStr),
+    name: &str,
+) -> Result<vk::Pipeline, GpuError> {
+    let stage = vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::COMPUTE)
+        .module(module)
+        .name(entry);
+    let info = vk::ComputePipelineCreateInfo::default()
+        .stage(stage)
+        .layout(layout);
+    let p = unsafe {
+        ctx.device
+            .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
+    }
+    .map_err(|(_, e)| GpuError::Vk {
+        call: "vkCreateComputePipelines",
+        result: e,
+    })?[0];
+    ctx.set_name(p, name);
+    Ok(p)
+}
+
 /// What `d` makes, hashed: everything but its name, its modules and layout by what they are
 /// made of.
 fn definition(store: &PipelineStore, d: &PipelineDesc) -> u64 {

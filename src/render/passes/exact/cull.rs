@@ -4,13 +4,14 @@
 //! the caster pass then draws only those. On llvmpipe, which runs vertex work on one thread,
 //! the triangles never pulled are the saving.
 
-use super::{caster_column, compute_pipeline, record::bind, ExactImmediates};
+use super::{caster_column, record::bind, ExactImmediates};
 use crate::gpu::context::{Context, GpuError, VkCheck};
 use crate::gpu::resources::Buffer;
 use crate::gpu::shaders::exact as sh;
 use crate::gpu::{BufferAccess, Recorder, SharedBuffer, Uses};
 use crate::plan::ExactPlan;
 use crate::render::gpu_scene::GpuScene;
+use crate::render::pipeline::create_compute_pipeline;
 use ash::vk;
 use glam::{Mat4, Vec4};
 use gpu_allocator::MemoryLocation;
@@ -57,8 +58,9 @@ impl Culling {
         let sets = [set_layout];
         let layout =
             crate::gpu::shaders::create_pipeline_layout(ctx, &sets, &ranges, "hybrid cull layout")?;
-        let pipeline = compute_pipeline(ctx, layout, module, sh::ENTRY_CS_CULL, "hybrid cull")?;
-        let thin_pipeline = compute_pipeline(
+        let pipeline =
+            create_compute_pipeline(ctx, layout, module, sh::ENTRY_CS_CULL, "hybrid cull")?;
+        let thin_pipeline = create_compute_pipeline(
             ctx,
             layout,
             module,

@@ -31,7 +31,8 @@ use crate::gpu::{Image, SharedBuffer};
 use crate::plan::{ExactMode, ExactPlan};
 use crate::render::gpu_scene::{vertex_layout, GpuScene};
 use crate::render::pipeline::{
-    create_layout, create_pipeline, ColorBlend, Depth, PipelineDesc, Stencil,
+    create_compute_pipeline, create_layout, create_pipeline, ColorBlend, Depth, PipelineDesc,
+    Stencil,
 };
 use crate::render::targets::Attachment;
 use ash::vk;
@@ -154,9 +155,10 @@ impl ExactPass {
         )?;
         let module = create_module(ctx, &sh::spirv()?, "exact.wgsl")?;
         let (receiver, caster) = graphics_pipelines(ctx, layout, module)?;
-        let build = compute_pipeline(ctx, layout, module, sh::ENTRY_CS_BUILD, "exact build")?;
+        let build =
+            create_compute_pipeline(ctx, layout, module, sh::ENTRY_CS_BUILD, "exact build")?;
         let contact =
-            compute_pipeline(ctx, layout, module, sh::ENTRY_CS_CONTACT, "contact shadows")?;
+            create_compute_pipeline(ctx, layout, module, sh::ENTRY_CS_CONTACT, "contact shadows")?;
         let (pool, sets) = allocate_sets(ctx, sh::BINDINGS, 0, set_layout, slots)?;
         let uniforms = (0..slots)
             .map(|i| {
@@ -366,52 +368,6 @@ fn graphics_pipelines(
         },
     )?;
     Ok((receiver, caster))
-}
-
-/// The compute pipeline of `module`'s entry point `entry`, named `name` (made once per context
-/// and kept by it: the caller never destroys it).
-fn compute_pipeline(
-    ctx: &Context,
-    layout: vk::PipelineLayout,
-    module: vk::ShaderModule,
-    entry: &std::ffi::CStr,
-    name: &str,
-) -> Result<vk::Pipeline, GpuError> {
-    use std::hash::{Hash, Hasher};
-    let mut h = crate::gpu::pipeline_store::hasher();
-    "compute".hash(&mut h);
-    ctx.pipelines.hash_made_of(layout, &mut h);
-    ctx.pipelines.hash_made_of(module, &mut h);
-    entry.hash(&mut h);
-    ctx.pipelines.get_or_create(h.finish(), || {
-        make_compute(ctx, layout, (module, entry), name)
-    })
-}
-
-/// Creates [`compute_pipeline`]'s pipeline the first time.
-fn make_compute(
-    ctx: &Context,
-    layout: vk::PipelineLayout,
-    (module, entry): (vk::ShaderModule, &std::ffi::CStr),
-    name: &str,
-) -> Result<vk::Pipeline, GpuError> {
-    let stage = vk::PipelineShaderStageCreateInfo::default()
-        .stage(vk::ShaderStageFlags::COMPUTE)
-        .module(module)
-        .name(entry);
-    let info = vk::ComputePipelineCreateInfo::default()
-        .stage(stage)
-        .layout(layout);
-    let p = unsafe {
-        ctx.device
-            .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
-    }
-    .map_err(|(_, e)| GpuError::Vk {
-        call: "vkCreateComputePipelines",
-        result: e,
-    })?[0];
-    ctx.set_name(p, name);
-    Ok(p)
 }
 
 impl Drop for ExactPass {
