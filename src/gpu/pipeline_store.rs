@@ -29,9 +29,11 @@ pub(crate) struct PipelineStore {
 
 #[derive(Default)]
 struct Inner {
-    /// A module's, set layout's or pipeline layout's raw handle → the hash of its definition.
-    /// A handle the driver hands out again after a destroy is noted again when it is created.
-    made_of: HashMap<u64, u64>,
+    /// A module's, set layout's or pipeline layout's type and raw handle → the hash of its
+    /// definition. The type is part of the key: Vulkan does not promise non-dispatchable handles
+    /// of different types distinct values. A handle the driver hands out again after a destroy is
+    /// noted again when it is created.
+    made_of: HashMap<(vk::ObjectType, u64), u64>,
     /// The hash of a pipeline's definition → the pipeline, once made. Each entry has a lock of
     /// its own, held while it is made: pipelines of different definitions are made in parallel
     /// (the camera pass makes its variants on several threads), one definition once.
@@ -51,12 +53,17 @@ impl PipelineStore {
 
     /// Notes what `handle` (a module, set layout or pipeline layout just created) is made of.
     pub(crate) fn note<H: vk::Handle>(&self, handle: H, definition: u64) {
-        self.lock().made_of.insert(handle.as_raw(), definition);
+        self.lock()
+            .made_of
+            .insert((H::TYPE, handle.as_raw()), definition);
     }
 
     /// What `handle` is made of (hashed), if it was noted.
     pub(crate) fn made_of<H: vk::Handle>(&self, handle: H) -> Option<u64> {
-        self.lock().made_of.get(&handle.as_raw()).copied()
+        self.lock()
+            .made_of
+            .get(&(H::TYPE, handle.as_raw()))
+            .copied()
     }
 
     /// Hashes what a module or layout is made of into `state`: its noted definition, or its handle
@@ -179,6 +186,18 @@ mod tests {
         // The driver hands handle 1 out again for other SPIR-V.
         store.note(vk::ShaderModule::from_raw(1), 43);
         assert_ne!(key(1), key(2));
+    }
+
+    /// A module and a layout that share a raw value (Vulkan allows it across types) keep their
+    /// own definitions.
+    #[test]
+    fn handles_of_different_types_are_kept_apart() {
+        let store = PipelineStore::default();
+        store.note(vk::ShaderModule::from_raw(7), 42);
+        store.note(vk::PipelineLayout::from_raw(7), 43);
+        assert_eq!(store.made_of(vk::ShaderModule::from_raw(7)), Some(42));
+        assert_eq!(store.made_of(vk::PipelineLayout::from_raw(7)), Some(43));
+        assert_eq!(store.made_of(vk::DescriptorSetLayout::from_raw(7)), None);
     }
 
     #[test]
