@@ -122,14 +122,21 @@ fn make_compute(
     let info = vk::ComputePipelineCreateInfo::default()
         .stage(stage)
         .layout(layout);
-    let p = unsafe {
+    let made = unsafe {
         ctx.device
             .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
-    }
-    .map_err(|(_, e)| GpuError::Vk {
-        call: "vkCreateComputePipelines",
-        result: e,
-    })?[0];
+    };
+    named_one(ctx, made, "vkCreateComputePipelines", name)
+}
+
+/// The one pipeline a `vkCreate*Pipelines` call `call` made, named `name`, or its error.
+fn named_one(
+    ctx: &Context,
+    made: Result<Vec<vk::Pipeline>, (Vec<vk::Pipeline>, vk::Result)>,
+    call: &'static str,
+    name: &str,
+) -> Result<vk::Pipeline, GpuError> {
+    let p = made.map_err(|(_, result)| GpuError::Vk { call, result })?[0];
     ctx.set_name(p, name);
     Ok(p)
 }
@@ -220,16 +227,11 @@ fn make_pipeline(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline, GpuErr
         .dynamic_state(&dynamic)
         .layout(d.layout)
         .push_next(&mut rendering);
-    let p = unsafe {
+    let made = unsafe {
         ctx.device
             .create_graphics_pipelines(ctx.pipeline_cache, &[info], None)
-    }
-    .map_err(|(_, e)| GpuError::Vk {
-        call: "vkCreateGraphicsPipelines",
-        result: e,
-    })?[0];
-    ctx.set_name(p, d.name);
-    Ok(p)
+    };
+    named_one(ctx, made, "vkCreateGraphicsPipelines", d.name)
 }
 
 /// One blend state per colour target; with independent blending, the last `d.masked_targets`
