@@ -357,6 +357,38 @@ def test_trimesh_meshes_and_scenes():
     r.close()
 
 
+def test_trimesh_face_colours_stay_on_their_faces():
+    import trimesh
+
+    # A square of two triangles, the lower right red and the upper left blue (trimesh's face
+    # colours): each half keeps its own colour, unblended at the shared corners.
+    p, i = quad(2.0)
+    mesh = trimesh.Trimesh(p, i, process=False)
+    mesh.visual.face_colors = [[255, 0, 0, 255], [0, 0, 255, 255]]
+    scene = umbra.Scene.from_trimesh(mesh)
+    assert scene.triangles == 2
+    r = umbra.OffscreenRenderer(W, H, validation=True)
+    camera, pose = head_on(3.0)
+    color = r.render(scene, camera, pose, background="#000000", ambient=1.0)[0].astype(int)
+    # The square spans 48.3 px a unit around (80, 60): the middles of the two halves.
+    lower_right, upper_left = color[60 + 24, 80 + 24], color[60 - 24, 80 - 24]
+    assert lower_right[0] > 200 and max(lower_right[1], lower_right[2]) < 10, lower_right
+    assert upper_left[2] > 200 and max(upper_left[0], upper_left[1]) < 10, upper_left
+    # What the conversion hands over: each face its own corners and colour; one colour on
+    # every face stays the material's, the corners shared.
+    from umbra._trimesh import to_arrays
+
+    two = to_arrays(mesh)[0]
+    assert two["positions"].shape == (6, 3) and (two["positions"] == p[i.reshape(-1)]).all()
+    assert (two["colors"] == [[255, 0, 0, 255]] * 3 + [[0, 0, 255, 255]] * 3).all()
+    mesh.visual.face_colors = [[0, 200, 0, 255], [0, 200, 0, 255]]
+    one = to_arrays(mesh)[0]
+    assert one["positions"].shape == (4, 3) and one["colors"] is None
+    assert one["base_color"] == pytest.approx([0.0, 200 / 255, 0.0, 1.0])
+    assert r.validation_problems == 0
+    r.close()
+
+
 def test_trimesh_textures_keep_their_orientation():
     import trimesh
     from PIL import Image as PILImage

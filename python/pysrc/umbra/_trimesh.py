@@ -15,9 +15,21 @@ def _mesh_arrays(mesh, pose, name):
     if kind == "vertex":
         colors = np.asarray(visual.vertex_colors, dtype=np.uint8)
     elif kind == "face":
-        # One colour per face is not a vertex attribute: the first face's, for the material.
-        c = np.asarray(visual.face_colors, dtype=np.float64)
-        if len(c):
+        c = np.asarray(visual.face_colors, dtype=np.uint8)
+        if len(c) and (c == c[0]).all():
+            # One colour for every face: the material's.
+            base = list(c[0] / 255.0)
+        elif len(c) == len(indices):
+            # Each face its own three corners, so that each keeps its own colour (the corners of
+            # a shared vertex would blend its faces' colours); normals as they were.
+            corners = indices.reshape(-1)
+            positions = positions[corners]
+            if normals is not None:
+                normals = normals[corners]
+            indices = np.arange(len(corners), dtype=np.uint32).reshape(-1, 3)
+            colors = np.repeat(c, 3, axis=0)
+        elif len(c):
+            # Colours that do not match the faces one to one: the first, for the material.
             base = list(c[0] / 255.0)
     elif kind == "texture":
         uv = getattr(visual, "uv", None)
