@@ -314,6 +314,11 @@ fn bad_arguments() {
         ),
         ("same.json", r#"[{"eye": [1, 2, 3], "target": [1, 2, 3]}]"#),
         ("empty.json", "[]"),
+        ("flat.json", "[[[1,0,0,0],[0,0,0,0],[0,0,1,5],[0,0,0,1]]]"),
+        (
+            "far.json",
+            r#"[{"eye": [0, 0, 1e30], "target": [0, 0, 0]}]"#,
+        ),
         ("one.json", &*format!("[{id}]")),
     ] {
         std::fs::write(d.join(name), text).unwrap();
@@ -324,6 +329,10 @@ fn bad_arguments() {
         (vec!["render", "--size", "0x0"], "size"),
         (vec!["render", "--camera", "7"], "camera 7"),
         (vec!["render", "--eye", "1,2,3"], "--target"),
+        (
+            vec!["render", "--eye", "0,0,1e30", "--target", "0,0,0"],
+            "--eye: its position is 1e30 from the origin",
+        ),
         (vec!["render", "--sun-dir", "0,0,0"], "zero"),
         (vec!["render", "--shadow-map", "3"], "shadow-map"),
         (vec!["render", "--shadow-budget", "150%"], "below 100%"),
@@ -354,6 +363,14 @@ fn bad_arguments() {
         (
             vec!["render", "--views", "empty.json", "-o", "v%d.png"],
             "no poses",
+        ),
+        (
+            vec!["render", "--views", "flat.json", "-o", "v%d.png"],
+            "pose 0: not a camera pose: its axes are degenerate",
+        ),
+        (
+            vec!["render", "--views", "far.json", "-o", "v%d.png"],
+            "pose 0: \"eye\": its position is 1e30 from the origin, beyond 1e18",
         ),
         (
             vec!["render", "--views", "one.json", "-o", "v.png"],

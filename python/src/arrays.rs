@@ -1,10 +1,11 @@
 //! numpy in and out: any array-like converted (`numpy.ascontiguousarray`) to the dtype a call
-//! needs and checked for shape, and frames returned as arrays of the documented shapes.
+//! needs and checked for shape, frames returned as arrays of the documented shapes, and the room
+//! a batch's stacked arrays need asked for before it renders.
 
 use glam::Mat4;
 use numpy::ndarray::{Array2, ArrayD, IxDyn};
 use numpy::{Element, IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 
 /// `obj` as a contiguous array of `dtype`: its values in C order and its shape.
@@ -109,4 +110,30 @@ pub fn image_out<'py, T: Element>(
         .expect("the values fill the shape")
         .into_pyarray(py)
         .into_any()
+}
+
+/// A MemoryError, before anything is rendered, for a batch of `n` frames whose stacked arrays
+/// of `outputs` at `w`×`h` this process cannot have (colour 3 bytes a pixel, normals 12, the
+/// others 4): allocating them after the first frame would abort the interpreter.
+pub fn check_room(outputs: &[&str], (w, h): (u32, u32), n: usize) -> PyResult<()> {
+    let per_pixel: usize = outputs
+        .iter()
+        .map(|o| match *o {
+            "color" => 3,
+            "normals" => 12,
+            _ => 4,
+        })
+        .sum();
+    let total = per_pixel
+        .saturating_mul(w as usize * h as usize)
+        .saturating_mul(n);
+    if Vec::<u8>::new().try_reserve_exact(total).is_err() {
+        return Err(PyMemoryError::new_err(format!(
+            "render_batch: {n} frames of {} at {w}x{h} take {:.1} GB as stacked arrays, more than \
+             this process can allocate: render the poses in smaller batches",
+            outputs.join(", "),
+            total as f64 / 1e9
+        )));
+    }
+    Ok(())
 }

@@ -116,16 +116,20 @@ impl OrthographicCamera {
     }
 }
 
-/// The engine camera of a Python camera object placed at `world_from_camera`, for an image of
-/// `aspect`.
+/// The world-from-view transform of the camera pose `m` given as argument `name`
+/// (`Camera::rigid_pose`: its scale left out); a ValueError naming it for a matrix that places
+/// no camera.
+pub fn camera_pose(m: glam::Mat4, name: &str) -> PyResult<glam::Mat4> {
+    Camera::rigid_pose(m).map_err(|e| PyValueError::new_err(format!("{name}: {e}")))
+}
+
+/// The engine camera of a Python camera object placed at `world_from_view` (a rigid pose, from
+/// `camera_pose`), for an image of `aspect`.
 pub fn engine_camera(
     camera: &Bound<'_, PyAny>,
-    world_from_camera: glam::Mat4,
+    world_from_view: glam::Mat4,
     aspect: f32,
 ) -> PyResult<Camera> {
-    // Scale in the pose would scale the view: keep its rotation and translation.
-    let (_, rot, pos) = world_from_camera.to_scale_rotation_translation();
-    let world_from_view = glam::Mat4::from_rotation_translation(rot, pos);
     if let Ok(p) = camera.cast::<PerspectiveCamera>() {
         let p = p.get();
         if let Some(a) = p.aspect.filter(|a| (a - aspect).abs() > 1e-3 * aspect) {

@@ -2,8 +2,8 @@
 //! camera, camera_pose)` → colour and depth), with more outputs and umbra's shadow settings. A
 //! scene is uploaded once and kept while it only moves; the GIL is released while the GPU works.
 
-use crate::arrays::{image_out, matrix4, values};
-use crate::camera::engine_camera;
+use crate::arrays::{check_room, image_out, matrix4, values};
+use crate::camera::{camera_pose, engine_camera};
 use crate::scene::PyScene;
 use crate::settings::{self, Extras};
 use crate::{gpu_error, UmbraError};
@@ -460,7 +460,7 @@ impl OffscreenRenderer {
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let names = parse_outputs(outputs)?;
-        let pose = matrix4(camera_pose, "camera_pose")?;
+        let pose = crate::camera::camera_pose(matrix4(camera_pose, "camera_pose")?, "camera_pose")?;
         let d = self.render_poses(py, scene, camera, &[pose], &names, settings, (false, false))?;
         if outputs.is_none() {
             let t = PyTuple::new(py, [d.get_item("color")?, d.get_item("depth")?])?;
@@ -494,16 +494,15 @@ impl OffscreenRenderer {
                 "poses: shape {shape:?}, expected (n, 4, 4) with n ≥ 1"
             )));
         }
-        let mut list = Vec::with_capacity(shape[0]);
-        for rows in m.chunks_exact(16) {
-            let pose = glam::Mat4::from_cols_slice(rows).transpose();
-            if !pose.is_finite() {
-                return Err(PyValueError::new_err(
-                    "poses: a pose holds a NaN or an infinity",
-                ));
-            }
-            list.push(pose);
-        }
+        check_room(&names, (self.width, self.height), shape[0])?;
+        let list = m
+            .chunks_exact(16)
+            .enumerate()
+            .map(|(i, rows)| {
+                let pose = glam::Mat4::from_cols_slice(rows).transpose();
+                camera_pose(pose, &format!("poses[{i}]"))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
         self.render_poses(
             py,
             scene,

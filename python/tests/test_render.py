@@ -231,6 +231,24 @@ def test_bad_input_raises(tmp_path):
         r.render(s, cam, pose, outputs=("colour",))
     with pytest.raises(ValueError, match="expected \\(n, 4, 4\\)"):
         r.render_batch(s, cam, np.zeros((0, 4, 4)))
+    # Matrices that place no camera: each refused in words, in a batch by its index.
+    flat, far = pose.copy(), pose.copy()
+    flat[:3, 1] = 0.0
+    far[2, 3] = 1e30
+    with pytest.raises(ValueError, match="camera_pose: its last row is 0 0 0 0"):
+        r.render(s, cam, np.zeros((4, 4)))
+    with pytest.raises(ValueError, match="camera_pose: its axes are degenerate"):
+        r.render(s, cam, flat)
+    with pytest.raises(ValueError, match="poses\\[1\\]: its position is 1e30 from the origin"):
+        r.render_batch(s, cam, np.stack([pose, far]))
+    with pytest.raises(ValueError, match="poses\\[0\\]: holds a NaN"):
+        r.render_batch(s, cam, np.full((1, 4, 4), np.nan))
+    # Stacked arrays no machine holds (100,000 frames of 16384², 188 TB): an exception before
+    # any rendering, not an aborted interpreter.
+    huge = umbra.OffscreenRenderer(16384, 16384)
+    with pytest.raises(MemoryError, match="100000 frames of color, depth at 16384x16384 take"):
+        huge.render_batch(s, cam, np.broadcast_to(pose, (100_000, 4, 4)))
+    huge.close()
     with pytest.raises(ValueError, match="alpha_mode 'GLASS'"):
         s.add_mesh(*quad(1.0), alpha_mode="glass")
     with pytest.raises(ValueError, match="texture: needs uvs"):

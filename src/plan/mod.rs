@@ -3,10 +3,11 @@
 //! and exposure, the frame's uniform block). The passes in [`crate::render`] record what a plan
 //! says; the ray-cast reference reads the same plan.
 //!
-//! In one direction: `settings`, `input`, `camera` → `views` (shadow views) → `lights`
+//! In one direction: `settings`, `input`, `camera`, `batch` → `views` (shadow views) → `lights`
 //! (shading lights, metering, their uniforms) → `frame` (the plan) ; `casters` and `uniforms`
 //! are the data the plan carries.
 
+pub(crate) mod batch;
 pub(crate) mod camera;
 pub(crate) mod casters;
 pub(crate) mod exact;
@@ -21,6 +22,7 @@ pub(crate) mod uniforms;
 pub(crate) mod view;
 pub(crate) mod views;
 
+pub use batch::ShadowBatch;
 pub use camera::{camera_projection, fitting_frustum};
 pub use casters::{flat_hides_nothing, CasterPlan, TexelRect, Viewpoint};
 pub use exact::{ExactMode, ExactPlan, CONTACT_TEXELS, CONTACT_THICKNESS};

@@ -1,6 +1,7 @@
 //! What a frame is asked to show: the `View` (camera, mode, shadow settings, exposure, tone curve,
 //! background, ambient) and what it carries across frames (`ShadowHold`).
 
+use super::batch::ShadowBatch;
 use super::settings::{PostAa, ShadowSettings, Tonemap, ViewMode, CLEAR_COLOR};
 use crate::scene::Camera;
 use glam::Vec3;
@@ -218,11 +219,12 @@ pub struct View {
     /// each frame; see [`ShadowHold`]). None: every frame fitted afresh, as a still is.
     pub shadow_hold: Option<ShadowHold>,
     /// The cameras of a batch whose views share their shadow maps (`Renderer::render_batch`
-    /// sets it): each directional light gets one map fitted to all of their frusta with the
-    /// scene (no cascades, no hold, no depth fit), the same in every view of the batch, so the
-    /// shadow cache draws it once for the whole batch. Spot and point lights' views never
-    /// depend on the camera. None: fitted to this view alone.
-    pub shadow_batch: Option<Arc<[Camera]>>,
+    /// sets it; in world coordinates, also when the view is rebased): each directional light
+    /// gets one map fitted to all of their frusta with the scene (no cascades, no hold, no depth
+    /// fit), the same in every view of the batch, so the shadow cache draws it once for the
+    /// whole batch. Spot and point lights' views never depend on the camera. None: fitted to
+    /// this view alone.
+    pub shadow_batch: Option<Arc<ShadowBatch>>,
 }
 
 /// The snapped extents a frame's directional lights used (per light: its direction, the side of
@@ -269,9 +271,6 @@ impl View {
         let mut v = self.clone();
         v.camera = v.camera.rebased(origin);
         v.shadow_fit_camera = v.shadow_fit_camera.map(|c| c.rebased(origin));
-        v.shadow_batch = v
-            .shadow_batch
-            .map(|b| b.iter().map(|c| c.rebased(origin)).collect());
         v
     }
 

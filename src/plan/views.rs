@@ -323,16 +323,15 @@ pub(super) fn directional_views(
     held: Option<&HeldLight>,
 ) -> Vec<ShadowView> {
     let bounds = scene.bounds;
-    // A batch's other cameras, whose frusta its shared map covers too.
-    let batch: Vec<CameraFrustum> = view
+    // Where a batch's cameras see the scene, which its shared map covers too (found once for
+    // the batch).
+    let also = view
         .shadow_batch
-        .iter()
-        .flat_map(|b| b.iter())
-        .map(|c| fitting_frustum(c, target.aspect, bounds))
-        .collect();
+        .as_ref()
+        .map(|b| b.receivers(scene.origin, l.direction, bounds, target.aspect));
     let fitter = Fitter {
         input: DirectionalFitInput {
-            also: &batch,
+            also,
             direction: l.direction,
             scene_bounds: *bounds,
             camera: None,
@@ -356,11 +355,11 @@ pub(super) fn directional_views(
     }
 }
 
-/// A directional light's fit for one frame: the settings, the batch's frusta and the extents
+/// A directional light's fit for one frame: the settings, the batch's receivers and the extents
 /// the light's views held the frame before.
 struct Fitter<'a> {
     /// Everything but the camera, the hold and (for a doubled map) the size.
-    input: DirectionalFitInput<'a>,
+    input: DirectionalFitInput,
     held: Option<&'a [f32]>,
 }
 

@@ -181,6 +181,9 @@ fn pose(p: &Value) -> anyhow::Result<Mat4> {
             if (target - eye).length_squared() <= 0.0 {
                 bail!("eye and target are the same point");
             }
+            for (p, name) in [(eye, "eye"), (target, "target")] {
+                Camera::check_position(p).map_err(|e| anyhow::anyhow!("\"{name}\": {e}"))?;
+            }
             Camera::look_at(eye, target, 1.0, 1.0).world_from_view
         }
         Value::Array(rows) => {
@@ -199,13 +202,8 @@ fn pose(p: &Value) -> anyhow::Result<Mat4> {
                     n.len()
                 );
             }
-            let m = Mat4::from_cols_slice(&n).transpose();
-            if !m.is_finite() || m.row(3) != glam::Vec4::W {
-                bail!("not a rigid pose (its last row must be 0 0 0 1, all finite)");
-            }
-            // Scale in the pose would scale the view: keep its rotation and translation.
-            let (_, rot, pos) = m.to_scale_rotation_translation();
-            Mat4::from_rotation_translation(rot, pos)
+            Camera::rigid_pose(Mat4::from_cols_slice(&n).transpose())
+                .map_err(|e| anyhow::anyhow!("not a camera pose: {e}"))?
         }
         _ => bail!("expected a 4×4 matrix or {{\"eye\", \"target\"}}"),
     };

@@ -202,16 +202,17 @@ pub fn frustum_box_intersection(f: &CameraFrustum, b: &Aabb) -> Vec<Vec3> {
 
 /// What a fitted directional-light projection needs.
 #[derive(Clone, Copy, Debug)]
-pub struct DirectionalFitInput<'a> {
+pub struct DirectionalFitInput {
     /// Direction the light travels (from the light into the scene).
     pub direction: Vec3,
     /// Bounds of everything that can cast or receive.
     pub scene_bounds: Aabb,
     /// The camera; `None` fits the whole scene.
     pub camera: Option<CameraFrustum>,
-    /// More cameras whose frusta the fit covers with `camera`'s (the views of a batch sharing
-    /// one map); ignored without `camera` and by the sphere fit.
-    pub also: &'a [CameraFrustum],
+    /// More receivers the fit covers with `camera`'s, as a box in the light's view space: where
+    /// the frusta of a batch's views meet the scene ([`batch_receivers`]: the views of a batch
+    /// sharing one map); ignored without `camera` and by the sphere fit.
+    pub also: Option<Aabb>,
     /// Shadow-map size in texels.
     pub map_size: u32,
     /// Quantise the extent and snap the origin to whole texels.
@@ -361,18 +362,19 @@ fn sphere_square(
 /// meets `scene`, within the scene's light-space box `scene_l`; that box itself without a camera
 /// or where they do not meet.
 fn receiver_box(input: &DirectionalFitInput, view: &Mat4, scene: &Aabb, scene_l: &Aabb) -> Aabb {
-    let receivers_world: Vec<Vec3> = match &input.camera {
-        Some(c) => std::iter::once(c)
-            .chain(input.also)
-            .flat_map(|c| frustum_box_intersection(c, scene))
-            .collect(),
-        None => Vec::new(),
+    let (seen, any) = match &input.camera {
+        Some(c) => {
+            let own = frustum_box_intersection(c, scene);
+            let also = input.also.unwrap_or(Aabb::EMPTY);
+            let seen = Aabb::from_points(own.iter().map(|p| view.transform_point3(*p)));
+            (seen.union(&also), !own.is_empty() || !also.is_empty())
+        }
+        None => (Aabb::EMPTY, false),
     };
-    let recv = if receivers_world.is_empty() {
-        *scene_l
+    let recv = if any {
+        seen.intersection(scene_l)
     } else {
-        Aabb::from_points(receivers_world.iter().map(|p| view.transform_point3(*p)))
-            .intersection(scene_l)
+        *scene_l
     };
     if recv.is_empty() {
         *scene_l
@@ -381,14 +383,34 @@ fn receiver_box(input: &DirectionalFitInput, view: &Mat4, scene: &Aabb, scene_l:
     }
 }
 
+/// The box a fit takes the scene as: its bounds, or ±1 for an empty scene.
+fn fitted_scene(bounds: &Aabb) -> Aabb {
+    if bounds.is_empty() {
+        Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))
+    } else {
+        *bounds
+    }
+}
+
+/// Where `frusta` meet the scene of `scene_bounds`, as a box in the view space of a light
+/// travelling along `direction`: [`DirectionalFitInput::also`] for a batch of views sharing
+/// one map. It depends on neither the view nor the map's size, so a batch finds it once per
+/// light rather than once per view (each finding clips every frustum of the batch).
+pub fn batch_receivers(frusta: &[CameraFrustum], scene_bounds: &Aabb, direction: Vec3) -> Aabb {
+    let view = light_view_rotation(direction);
+    let scene = fitted_scene(scene_bounds);
+    Aabb::from_points(
+        frusta
+            .iter()
+            .flat_map(|c| frustum_box_intersection(c, &scene))
+            .map(|p| view.transform_point3(p)),
+    )
+}
+
 /// Fits an orthographic light projection (see the module documentation).
 pub fn fit_directional(input: &DirectionalFitInput) -> DirectionalFit {
     let view = light_view_rotation(input.direction);
-    let scene = if input.scene_bounds.is_empty() {
-        Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))
-    } else {
-        input.scene_bounds
-    };
+    let scene = fitted_scene(&input.scene_bounds);
     let scene_l = scene.transformed(&view);
     let recv = receiver_box(input, &view, &scene, &scene_l);
     let size = input.map_size.max(1) as f32;

@@ -48,7 +48,7 @@ fn fitted_extent_at_most_scene_and_covers_receivers() {
     let cam = camera(Vec3::new(2.0, 2.0, 4.0), Vec3::new(0.0, 0.0, 0.0));
     for snap in [false, true] {
         let whole = fit_directional(&DirectionalFitInput {
-            also: &[],
+            also: None,
             direction: dir,
             scene_bounds: scene(),
             camera: None,
@@ -59,7 +59,7 @@ fn fitted_extent_at_most_scene_and_covers_receivers() {
             hold: None,
         });
         let fit = fit_directional(&DirectionalFitInput {
-            also: &[],
+            also: None,
             direction: dir,
             scene_bounds: scene(),
             camera: Some(cam),
@@ -94,7 +94,7 @@ fn fitted_extent_at_most_scene_and_covers_receivers() {
 fn snapped_fit_moves_by_whole_texels() {
     let dir = Vec3::new(-0.4, -1.0, 0.3).normalize();
     let base = fit_directional(&DirectionalFitInput {
-        also: &[],
+        also: None,
         direction: dir,
         scene_bounds: scene(),
         camera: Some(camera(Vec3::new(3.0, 4.0, 9.0), Vec3::ZERO)),
@@ -107,7 +107,7 @@ fn snapped_fit_moves_by_whole_texels() {
     for i in 1..20 {
         let dx = i as f32 * base.texel_world * 0.09;
         let moved = fit_directional(&DirectionalFitInput {
-            also: &[],
+            also: None,
             direction: dir,
             scene_bounds: scene(),
             camera: Some(camera(
@@ -183,7 +183,7 @@ fn sphere_fit_keeps_its_size_as_the_camera_moves_and_turns() {
             ..camera(eye, target)
         };
         let f = fit_directional(&DirectionalFitInput {
-            also: &[],
+            also: None,
             direction: dir,
             scene_bounds: scene(),
             camera: Some(cam),

@@ -7,7 +7,7 @@ use super::{RenderedFrame, Renderer};
 use crate::gpu::context::GpuError;
 use crate::plan::settings::ViewMode;
 use crate::plan::view::View;
-use crate::plan::FramePlan;
+use crate::plan::{FramePlan, ShadowBatch};
 use crate::scene::{Camera, LightKind};
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -184,9 +184,10 @@ impl Renderer {
                 .plan(v, width.saturating_mul(s), height.saturating_mul(s))
         };
         let cameras: Arc<[Camera]> = views.iter().map(|v| v.camera).collect();
+        let batch = Arc::new(ShadowBatch::new(cameras));
         let share = |v: &View, size: u32| {
             let mut v = v.clone();
-            v.shadow_batch = Some(cameras.clone());
+            v.shadow_batch = Some(batch.clone());
             v.shadow.map_size = size;
             v
         };

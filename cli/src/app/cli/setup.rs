@@ -269,6 +269,8 @@ fn camera_of(scene: &Scene, a: &ViewArgs, aspect: f32) -> anyhow::Result<Camera>
             } else {
                 (b.diagonal() * 1e-4).max(1e-4)
             };
+            Camera::check_position(eye).map_err(|e| anyhow!("--eye: {e}"))?;
+            Camera::check_position(target).map_err(|e| anyhow!("--target: {e}"))?;
             Camera::look_at(eye, target, 45f32.to_radians(), near)
         }
         (Some(_), None, _) | (None, Some(_), _) => bail!("--eye and --target go together"),
